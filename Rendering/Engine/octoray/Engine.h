@@ -1,0 +1,59 @@
+// The engine: one octree built from points on one backend. Both backends
+// run the same per-point and per-node functions (OctreeKernels.h); they
+// differ only in where memory lives and how loops are launched.
+#pragma once
+
+#include "Octree.h"
+#include "PointCloud.h"
+
+#include <memory>
+#include <string>
+
+namespace octoray
+{
+enum class Backend
+{
+  CPU,
+  CUDA
+};
+
+const char* ToString(Backend backend);
+
+class Engine
+{
+public:
+  virtual ~Engine() = default;
+
+  virtual Backend Kind() const = 0;
+  // E.g. "CPU (2 threads)" or "CUDA (NVIDIA H100 80GB HBM3)".
+  virtual std::string Description() const = 0;
+
+  // Builds the octree of `points`, replacing any previous one. Throws Error
+  // for empty input, a non-finite coordinate (naming the first such point),
+  // an unsupported option or exhausted memory; the previous octree is then
+  // left as it was.
+  virtual BuildStats Build(const PointCloudView& points, const BuildOptions& options) = 0;
+
+  // Moves points (all, or those listed in positions.indices). The result is
+  // the octree a Build from the new positions would give: the same nodes and
+  // counts, the same means within float rounding. While every point stays
+  // in the root cube the cube is kept; when one leaves, the octree is
+  // rebuilt around the new bounds (UpdateStats::Path::NewCube) at the same
+  // depth. Throws Error for a non-finite coordinate or an index out of range.
+  virtual UpdateStats Update(const PositionsView& positions) = 0;
+
+  virtual std::size_t PointCount() const = 0;
+  virtual void CopyToHost(HostOctree& out) const = 0;
+  virtual MemoryReport Memory() const = 0;
+
+  // Threads the CPU backend uses (ignored by CUDA); default: all cores.
+  virtual void SetThreadCount(int threads) { (void)threads; }
+};
+
+// The backend's engine. Throws Error when the backend is not available here
+// (CUDA not compiled in, or no usable device), saying why.
+std::unique_ptr<Engine> CreateEngine(Backend backend);
+
+// Whether CreateEngine(Backend::CUDA) would succeed; if not, why.
+bool CudaAvailable(std::string* why = nullptr);
+}

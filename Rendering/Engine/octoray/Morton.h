@@ -1,0 +1,55 @@
+// 63-bit Morton keys: 21 bits per axis, x in the lowest bit of each triple.
+#pragma once
+
+#include "Config.h"
+
+namespace octoray
+{
+// Spreads the low 21 bits of v so that bit i lands on bit 3i.
+OCTORAY_HD std::uint64_t SpreadBits3(std::uint64_t v)
+{
+  v &= 0x1FFFFFull;
+  v = (v | (v << 32)) & 0x1F00000000FFFFull;
+  v = (v | (v << 16)) & 0x1F0000FF0000FFull;
+  v = (v | (v << 8)) & 0x100F00F00F00F00Full;
+  v = (v | (v << 4)) & 0x10C30C30C30C30C3ull;
+  v = (v | (v << 2)) & 0x1249249249249249ull;
+  return v;
+}
+
+// Inverse of SpreadBits3: gathers bits 0, 3, 6, ... into the low 21 bits.
+OCTORAY_HD std::uint32_t CompactBits3(std::uint64_t v)
+{
+  v &= 0x1249249249249249ull;
+  v = (v ^ (v >> 2)) & 0x10C30C30C30C30C3ull;
+  v = (v ^ (v >> 4)) & 0x100F00F00F00F00Full;
+  v = (v ^ (v >> 8)) & 0x1F0000FF0000FFull;
+  v = (v ^ (v >> 16)) & 0x1F00000000FFFFull;
+  v = (v ^ (v >> 32)) & 0x1FFFFFull;
+  return static_cast<std::uint32_t>(v);
+}
+
+OCTORAY_HD std::uint64_t EncodeMorton(std::uint32_t x, std::uint32_t y, std::uint32_t z)
+{
+  return SpreadBits3(x) | (SpreadBits3(y) << 1) | (SpreadBits3(z) << 2);
+}
+
+OCTORAY_HD void DecodeMorton(std::uint64_t key, std::uint32_t& x, std::uint32_t& y, std::uint32_t& z)
+{
+  x = CompactBits3(key);
+  y = CompactBits3(key >> 1);
+  z = CompactBits3(key >> 2);
+}
+
+// The key of the level-`level` ancestor of a full-depth (level 21) key.
+OCTORAY_HD std::uint64_t AncestorKey(std::uint64_t fullKey, int level)
+{
+  return fullKey >> (3 * (kMaxLevel - level));
+}
+
+// Which of its parent's eight octants a node occupies (bit 0: +x, 1: +y, 2: +z).
+OCTORAY_HD int OctantOf(std::uint64_t key)
+{
+  return static_cast<int>(key & 7u);
+}
+}

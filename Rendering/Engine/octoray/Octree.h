@@ -1,0 +1,164 @@
+// The compact sparse octree: every level 0..depth stored breadth-first, each
+// level sorted by its Morton key, as structure-of-arrays. Nodes exist only
+// where points are, so memory is linear in occupied nodes and the whole
+// layout is fixed by the sorted keys (both backends produce identical
+// topology arrays).
+#pragma once
+
+#include "Config.h"
+#include "Morton.h"
+#include "RootCube.h"
+#include "Types.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace octoray
+{
+// Plain pointers into the node arrays (host or device memory). Attribute
+// pointers are null when the input lacked that attribute.
+struct OctreeView
+{
+  int depth = 0;                                 // leaves live at this level
+  std::uint32_t nodeCount = 0;
+  std::uint32_t levelBegin[kMaxLevel + 2] = {};  // nodes of level l: [levelBegin[l], levelBegin[l+1])
+  unsigned attributes = 0;                       // AttributeBits present
+  RootCube cube;
+
+  std::uint64_t* key = nullptr;        // level-local key: 3*level bits
+  std::uint8_t* childMask = nullptr;   // bit o set: child in octant o exists
+  std::uint32_t* firstChild = nullptr; // global index of the first child; kInvalidIndex for leaves
+  std::uint32_t* parent = nullptr;     // kInvalidIndex for the root
+  std::uint32_t* pointCount = nullptr;
+  Rgba* color = nullptr;               // averaged colour
+  float* scalar = nullptr;
+  float* reflectivity = nullptr;
+  float* refraction = nullptr;
+  Vec3f* normal = nullptr;             // averaged, normalised; zero where normals cancel
+
+  OCTORAY_HD std::uint32_t LevelSize(int level) const
+  {
+    return levelBegin[level + 1] - levelBegin[level];
+  }
+
+  // Global index of the child in `octant`, or kInvalidIndex when absent.
+  OCTORAY_HD std::uint32_t Child(std::uint32_t node, int octant) const
+  {
+    const unsigned mask = childMask[node];
+    if (!(mask & (1u << octant)))
+    {
+      return kInvalidIndex;
+    }
+    const unsigned before = mask & ((1u << octant) - 1u);
+    unsigned rank = 0;
+#if OCTORAY_DEVICE_CODE && defined(__CUDA_ARCH__)
+    rank = __popc(before);
+#else
+    rank = static_cast<unsigned>(__builtin_popcount(before));
+#endif
+    return firstChild[node] + rank;
+  }
+
+  // Binary search for a node of `level` by its level-local key.
+  OCTORAY_HD std::uint32_t Find(int level, std::uint64_t levelKey) const
+  {
+    std::uint32_t lo = levelBegin[level];
+    std::uint32_t hi = levelBegin[level + 1];
+    while (lo < hi)
+    {
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      if (key[mid] < levelKey)
+      {
+        lo = mid + 1;
+      }
+      else
+      {
+        hi = mid;
+      }
+    }
+    return (lo < levelBegin[level + 1] && key[lo] == levelKey) ? lo : kInvalidIndex;
+  }
+};
+
+// The octree in host memory (what tests and the VTK layer inspect).
+struct HostOctree
+{
+  int depth = 0;
+  std::vector<std::uint32_t> levelBegin;
+  unsigned attributes = 0;
+  RootCube cube;
+  std::vector<std::uint64_t> key;
+  std::vector<std::uint8_t> childMask;
+  std::vector<std::uint32_t> firstChild;
+  std::vector<std::uint32_t> parent;
+  std::vector<std::uint32_t> pointCount;
+  std::vector<Rgba> color;
+  std::vector<float> scalar;
+  std::vector<float> reflectivity;
+  std::vector<float> refraction;
+  std::vector<Vec3f> normal;
+
+  std::size_t NodeCount() const { return key.size(); }
+  // Resizes every array for `nodes` nodes (attribute arrays only if present).
+  void Allocate(std::size_t nodes, unsigned attributeBits);
+  OctreeView View();
+};
+
+// Bytes held by the engine, one entry per array.
+struct MemoryReport
+{
+  std::vector<std::pair<std::string, std::size_t>> arrays;
+  std::size_t Total() const
+  {
+    std::size_t total = 0;
+    for (const auto& a : arrays)
+    {
+      total += a.second;
+    }
+    return total;
+  }
+  void Add(const std::string& name, std::size_t bytes)
+  {
+    if (bytes)
+    {
+      arrays.emplace_back(name, bytes);
+    }
+  }
+};
+
+struct BuildOptions
+{
+  // Leaf level 1..21, or 0 to choose it from the data (see ChooseDepth).
+  int depth = 0;
+};
+
+struct BuildStats
+{
+  std::size_t points = 0;
+  int depth = 0;
+  std::vector<std::uint32_t> nodesPerLevel;
+  std::size_t nodes = 0;
+  std::size_t bytes = 0;     // MemoryReport::Total() after the build
+  double seconds = 0.0;      // whole build, wall clock
+  double keySeconds = 0.0;   // bounds and Morton keys
+  double sortSeconds = 0.0;  // radix sort of (key, index)
+  double levelSeconds = 0.0; // unique keys per level, links and averages
+};
+
+struct UpdateStats
+{
+  std::size_t moved = 0;        // points given new positions
+  std::size_t changedLeaf = 0;  // of those, points that left their leaf
+  enum class Path
+  {
+    Unchanged,     // no point left its leaf: nothing to do
+    InPlace,       // same nodes: counts and averages adjusted along the moved points' paths
+    Relevel,       // nodes appeared or vanished: points re-sorted, levels rebuilt in the same buffers
+    NewCube        // a point left the root cube: full rebuild around the new bounds
+  } path = Path::Unchanged;
+  double seconds = 0.0;
+};
+
+const char* ToString(UpdateStats::Path path);
+}

@@ -1,0 +1,98 @@
+#include "RadixSort.h"
+
+#include "Parallel.h"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+namespace octoray
+{
+void RadixSortPairs(std::uint64_t* keys, std::uint32_t* values, std::size_t n, int bits, int threads,
+  std::vector<std::uint64_t>& scratchKeys, std::vector<std::uint32_t>& scratchValues)
+{
+  if (n < 2 || bits <= 0)
+  {
+    return;
+  }
+  // 11-bit digits keep a pass's histogram (2048 counters per thread) in L1
+  // while needing only 6 passes for 63-bit keys; the digit width is evened
+  // out over the passes so that e.g. 30 bits take 3 passes of 10.
+  const int passes = (bits + 10) / 11;
+  const int digitBits = (bits + passes - 1) / passes;
+  const std::size_t buckets = std::size_t(1) << digitBits;
+  const std::uint64_t digitMask = buckets - 1;
+
+  scratchKeys.resize(n);
+  scratchValues.resize(n);
+  std::uint64_t* srcK = keys;
+  std::uint32_t* srcV = values;
+  std::uint64_t* dstK = scratchKeys.data();
+  std::uint32_t* dstV = scratchValues.data();
+
+  const int chunks = n < 65536 ? 1 : threads;
+  std::vector<std::size_t> histogram(static_cast<std::size_t>(chunks) * buckets);
+
+  for (int pass = 0; pass < passes; ++pass)
+  {
+    const int shift = pass * digitBits;
+    std::fill(histogram.begin(), histogram.end(), 0);
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::size_t* h = histogram.data() + c * buckets;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        ++h[(srcK[i] >> shift) & digitMask];
+      }
+    });
+    // Skip a pass in which every key has the same digit: it would only copy.
+    bool trivial = false;
+    for (std::size_t d = 0; d < buckets; ++d)
+    {
+      std::size_t total = 0;
+      for (int c = 0; c < chunks; ++c)
+      {
+        total += histogram[c * buckets + d];
+      }
+      if (total == n)
+      {
+        trivial = true;
+      }
+      if (total)
+      {
+        break;
+      }
+    }
+    if (trivial)
+    {
+      continue;
+    }
+    // Exclusive offsets, digit-major then chunk: keeps the sort stable.
+    std::size_t running = 0;
+    for (std::size_t d = 0; d < buckets; ++d)
+    {
+      for (int c = 0; c < chunks; ++c)
+      {
+        const std::size_t count = histogram[c * buckets + d];
+        histogram[c * buckets + d] = running;
+        running += count;
+      }
+    }
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::size_t* offset = histogram.data() + c * buckets;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        const std::size_t slot = offset[(srcK[i] >> shift) & digitMask]++;
+        dstK[slot] = srcK[i];
+        dstV[slot] = srcV[i];
+      }
+    });
+    std::swap(srcK, dstK);
+    std::swap(srcV, dstV);
+  }
+  if (srcK != keys)
+  {
+    std::memcpy(keys, srcK, n * sizeof(std::uint64_t));
+    std::memcpy(values, srcV, n * sizeof(std::uint32_t));
+  }
+}
+}
