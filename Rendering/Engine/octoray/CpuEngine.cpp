@@ -98,20 +98,17 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
   const std::size_t n = points.count;
 
   // Bounds, and the first non-finite point, before anything is replaced.
+  constexpr double inf = std::numeric_limits<double>::infinity();
   struct ChunkBounds
   {
-    double lo[3], hi[3];
-    std::size_t firstBad;
+    double lo[3] = { inf, inf, inf };
+    double hi[3] = { -inf, -inf, -inf };
+    std::size_t firstBad = std::numeric_limits<std::size_t>::max();
   };
+  // One entry per thread; a small input may use fewer chunks.
   std::vector<ChunkBounds> chunkBounds(Threads);
   ParallelChunks(n, Threads, [&](std::size_t begin, std::size_t end, int c) {
     ChunkBounds b;
-    for (int a = 0; a < 3; ++a)
-    {
-      b.lo[a] = std::numeric_limits<double>::infinity();
-      b.hi[a] = -std::numeric_limits<double>::infinity();
-    }
-    b.firstBad = std::numeric_limits<std::size_t>::max();
     for (std::size_t i = begin; i < end; ++i)
     {
       const double p[3] = { points.Coordinate(i, 0), points.Coordinate(i, 1), points.Coordinate(i, 2) };
@@ -146,6 +143,23 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
     {
       lo[a] = std::min(lo[a], b.lo[a]);
       hi[a] = std::max(hi[a], b.hi[a]);
+    }
+  }
+
+  if (options.fixedCube)
+  {
+    // Checked before anything is replaced, like the coordinates.
+    std::uint32_t cell[3];
+    if (!options.cube.GridCell(lo[0], lo[1], lo[2], cell) || !options.cube.GridCell(hi[0], hi[1], hi[2], cell))
+    {
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const double p[3] = { points.Coordinate(i, 0), points.Coordinate(i, 1), points.Coordinate(i, 2) };
+        if (!options.cube.GridCell(p[0], p[1], p[2], cell))
+        {
+          throw Error(OutsideCubeMessage(i, p));
+        }
+      }
     }
   }
 
@@ -202,7 +216,8 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
   }
   Attributes = points.Attributes();
 
-  BuildStats stats = BuildFromPointState(RootCube::FromBounds(lo, hi), options.depth);
+  BuildStats stats =
+    BuildFromPointState(options.fixedCube ? options.cube : RootCube::FromBounds(lo, hi), options.depth);
   stats.seconds = SecondsSince(start);
   return stats;
 }
@@ -221,7 +236,7 @@ BuildStats CpuEngine::BuildFromPointState(const RootCube& cube, int requestedDep
     {
       double p[3];
       pts.Position(i, p);
-      throw Error(NonFinitePointMessage(i, p) + " or lies outside the root cube");
+      throw Error(OutsideCubeMessage(i, p));
     }
   });
   stats.keySeconds = SecondsSince(phase);

@@ -74,6 +74,13 @@ std::string NonFinitePointMessage(std::size_t index, const double p[3])
   return s.str();
 }
 
+std::string OutsideCubeMessage(std::size_t index, const double p[3])
+{
+  std::ostringstream s;
+  s << "octoray: point " << index << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") lies outside the root cube";
+  return s.str();
+}
+
 std::string OutOfMemoryMessage(const char* what, std::size_t bytesNeeded, std::size_t bytesFree)
 {
   std::ostringstream s;
