@@ -4,6 +4,7 @@
 #include "CpuEngine.h"
 
 #include "DepthChoice.h"
+#include "Frame.h"
 #include "OctreeKernels.h"
 #include "Parallel.h"
 #include "RadixSort.h"
@@ -534,6 +535,44 @@ UpdateStats CpuEngine::Update(const PositionsView& positions)
     RadixSortPairs(SortedKey.data(), SortedIndex.data(), Count, 3 * depth, Threads, ScratchKey, ScratchIndex);
     BuildLevels(Tree.cube, depth);
     stats.path = UpdateStats::Path::Relevel;
+  }
+  stats.seconds = SecondsSince(start);
+  return stats;
+}
+
+RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
+{
+  if (Count == 0)
+  {
+    throw Error("octoray: render before any build");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const OctreeView view = Tree.View();
+  const FrameConstants frame = MakeFrame(settings, Tree.cube, view.reflectivity != nullptr);
+  image.width = settings.width;
+  image.height = settings.height;
+  const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
+  image.rgba.resize(4 * pixels);
+  image.depth.resize(pixels);
+  // Rows are interleaved over threads so that costly regions are shared.
+  std::vector<std::size_t> secondary(Threads, 0);
+  ParallelChunks(static_cast<std::size_t>(Threads), Threads, [&](std::size_t, std::size_t, int t) {
+    std::size_t rays = 0;
+    for (int y = t; y < settings.height; y += Threads)
+    {
+      for (int x = 0; x < settings.width; ++x)
+      {
+        const std::size_t i = static_cast<std::size_t>(y) * settings.width + x;
+        RenderPixel(frame, view, x, y, &image.rgba[4 * i], image.depth[i], rays);
+      }
+    }
+    secondary[t] = rays;
+  });
+  RenderStats stats;
+  stats.primaryRays = pixels;
+  for (std::size_t r : secondary)
+  {
+    stats.secondaryRays += r;
   }
   stats.seconds = SecondsSince(start);
   return stats;

@@ -6,6 +6,7 @@
 #include "CudaEngine.h"
 
 #include "DepthChoice.h"
+#include "Frame.h"
 #include "OctreeKernels.h"
 
 #include <cub/device/device_radix_sort.cuh>
@@ -239,6 +240,26 @@ __global__ void MovedKeysKernel(PointArraysView pts, RootCube cube, int leafShif
       atomicAdd(changedLeaf, 1ull);
     }
     pointKey[i] = key;
+  }
+}
+
+__global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, float* depth,
+  unsigned long long* secondaryRays)
+{
+  const int x = blockIdx.x * blockDim.x + threadIdx.x;
+  const int y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x >= f.width || y >= f.height)
+  {
+    return;
+  }
+  const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
+  std::size_t rays = 0;
+  float pixel[4];
+  RenderPixel(f, tree, x, y, pixel, depth[i], rays);
+  reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
+  if (rays)
+  {
+    atomicAdd(secondaryRays, static_cast<unsigned long long>(rays));
   }
 }
 
@@ -669,6 +690,50 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
     stats.path = UpdateStats::Path::Relevel;
   }
   stats.seconds = SecondsSince(start);
+  return stats;
+}
+
+RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
+{
+  const DeviceState& s = *State;
+  if (s.count == 0)
+  {
+    throw Error("octoray: render before any build");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const OctreeView view = s.View();
+  FrameConstants frame = MakeFrame(settings, s.cube, view.reflectivity != nullptr);
+  const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
+  if (frame.transfer)
+  {
+    Upload(Pool, Transfer, settings.transfer.table.data(), settings.transfer.table.size(), "transfer function");
+    frame.transfer = Transfer.Get();
+  }
+  if (frame.depthBuffer)
+  {
+    Upload(Pool, DepthIn, settings.depthBuffer.data(), pixels, "depth buffer");
+    frame.depthBuffer = DepthIn.Get();
+  }
+  ImageRgba.Reserve(Pool, 4 * pixels, "image colours");
+  ImageDepth.Reserve(Pool, pixels, "image depth");
+  DeviceBuffer<unsigned long long> counter;
+  counter.Reserve(Pool, 1, "counters");
+  CudaCheck(cudaMemset(counter.Get(), 0, sizeof(unsigned long long)), "cudaMemset");
+  const dim3 block(16, 8);
+  const dim3 grid((settings.width + block.x - 1) / block.x, (settings.height + block.y - 1) / block.y);
+  RenderKernel<<<grid, block>>>(frame, view, ImageRgba.Get(), ImageDepth.Get(), counter.Get());
+  CudaCheckLaunch("RenderKernel");
+  CudaCheck(cudaDeviceSynchronize(), "RenderKernel");
+  RenderStats stats;
+  stats.primaryRays = pixels;
+  unsigned long long secondary = 0;
+  CudaCheck(cudaMemcpy(&secondary, counter.Get(), sizeof(secondary), cudaMemcpyDeviceToHost), "RenderKernel");
+  stats.secondaryRays = secondary;
+  stats.seconds = SecondsSince(start); // the frame on the device, before the copy to the host
+  image.width = settings.width;
+  image.height = settings.height;
+  Download(ImageRgba, image.rgba);
+  Download(ImageDepth, image.depth);
   return stats;
 }
 

@@ -19,6 +19,7 @@ public:
   std::string Description() const override;
   BuildStats Build(const PointCloudView& points, const BuildOptions& options) override;
   UpdateStats Update(const PositionsView& positions) override;
+  RenderStats Render(const RenderSettings& settings, Image& image) override;
   std::size_t PointCount() const override { return State->count; }
   void CopyToHost(HostOctree& out) const override;
   MemoryReport Memory() const override;
@@ -70,5 +71,8 @@ private:
   DeviceBuffer<std::uint32_t> SortIndex[2];
   DeviceBuffer<std::uint32_t> Starts;
   DeviceBuffer<unsigned char> CubScratch;
+  // Per-frame buffers, kept while the viewport keeps its size.
+  DeviceBuffer<Rgba> Transfer;
+  DeviceBuffer<float> DepthIn, ImageRgba, ImageDepth;
 };
 }

@@ -5,6 +5,7 @@
 
 #include "Octree.h"
 #include "PointCloud.h"
+#include "Render.h"
 
 #include <memory>
 #include <string>
@@ -41,6 +42,10 @@ public:
   // rebuilt around the new bounds (UpdateStats::Path::NewCube) at the same
   // depth. Throws Error for a non-finite coordinate or an index out of range.
   virtual UpdateStats Update(const PositionsView& positions) = 0;
+
+  // Ray-traces the octree into `image` (resized to the viewport). Throws
+  // Error for settings that cannot make a picture or before any build.
+  virtual RenderStats Render(const RenderSettings& settings, Image& image) = 0;
 
   virtual std::size_t PointCount() const = 0;
   virtual void CopyToHost(HostOctree& out) const = 0;
