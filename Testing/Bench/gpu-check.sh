@@ -12,10 +12,10 @@ mkdir -p "$out"
 status=()
 step() { # name, command...
   local name=$1; shift
-  local t0=$(date +%s.%N)
+  local t0=$(date +%s%N)
   if "$@" >"$out/$name.log" 2>&1; then r=pass; else r=FAIL; fi
-  local t1=$(date +%s.%N)
-  status+=("$(printf '%-22s %-5s %6.1f s' "$name" "$r" "$(echo "$t1 - $t0" | bc)")")
+  local t1=$(date +%s%N)
+  status+=("$(printf '%-22s %-5s %6d ms' "$name" "$r" "$(( (t1 - t0) / 1000000 ))")")
   tail -n 5 "$out/$name.log"
 }
 

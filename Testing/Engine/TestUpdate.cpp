@@ -138,7 +138,8 @@ TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
     to.insert(to.end(), { c.xyz[3 * target], c.xyz[3 * target + 1], c.xyz[3 * target + 2] });
   }
   const UpdateStats s = MoveAndCheck(GetParam(), *engine, c, idx, to);
-  EXPECT_EQ(s.path, UpdateStats::Path::InPlace);
+  // The CUDA backend has no in-place path yet: it re-sorts (see Engine.h).
+  EXPECT_EQ(s.path, GetParam() == Backend::CPU ? UpdateStats::Path::InPlace : UpdateStats::Path::Relevel);
   EXPECT_GT(s.changedLeaf, 10u);
 }
 

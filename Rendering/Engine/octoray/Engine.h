@@ -36,11 +36,16 @@ public:
   virtual BuildStats Build(const PointCloudView& points, const BuildOptions& options) = 0;
 
   // Moves points (all, or those listed in positions.indices). The result is
-  // the octree a Build from the new positions would give: the same nodes and
-  // counts, the same means within float rounding. While every point stays
-  // in the root cube the cube is kept; when one leaves, the octree is
-  // rebuilt around the new bounds (UpdateStats::Path::NewCube) at the same
-  // depth. Throws Error for a non-finite coordinate or an index out of range.
+  // the octree a Build from the new positions in the same root cube would
+  // give: the same nodes and counts, the same means within float rounding.
+  // Points that stay in their leaf cost nothing; when points change leaf
+  // but no node appears or empties, the CPU backend adjusts counts and means
+  // along their paths (cost proportional to the points moved); otherwise the
+  // stored keys are re-sorted and the levels rebuilt in the same buffers
+  // (the CUDA backend always takes this path for now). When a point leaves
+  // the root cube, the octree is rebuilt around the new bounds
+  // (UpdateStats::Path::NewCube) at the same depth. Throws Error for a
+  // non-finite coordinate or an index out of range, before changing anything.
   virtual UpdateStats Update(const PositionsView& positions) = 0;
 
   // Ray-traces the octree into `image` (resized to the viewport). Throws
