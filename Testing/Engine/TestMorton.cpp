@@ -75,3 +75,22 @@ TEST(DepthChoice, SharedLevelsOfNeighbouringKeys)
   // Keys that differ in the top triple share only the root.
   EXPECT_EQ(SharedLevels(0, 1ull << 62), 0);
 }
+
+#include <octoray/RenderKernels.h>
+
+TEST(PortablePow, AgreesWithLibmToAFewUlps)
+{
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<float> base(1e-6f, 1.0f), exponent(0.0f, 200.0f);
+  for (int i = 0; i < 100000; ++i)
+  {
+    const float b = base(rng), e = exponent(rng);
+    const double exact = std::pow(double(b), double(e));
+    if (exact < 1e-30)
+      continue;
+    EXPECT_NEAR(PortablePow(b, e) / exact, 1.0, 2e-5) << b << "^" << e;
+  }
+  EXPECT_EQ(PortablePow(0.0f, 2.0f), 0.0f);
+  EXPECT_NEAR(PortablePow(0.5f, 1.0f), 0.5f, 1e-7f);
+  EXPECT_NEAR(PortablePow(1.0f, 1e4f), 1.0f, 1e-6f);
+}

@@ -142,6 +142,39 @@ OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, doub
   return true;
 }
 
+// b^e for b > 0 from +, -, *, / and exact exponent manipulation only, so
+// that the CPU and CUDA backends round it alike (their libm powf do not
+// agree to the last bit, and a composite ray compounds that over hundreds of
+// voxels). Accurate to a few float ulps.
+OCTORAY_HD float PortablePow(float b, float e)
+{
+  if (!(b > 0.0f))
+  {
+    return 0.0f;
+  }
+  int exponent;
+  const float m = frexpf(b, &exponent); // b = m 2^exponent, m in [0.5, 1)
+  // log2(m) = 2 atanh(s) / ln 2 with s = (m - 1) / (m + 1) in [-1/3, 0).
+  const float s = (m - 1.0f) / (m + 1.0f);
+  const float s2 = s * s;
+  const float series =
+    s * (1.0f + s2 * (1.0f / 3 + s2 * (1.0f / 5 + s2 * (1.0f / 7 + s2 * (1.0f / 9 + s2 * (1.0f / 11 + s2 / 13))))));
+  const float x = e * (static_cast<float>(exponent) + 2.0f * series * 1.44269504f); // e log2(b)
+  if (x < -149.0f)
+  {
+    return 0.0f;
+  }
+  if (x > 128.0f)
+  {
+    return INFINITY;
+  }
+  const float whole = floorf(x);
+  const float y = (x - whole) * 0.693147181f; // 2^f = e^y, y in [0, ln 2)
+  const float p =
+    1.0f + y * (1.0f + y * (0.5f + y * (1.0f / 6 + y * (1.0f / 24 + y * (1.0f / 120 + y * (1.0f / 720 + y / 5040))))));
+  return ldexpf(p, static_cast<int>(whole));
+}
+
 OCTORAY_HD float Dot(const float a[3], const float b[3])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -301,7 +334,7 @@ OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, co
     }
     const float r[3] = { 2.0f * nl * n[0] - l[0], 2.0f * nl * n[1] - l[1], 2.0f * nl * n[2] - l[2] };
     const float rv = Dot(r, view);
-    const float spec = rv > 0.0f ? f.specular * powf(rv, f.specularPower) : 0.0f;
+    const float spec = rv > 0.0f ? f.specular * PortablePow(rv, f.specularPower) : 0.0f;
     for (int a = 0; a < 3; ++a)
     {
       lit[a] += color[a] * (f.diffuse * nl * (&base.r)[a] + spec);
@@ -336,7 +369,7 @@ struct BlendVisitor
       {
         const Rgba c = NodeColor(*f, *tree, hit.node);
         // Opacity is given per unit distance; correct it for this length.
-        const float alpha = 1.0f - powf(1.0f - fminf(fmaxf(c.a, 0.0f), 1.0f), dt / f->opacityUnitDistance);
+        const float alpha = 1.0f - PortablePow(1.0f - fminf(fmaxf(c.a, 0.0f), 1.0f), dt / f->opacityUnitDistance);
         const float w = (1.0f - rgba[3]) * alpha;
         rgba[0] += w * c.r, rgba[1] += w * c.g, rgba[2] += w * c.b, rgba[3] += w;
         any = true;
