@@ -26,8 +26,9 @@ test: build
 demo: build
 	$(BUILD)/bin/octoray stats Data/Particles/bunny.xyzrgb
 
+# --verbose: the benchmarks' tables are the output wanted, pass or fail.
 bench: build
-	cd $(BUILD) && ctest --output-on-failure -L bench
+	cd $(BUILD) && ctest --verbose -L bench
 
 clean:
 	rm -rf $(BUILD)
