@@ -24,7 +24,7 @@ test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench
 
 demo: build
-	$(BUILD)/bin/octoray stats Data/Particles/bunny.xyzrgb
+	$(BUILD)/bin/octoray stats Data/Particles/lidar_simple.particles
 
 # --verbose: the benchmarks' tables are the output wanted, pass or fail.
 bench: build
