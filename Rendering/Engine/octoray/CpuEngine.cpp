@@ -548,7 +548,7 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
   }
   const auto start = std::chrono::steady_clock::now();
   const OctreeView view = Tree.View();
-  const FrameConstants frame = MakeFrame(settings, Tree.cube, view.reflectivity != nullptr);
+  const FrameConstants frame = MakeFrame(settings, Tree.cube, view.reflectivity != nullptr || view.refraction != nullptr);
   image.width = settings.width;
   image.height = settings.height;
   const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;

@@ -702,7 +702,7 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   }
   const auto start = std::chrono::steady_clock::now();
   const OctreeView view = s.View();
-  FrameConstants frame = MakeFrame(settings, s.cube, view.reflectivity != nullptr);
+  FrameConstants frame = MakeFrame(settings, s.cube, view.reflectivity != nullptr || view.refraction != nullptr);
   const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
   if (frame.transfer)
   {

@@ -85,7 +85,7 @@ double Distance(const double a[3], const double b[3])
 }
 }
 
-FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool treeHasReflectivity)
+FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool secondaryRays)
 {
   if (s.width <= 0 || s.height <= 0)
   {
@@ -130,7 +130,7 @@ FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool tre
   f.specularPower = s.specularPower;
   f.depthCue = s.depthCue;
   f.shadows = s.shadows && !s.lights.empty() && s.shade == ShadeMode::Phong;
-  f.maxBounces = treeHasReflectivity ? s.maxBounces : 0;
+  f.maxBounces = secondaryRays ? s.maxBounces : 0;
   f.lodPixels = s.lodPixels;
   f.opacityUnitDistance = s.opacityUnitDistance > 0 ? s.opacityUnitDistance / static_cast<float>(cube.size) : 1.0f;
 

@@ -11,7 +11,9 @@ namespace octoray
 // singular camera matrix, a depth buffer of the wrong size, too many lights).
 // Table and depth-buffer pointers are the host vectors of `settings`; a
 // device backend replaces them with device copies.
-FrameConstants MakeFrame(const RenderSettings& settings, const RootCube& cube, bool treeHasReflectivity);
+// `secondaryRays`: whether any node reflects or refracts; without, the
+// frame casts no mirror or refracted rays whatever the bounce limit.
+FrameConstants MakeFrame(const RenderSettings& settings, const RootCube& cube, bool secondaryRays);
 
 // Inverse of a row-major 4x4 matrix; false when it is singular.
 bool Invert4x4(const double m[16], double inverse[16]);

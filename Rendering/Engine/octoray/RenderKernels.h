@@ -417,6 +417,149 @@ OCTORAY_HD Rgba ProjectedColor(const FrameConstants& f, float value)
   return Rgba{ v, v, v, 1.0f };
 }
 
+// A ray still to be traced and the weight of its colour in the pixel.
+struct PendingRay
+{
+  Ray ray;
+  float weight[3];
+  int bounces;
+  float tFromNear;
+};
+// Enough for every path of 2 bounces (each hit spawns at most 2 rays).
+constexpr int kMaxPendingRays = 8;
+// Voxels a refracted ray may cross inside one medium before it is dropped.
+constexpr int kMaxMediumSteps = 1 << 12;
+
+OCTORAY_HD void Reflect(const float d[3], const float n[3], float r[3])
+{
+  const float dn = Dot(d, n);
+  for (int a = 0; a < 3; ++a)
+  {
+    r[a] = d[a] - 2.0f * dn * n[a];
+  }
+}
+
+// Snell's law: d enters through a surface with normal n (facing against d)
+// from index n1 into n2, eta = n1 / n2. False on total internal reflection.
+OCTORAY_HD bool Refract(const float d[3], const float n[3], float eta, float t[3])
+{
+  const float cosIn = -Dot(d, n);
+  const float sin2Out = eta * eta * (1.0f - cosIn * cosIn);
+  if (sin2Out > 1.0f)
+  {
+    return false;
+  }
+  const float cosOut = sqrtf(1.0f - sin2Out);
+  for (int a = 0; a < 3; ++a)
+  {
+    t[a] = eta * d[a] + (eta * cosIn - cosOut) * n[a];
+  }
+  Normalize(t);
+  return true;
+}
+
+// A secondary ray from p; tMin skips the surface it starts on.
+OCTORAY_HD void StartRay(Ray& ray, const float p[3], const float d[3], float tMin)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    ray.origin[a] = p[a];
+  }
+  SetDirection(ray, d);
+  ray.tMin = tMin;
+  ray.tMax = INFINITY;
+}
+
+// A ray that entered the refracting voxel `hit` through the shading normal n
+// crosses the occupied voxels of the hit's level (the medium) voxel by
+// voxel, reflecting totally inside where Snell allows no exit, until it
+// leaves through a face, where it refracts back into air. The emerging ray
+// goes into `out` (its weight and bounces set by the caller; each internal
+// reflection costs a bounce). False when the bounces run out inside.
+OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const NodeHit& hit, const float n[3],
+  float ior, int maxBounces, PendingRay& out)
+{
+  float d[3];
+  if (!Refract(in.direction, n, 1.0f / ior, d))
+  {
+    return false; // an index below 1 seen at a grazing angle: all reflected
+  }
+  const float tEnter = hit.tEnter > in.tMin ? hit.tEnter : in.tMin;
+  float p[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    p[a] = in.origin[a] + tEnter * in.direction[a];
+  }
+  const int level = hit.level;
+  const std::uint32_t cells = 1u << level;
+  const float size = hit.size;
+  std::uint32_t cell[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cell[a] = static_cast<std::uint32_t>(hit.lo[a] * static_cast<float>(cells));
+  }
+  for (int step = 0; step < kMaxMediumSteps; ++step)
+  {
+    // Where the ray leaves the current cell, and through which face.
+    float tExit = INFINITY;
+    int axis = -1;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (d[a] != 0.0f)
+      {
+        const float plane = (static_cast<float>(cell[a]) + (d[a] > 0.0f ? 1.0f : 0.0f)) * size;
+        const float t = (plane - p[a]) / d[a];
+        if (t < tExit)
+        {
+          tExit = t;
+          axis = a;
+        }
+      }
+    }
+    if (axis < 0)
+    {
+      return false;
+    }
+    tExit = tExit > 0.0f ? tExit : 0.0f;
+    for (int a = 0; a < 3; ++a)
+    {
+      p[a] += tExit * d[a];
+    }
+    p[axis] = (static_cast<float>(cell[axis]) + (d[axis] > 0.0f ? 1.0f : 0.0f)) * size; // exactly on the face
+    const int stepDir = d[axis] > 0.0f ? 1 : -1;
+    const long long next = static_cast<long long>(cell[axis]) + stepDir;
+    bool medium = false;
+    if (next >= 0 && next < static_cast<long long>(cells))
+    {
+      std::uint32_t c[3] = { cell[0], cell[1], cell[2] };
+      c[axis] = static_cast<std::uint32_t>(next);
+      const std::uint32_t node = tree.Find(level, EncodeMorton(c[0], c[1], c[2]));
+      medium = node != kInvalidIndex && (!tree.refraction || tree.refraction[node] > 0.0f);
+    }
+    if (medium)
+    {
+      cell[axis] = static_cast<std::uint32_t>(next);
+      continue;
+    }
+    // At the medium's boundary: out into air, or totally reflected inside.
+    float inward[3] = { 0.0f, 0.0f, 0.0f };
+    inward[axis] = -static_cast<float>(stepDir);
+    float outDir[3];
+    if (Refract(d, inward, ior, outDir))
+    {
+      StartRay(out.ray, p, outDir, 1e-4f * size);
+      return true;
+    }
+    if (out.bounces >= maxBounces)
+    {
+      return false;
+    }
+    ++out.bounces;
+    d[axis] = -d[axis];
+  }
+  return false;
+}
+
 // One pixel: premultiplied RGBA and window depth (1 = nothing hit).
 OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
   float& depth, std::size_t& secondaryRays)
@@ -468,53 +611,83 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     return;
   }
 
-  // Surface: the first voxel, then mirror bounces weighted by reflectivity.
-  float throughput = 1.0f;
-  float tFromNear = static_cast<float>(tBase);
-  for (int bounce = 0;; ++bounce)
+  // Surface: the first voxel, then the mirror and refracted rays it spawns,
+  // each carrying its weight in the pixel, until the bounce limit.
+  PendingRay pending[kMaxPendingRays];
+  int top = 0;
+  pending[top++] = PendingRay{ ray, { 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(tBase) };
+  bool primary = true;
+  while (top > 0)
   {
+    const PendingRay path = pending[--top];
     FirstHitVisitor first;
-    Traverse(tree, ray, lod, first);
+    Traverse(tree, path.ray, lod, first);
     if (!first.found)
     {
-      break;
+      primary = false;
+      continue;
     }
     const NodeHit& hit = first.hit;
-    const float tHit = hit.tEnter > ray.tMin ? hit.tEnter : ray.tMin;
-    if (bounce == 0)
+    const float tHit = hit.tEnter > path.ray.tMin ? hit.tEnter : path.ray.tMin;
+    if (primary)
     {
       const double p[3] = { origin[0] + tHit * direction[0], origin[1] + tHit * direction[1],
         origin[2] + tHit * direction[2] };
       depth = WindowDepth(f, p);
       rgba[3] = 1.0f;
+      primary = false;
     }
     float rgb[3];
-    ShadeSurface(f, tree, ray, hit, tFromNear + tHit, lod, rgb, secondaryRays);
-    const float reflectivity = tree.reflectivity && bounce < f.maxBounces ? tree.reflectivity[hit.node] : 0.0f;
+    ShadeSurface(f, tree, path.ray, hit, path.tFromNear + tHit, lod, rgb, secondaryRays);
+    const bool canBounce = path.bounces < f.maxBounces;
+    float reflectivity = canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f;
+    reflectivity = reflectivity < 0.0f ? 0.0f : (reflectivity > 1.0f ? 1.0f : reflectivity);
+    const float ior = canBounce && tree.refraction ? tree.refraction[hit.node] : 0.0f;
+    // A refracting voxel is clear: it tints what is seen through it instead
+    // of showing its own lit colour.
+    const float opaque = (1.0f - reflectivity) * (ior > 0.0f ? 0.0f : 1.0f);
     for (int a = 0; a < 3; ++a)
     {
-      rgba[a] += throughput * (1.0f - reflectivity) * rgb[a];
+      rgba[a] += path.weight[a] * opaque * rgb[a];
     }
-    if (reflectivity <= 0.0f)
+    if (!(reflectivity > 0.0f || ior > 0.0f))
     {
-      break;
+      continue;
     }
-    throughput *= reflectivity;
-    float n[3], p[3];
-    SurfaceNormal(tree, ray, hit, n);
-    EntryPoint(ray, hit, p);
-    const float dn = Dot(ray.direction, n);
-    const float r[3] = { ray.direction[0] - 2.0f * dn * n[0], ray.direction[1] - 2.0f * dn * n[1],
-      ray.direction[2] - 2.0f * dn * n[2] };
-    for (int a = 0; a < 3; ++a)
+    float n[3];
+    SurfaceNormal(tree, path.ray, hit, n);
+    if (reflectivity > 0.0f && top < kMaxPendingRays)
     {
-      ray.origin[a] = p[a];
+      PendingRay mirror;
+      float p[3], r[3];
+      EntryPoint(path.ray, hit, p);
+      Reflect(path.ray.direction, n, r);
+      StartRay(mirror.ray, p, r, 0.0f);
+      for (int a = 0; a < 3; ++a)
+      {
+        mirror.weight[a] = path.weight[a] * reflectivity;
+      }
+      mirror.bounces = path.bounces + 1;
+      mirror.tFromNear = path.tFromNear + tHit;
+      pending[top++] = mirror;
+      ++secondaryRays;
     }
-    SetDirection(ray, r);
-    ray.tMin = 0.0f;
-    ray.tMax = INFINITY;
-    tFromNear += tHit;
-    ++secondaryRays;
+    if (ior > 0.0f && top < kMaxPendingRays)
+    {
+      const Rgba tint = NodeColor(f, tree, hit.node);
+      PendingRay through;
+      for (int a = 0; a < 3; ++a)
+      {
+        through.weight[a] = path.weight[a] * (1.0f - reflectivity) * (&tint.r)[a];
+      }
+      through.bounces = path.bounces + 1;
+      through.tFromNear = path.tFromNear + tHit;
+      if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
+      {
+        pending[top++] = through;
+        ++secondaryRays;
+      }
+    }
   }
 }
 }
