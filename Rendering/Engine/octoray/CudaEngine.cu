@@ -729,11 +729,21 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   unsigned long long secondary = 0;
   CudaCheck(cudaMemcpy(&secondary, counter.Get(), sizeof(secondary), cudaMemcpyDeviceToHost), "RenderKernel");
   stats.secondaryRays = secondary;
-  stats.seconds = SecondsSince(start); // the frame on the device, before the copy to the host
+  stats.seconds = SecondsSince(start);
   image.width = settings.width;
   image.height = settings.height;
-  Download(ImageRgba, image.rgba);
-  Download(ImageDepth, image.depth);
+  if (settings.copyToHost)
+  {
+    const auto copy = std::chrono::steady_clock::now();
+    Download(ImageRgba, image.rgba);
+    Download(ImageDepth, image.depth);
+    stats.copySeconds = SecondsSince(copy);
+  }
+  else
+  {
+    image.rgba.clear();
+    image.depth.clear();
+  }
   return stats;
 }
 

@@ -57,6 +57,11 @@ public:
 
   OctreeView View() const { return State->View(); }
 
+  // The last frame in device memory: premultiplied RGBA (4 floats a pixel)
+  // and window depth, rows from the bottom.
+  const float* DeviceImageRgba() const { return ImageRgba.Get(); }
+  const float* DeviceImageDepth() const { return ImageDepth.Get(); }
+
 private:
   void DataBounds(const DeviceState& s, double lo[3], double hi[3]);
   BuildStats BuildFromState(DeviceState& s, const RootCube& cube, int requestedDepth);

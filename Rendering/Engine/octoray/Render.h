@@ -63,6 +63,9 @@ struct RenderSettings
   // Window depth ([0,1], OpenGL convention, row-major from the bottom row) of
   // opaque geometry already drawn; rays stop there. Empty = none.
   std::vector<float> depthBuffer;
+  // CUDA: copy the picture to the host Image. Off, it stays in device memory
+  // (CudaEngine::DeviceImage) for a caller that draws it from there.
+  bool copyToHost = true;
 };
 
 // Premultiplied RGBA and window depth (1 where nothing was hit), rows from
@@ -76,7 +79,8 @@ struct Image
 
 struct RenderStats
 {
-  double seconds = 0.0;
+  double seconds = 0.0;     // the frame, up to the picture in the backend's memory
+  double copySeconds = 0.0; // CUDA: the copy of the picture to the host
   std::size_t primaryRays = 0;
   std::size_t secondaryRays = 0; // shadow, reflected and refracted
 };

@@ -96,81 +96,102 @@ struct NodeHit
   float size;
 };
 
-constexpr int kTraversalStack = 8 * (kMaxLevel + 1);
+// A ray crosses each splitting plane of a node at most once, so it passes
+// through at most 4 of the 8 children (the stack then holds at most 3 per
+// level plus one); one that grazes the node's centre can touch all 8 with
+// zero length, so room is kept for 7 per level: the stack never overflows
+// (the check in Traverse is a guard only).
+constexpr int kTraversalStack = 7 * (kMaxLevel + 1) + 1;
+
+struct TraversalEntry
+{
+  std::uint32_t node;
+  std::int32_t level;
+  float tEnter;
+};
 
 // Visits the drawn voxels (leaves, or nodes where the level of detail
 // stops) that the ray meets within [tMin, tMax], nearest first, until the
-// visitor's Visit(const NodeHit&) returns true. Children of a node are
-// pushed farthest first, so the stack pops them in the order the ray meets
-// them; disjoint boxes along a ray have disjoint intervals, so depth-first
-// in that order is front to back overall.
+// visitor's Visit(const NodeHit&) returns true.
+//
+// Order: a ray moving towards +x crosses a node's x = mid plane from the low
+// half to the high one, never back; so the octants it meets form a chain in
+// which each next octant sets one more bit of (octant ^ signMask), where
+// signMask has bit a set for a negative direction component. Visiting
+// octants by increasing (octant ^ signMask) is thus the order the ray meets
+// them, and depth-first in that order is front to back overall (disjoint
+// boxes along a ray have disjoint intervals). No sorting is needed, and the
+// stack keeps only node, level and entry distance; a node's box comes back
+// from its key.
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
-  NodeHit stack[kTraversalStack];
+  TraversalEntry stack[kTraversalStack];
   int top = 0;
   {
-    NodeHit root;
-    root.node = 0;
-    root.level = 0;
-    root.lo[0] = root.lo[1] = root.lo[2] = 0.0f;
-    root.size = 1.0f;
-    if (!IntersectBox(ray, root.lo, 1.0f, root.tEnter, root.tExit, root.axis) || root.tExit < ray.tMin ||
-      root.tEnter > ray.tMax)
+    const float origin[3] = { 0.0f, 0.0f, 0.0f };
+    float t0, t1;
+    int axis;
+    if (!IntersectBox(ray, origin, 1.0f, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax)
     {
       return;
     }
-    stack[top++] = root;
+    stack[top++] = TraversalEntry{ 0u, 0, t0 };
   }
+  const unsigned signMask =
+    (ray.direction[0] < 0.0f ? 1u : 0u) | (ray.direction[1] < 0.0f ? 2u : 0u) | (ray.direction[2] < 0.0f ? 4u : 0u);
   while (top > 0)
   {
-    const NodeHit hit = stack[--top];
-    if (hit.tEnter > ray.tMax)
+    const TraversalEntry e = stack[--top];
+    if (e.tEnter > ray.tMax)
     {
       return; // everything left on the stack is farther
     }
-    if (hit.level == tree.depth || lod.StopAt(hit.level, hit.tEnter))
+    NodeHit hit;
+    hit.node = e.node;
+    hit.level = e.level;
+    hit.size = ldexpf(1.0f, -e.level);
+    std::uint32_t cell[3];
+    DecodeMorton(tree.key[e.node], cell[0], cell[1], cell[2]);
+    for (int a = 0; a < 3; ++a)
     {
+      hit.lo[a] = static_cast<float>(cell[a]) * hit.size;
+    }
+    if (e.level == tree.depth || lod.StopAt(e.level, e.tEnter))
+    {
+      IntersectBox(ray, hit.lo, hit.size, hit.tEnter, hit.tExit, hit.axis);
       if (visitor.Visit(hit))
       {
         return;
       }
       continue;
     }
-    // Children the ray meets, sorted nearest first (at most 8).
-    NodeHit children[8];
-    int count = 0;
     const float half = 0.5f * hit.size;
-    const unsigned mask = tree.childMask[hit.node];
-    std::uint32_t child = tree.firstChild[hit.node];
-    for (int octant = 0; octant < 8; ++octant)
+    const unsigned mask = tree.childMask[e.node];
+    const std::uint32_t firstChild = tree.firstChild[e.node];
+    // Pushed farthest first, so that they pop nearest first.
+    for (int i = 7; i >= 0; --i)
     {
+      const unsigned octant = static_cast<unsigned>(i) ^ signMask;
       if (!(mask & (1u << octant)))
       {
         continue;
       }
-      NodeHit c;
-      c.node = child++;
-      c.level = hit.level + 1;
-      c.size = half;
-      c.lo[0] = hit.lo[0] + ((octant & 1) ? half : 0.0f);
-      c.lo[1] = hit.lo[1] + ((octant & 2) ? half : 0.0f);
-      c.lo[2] = hit.lo[2] + ((octant & 4) ? half : 0.0f);
-      if (!IntersectBox(ray, c.lo, half, c.tEnter, c.tExit, c.axis) || c.tExit < ray.tMin || c.tEnter > ray.tMax)
+      const float lo[3] = { hit.lo[0] + ((octant & 1u) ? half : 0.0f), hit.lo[1] + ((octant & 2u) ? half : 0.0f),
+        hit.lo[2] + ((octant & 4u) ? half : 0.0f) };
+      float t0, t1;
+      int axis;
+      if (!IntersectBox(ray, lo, half, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax || top == kTraversalStack)
       {
         continue;
       }
-      int k = count++;
-      while (k > 0 && children[k - 1].tEnter > c.tEnter)
-      {
-        children[k] = children[k - 1];
-        --k;
-      }
-      children[k] = c;
-    }
-    for (int k = count - 1; k >= 0; --k)
-    {
-      stack[top++] = children[k];
+      const unsigned before = mask & ((1u << octant) - 1u);
+#if defined(__CUDA_ARCH__)
+      const unsigned rank = __popc(before);
+#else
+      const unsigned rank = static_cast<unsigned>(__builtin_popcount(before));
+#endif
+      stack[top++] = TraversalEntry{ firstChild + rank, e.level + 1, t0 };
     }
   }
 }
