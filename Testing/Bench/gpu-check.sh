@@ -24,9 +24,9 @@ step configure cmake -S Rendering/Engine -B build-gpu -G Ninja -DCMAKE_BUILD_TYP
   -DOCTORAY_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DOCTORAY_GTEST_SOURCE_DIR="$PWD/.deps/googletest"
 step build cmake --build build-gpu -j 16
 step tests build-gpu/bin/octoray_engine_tests
-step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*'
-step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:-*EveryDepth*'
-step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:-*EveryDepth*'
+step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*'
+step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
+step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
 step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
 
 echo

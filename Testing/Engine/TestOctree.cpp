@@ -269,3 +269,45 @@ TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, OctreeBuild, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
+
+// Out of device memory: a clear error naming what did not fit, the previous
+// octree intact and still drawable, and a later build within budget works.
+TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
+{
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    GTEST_SKIP() << "CUDA backend not usable here: " << why;
+  }
+  auto engine = CreateEngine(Backend::CUDA);
+  const Cloud small = UniformCloud(1000, 51);
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(small.View(), options);
+  HostOctree before;
+  engine->CopyToHost(before);
+  const std::size_t held = engine->Memory().Total();
+
+  engine->SetMemoryBudget(held + 200000); // far too little for 100 k points
+  const Cloud big = UniformCloud(100000, 52);
+  try
+  {
+    engine->Build(big.View(), options);
+    FAIL() << "no error past the memory budget";
+  }
+  catch (const Error& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("octoray: out of memory for "), std::string::npos) << message;
+    EXPECT_NE(message.find("within the engine's budget"), std::string::npos) << message;
+  }
+  HostOctree after;
+  engine->CopyToHost(after);
+  EXPECT_EQ(after.key, before.key);
+  EXPECT_EQ(after.pointCount, before.pointCount);
+
+  engine->SetMemoryBudget(~std::size_t(0));
+  EXPECT_NO_THROW(engine->Build(big.View(), options));
+  engine->CopyToHost(after);
+  ExpectMatchesReference(after, big);
+}

@@ -138,8 +138,7 @@ TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
     to.insert(to.end(), { c.xyz[3 * target], c.xyz[3 * target + 1], c.xyz[3 * target + 2] });
   }
   const UpdateStats s = MoveAndCheck(GetParam(), *engine, c, idx, to);
-  // The CUDA backend has no in-place path yet: it re-sorts (see Engine.h).
-  EXPECT_EQ(s.path, GetParam() == Backend::CPU ? UpdateStats::Path::InPlace : UpdateStats::Path::Relevel);
+  EXPECT_EQ(s.path, UpdateStats::Path::InPlace);
   EXPECT_GT(s.changedLeaf, 10u);
 }
 
@@ -166,8 +165,7 @@ TEST_P(OctreeUpdate, RandomMovesOfSomePoints)
         to.push_back(std::max(-4.0, std::min(4.0, v)));
       }
     }
-    // Remove duplicates: a point listed twice takes its last position, which
-    // the cloud bookkeeping here would not mirror.
+    // Remove duplicates: the engine refuses a point listed twice.
     std::vector<std::uint32_t> uniqueIdx;
     std::vector<double> uniqueTo;
     std::vector<bool> seen(20000, false);
@@ -272,6 +270,20 @@ TEST_P(OctreeUpdate, BadUpdatesAreErrorsAndChangeNothing)
   {
     EXPECT_NE(std::string(e.what()).find("names point 1000 of an octree of 1000 points"), std::string::npos)
       << e.what();
+  }
+  const std::uint32_t twice[2] = { 7, 7 };
+  const double two[6] = { 0, 0, 0, 0.1, 0, 0 };
+  moved.count = 2;
+  moved.indices = twice;
+  moved.xyzDouble = two;
+  try
+  {
+    engine->Update(moved);
+    FAIL() << "no error for a point listed twice";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_STREQ(e.what(), "octoray: update index 1 names point 7 a second time");
   }
   engine->CopyToHost(after);
   EXPECT_EQ(after.key, before.key);

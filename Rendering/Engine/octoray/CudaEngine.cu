@@ -220,10 +220,18 @@ __global__ void ScatterPositionsKernel(const T* xyz, const std::uint32_t* indice
   }
 }
 
-// New keys of moved points: counts those that left their leaf, and flags
+// A point that changed leaf in an update (leaf keys before and after).
+struct LeafMove
+{
+  std::uint32_t point;
+  std::uint64_t from, to;
+};
+
+// New keys of moved points: lists those that left their leaf, and flags
 // (first index) a point outside the cube.
 __global__ void MovedKeysKernel(PointArraysView pts, RootCube cube, int leafShift, const std::uint32_t* indices,
-  std::size_t moved, std::uint64_t* pointKey, unsigned long long* changedLeaf, unsigned long long* firstOutside)
+  std::size_t moved, std::uint64_t* pointKey, LeafMove* moves, unsigned long long* changedLeaf,
+  unsigned long long* firstOutside)
 {
   const std::size_t k = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
   if (k < moved)
@@ -237,10 +245,97 @@ __global__ void MovedKeysKernel(PointArraysView pts, RootCube cube, int leafShif
     }
     if ((key >> leafShift) != (pointKey[i] >> leafShift))
     {
-      atomicAdd(changedLeaf, 1ull);
+      const unsigned long long slot = atomicAdd(changedLeaf, 1ull);
+      moves[slot] = LeafMove{ static_cast<std::uint32_t>(i), pointKey[i] >> leafShift, key >> leafShift };
     }
     pointKey[i] = key;
   }
+}
+
+// For each move, the depth+1 nodes on the path from its old leaf to the
+// root (the point leaves them) and from its new leaf (it joins them), as
+// (node, 2 * point + joins) records. A new leaf that does not exist means
+// the topology changes: flagged, and its records point nowhere.
+__global__ void PathRecordsKernel(OctreeView t, const LeafMove* moves, std::size_t count, std::uint32_t* recordNode,
+  std::uint32_t* recordPoint, unsigned* topologyChanged)
+{
+  const std::size_t k = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  if (k >= count)
+  {
+    return;
+  }
+  const LeafMove m = moves[k];
+  const std::size_t pathLength = static_cast<std::size_t>(t.depth) + 1;
+  for (int joins = 0; joins < 2; ++joins)
+  {
+    std::uint32_t node = t.Find(t.depth, joins ? m.to : m.from);
+    if (node == kInvalidIndex)
+    {
+      *topologyChanged = 1u;
+    }
+    const std::size_t base = (2 * k + joins) * pathLength;
+    for (std::size_t step = 0; step < pathLength; ++step)
+    {
+      recordNode[base + step] = node;
+      recordPoint[base + step] = 2u * m.point + static_cast<std::uint32_t>(joins);
+      node = node == kInvalidIndex ? kInvalidIndex : t.parent[node];
+    }
+  }
+}
+
+struct IsRunStart32
+{
+  const std::uint32_t* keys;
+  __device__ bool operator()(std::uint32_t i) const
+  {
+    return i == 0 || keys[i] != keys[i - 1];
+  }
+};
+
+// Per node touched (a run of sorted records): would it empty?
+__global__ void EmptiedNodesKernel(OctreeView t, const std::uint32_t* recordNode, const std::uint32_t* recordPoint,
+  const std::uint32_t* starts, std::uint32_t runs, unsigned* emptied)
+{
+  const std::uint32_t r = blockIdx.x * blockDim.x + threadIdx.x;
+  if (r >= runs || recordNode[starts[r]] == kInvalidIndex)
+  {
+    return;
+  }
+  long long dCount = 0;
+  for (std::uint32_t j = starts[r]; j < starts[r + 1]; ++j)
+  {
+    dCount += (recordPoint[j] & 1u) ? 1 : -1;
+  }
+  if (static_cast<long long>(t.pointCount[recordNode[starts[r]]]) + dCount <= 0)
+  {
+    *emptied = 1u;
+  }
+}
+
+// Per node touched: adjust its count and means by the points that left and
+// joined it (the in-place update, as on the CPU).
+__global__ void ApplyDeltasKernel(OctreeView t, PointArraysView pts, const std::uint32_t* recordNode,
+  const std::uint32_t* recordPoint, const std::uint32_t* starts, std::uint32_t runs)
+{
+  const std::uint32_t r = blockIdx.x * blockDim.x + threadIdx.x;
+  if (r >= runs)
+  {
+    return;
+  }
+  long long dCount = 0;
+  double dSum[kSlotCount] = {};
+  float v[kSlotCount] = {};
+  for (std::uint32_t j = starts[r]; j < starts[r + 1]; ++j)
+  {
+    const bool joins = recordPoint[j] & 1u;
+    dCount += joins ? 1 : -1;
+    pts.Attributes(recordPoint[j] >> 1, v);
+    for (int s = 0; s < kSlotCount; ++s)
+    {
+      dSum[s] += joins ? v[s] : -v[s];
+    }
+  }
+  ApplyNodeDelta(t, recordNode[starts[r]], dCount, dSum);
 }
 
 __global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, float* depth,
@@ -663,8 +758,10 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
   counters.Reserve(Pool, 2, "counters");
   const unsigned long long init[2] = { 0ull, ~0ull };
   CudaCheck(cudaMemcpy(counters.Get(), init, sizeof(init), cudaMemcpyHostToDevice), "counters");
+  DeviceBuffer<LeafMove> moves;
+  moves.Reserve(Pool, moved, "update moves");
   MovedKeysKernel<<<Blocks(moved), kBlock>>>(s.Points(), s.cube, leafShift, indices.Get(), moved, s.pointKey.Get(),
-    counters.Get(), counters.Get() + 1);
+    moves.Get(), counters.Get(), counters.Get() + 1);
   CudaCheckLaunch("MovedKeysKernel");
   unsigned long long result[2];
   CudaCheck(cudaMemcpy(result, counters.Get(), sizeof(result), cudaMemcpyDeviceToHost), "MovedKeysKernel");
@@ -681,10 +778,15 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
   {
     stats.path = UpdateStats::Path::Unchanged;
   }
+  else if (result[0] <= s.count / 16 && UpdateInPlace(s, moves.Get(), result[0]))
+  {
+    stats.changedLeaf = result[0];
+    stats.path = UpdateStats::Path::InPlace;
+  }
   else
   {
-    // Points changed leaf: re-sort the stored keys and rebuild the levels in
-    // the same buffers (no new cube, no new keys for points that stayed).
+    // Nodes appear or empty (or too many points moved for the in-place
+    // path to pay): rebuild keys, sort and levels in the same buffers.
     stats.changedLeaf = result[0];
     BuildFromState(s, s.cube, s.depth);
     stats.path = UpdateStats::Path::Relevel;
@@ -745,6 +847,65 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
     image.depth.clear();
   }
   return stats;
+}
+
+bool CudaEngine::UpdateInPlace(DeviceState& s, const void* deviceMoves, std::size_t changed)
+{
+  const LeafMove* moves = static_cast<const LeafMove*>(deviceMoves);
+  const OctreeView view = s.View();
+  const std::size_t records = 2 * changed * (static_cast<std::size_t>(s.depth) + 1);
+  DeviceBuffer<std::uint32_t> node[2], point[2];
+  for (int b = 0; b < 2; ++b)
+  {
+    node[b].Reserve(Pool, records, "update records");
+    point[b].Reserve(Pool, records, "update records");
+  }
+  DeviceBuffer<unsigned> flags;
+  flags.Reserve(Pool, 2, "counters");
+  CudaCheck(cudaMemset(flags.Get(), 0, 2 * sizeof(unsigned)), "cudaMemset");
+  PathRecordsKernel<<<Blocks(changed), kBlock>>>(view, moves, changed, node[0].Get(), point[0].Get(), flags.Get());
+  CudaCheckLaunch("PathRecordsKernel");
+  unsigned topologyChanged = 0;
+  CudaCheck(cudaMemcpy(&topologyChanged, flags.Get(), sizeof(unsigned), cudaMemcpyDeviceToHost), "PathRecordsKernel");
+  if (topologyChanged)
+  {
+    return false;
+  }
+  // Records grouped by node; the stable sort keeps each node's sums in a
+  // fixed order, so repeated updates give the same bits.
+  cub::DoubleBuffer<std::uint32_t> keys(node[0].Get(), node[1].Get());
+  cub::DoubleBuffer<std::uint32_t> values(point[0].Get(), point[1].Get());
+  std::size_t bytes = 0;
+  CudaCheck(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys, values, records), "cub::DeviceRadixSort (update)");
+  CudaCheck(cub::DeviceRadixSort::SortPairs(CubTemp(bytes), bytes, keys, values, records),
+    "cub::DeviceRadixSort (update)");
+  Starts.Reserve(Pool, records + 1, "run starts");
+  DeviceBuffer<int> selected;
+  selected.Reserve(Pool, 1, "counters");
+  auto in = thrust::counting_iterator<std::uint32_t>(0);
+  CudaCheck(cub::DeviceSelect::If(nullptr, bytes, in, Starts.Get(), selected.Get(), records,
+              IsRunStart32{ keys.Current() }),
+    "cub::DeviceSelect (update)");
+  CudaCheck(cub::DeviceSelect::If(CubTemp(bytes), bytes, in, Starts.Get(), selected.Get(), records,
+              IsRunStart32{ keys.Current() }),
+    "cub::DeviceSelect (update)");
+  int runs = 0;
+  CudaCheck(cudaMemcpy(&runs, selected.Get(), sizeof(int), cudaMemcpyDeviceToHost), "cub::DeviceSelect (update)");
+  const std::uint32_t end = static_cast<std::uint32_t>(records);
+  CudaCheck(cudaMemcpy(Starts.Get() + runs, &end, sizeof(end), cudaMemcpyHostToDevice), "run starts");
+  EmptiedNodesKernel<<<Blocks(runs), kBlock>>>(view, keys.Current(), values.Current(), Starts.Get(), runs,
+    flags.Get() + 1);
+  CudaCheckLaunch("EmptiedNodesKernel");
+  unsigned emptied = 0;
+  CudaCheck(cudaMemcpy(&emptied, flags.Get() + 1, sizeof(unsigned), cudaMemcpyDeviceToHost), "EmptiedNodesKernel");
+  if (emptied)
+  {
+    return false;
+  }
+  ApplyDeltasKernel<<<Blocks(runs), kBlock>>>(view, s.Points(), keys.Current(), values.Current(), Starts.Get(), runs);
+  CudaCheckLaunch("ApplyDeltasKernel");
+  CudaCheck(cudaDeviceSynchronize(), "ApplyDeltasKernel");
+  return true;
 }
 
 void CudaEngine::CopyToHost(HostOctree& out) const

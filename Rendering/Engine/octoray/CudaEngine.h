@@ -26,7 +26,7 @@ public:
 
   // Device bytes the engine may hold; allocations beyond it fail with the
   // out-of-memory error, as a full GPU would.
-  void SetMemoryBudget(std::size_t bytes) { Pool.budget = bytes; }
+  void SetMemoryBudget(std::size_t bytes) override { Pool.budget = bytes; }
 
   // Everything one octree holds on the device.
   struct DeviceState
@@ -66,6 +66,10 @@ private:
   void DataBounds(const DeviceState& s, double lo[3], double hi[3]);
   BuildStats BuildFromState(DeviceState& s, const RootCube& cube, int requestedDepth);
   void* CubTemp(std::size_t bytes);
+  // Counts and means adjusted along the paths of the points that changed
+  // leaf (device array of LeafMove); false, with nothing changed, when a
+  // node would appear or empty.
+  bool UpdateInPlace(DeviceState& s, const void* moves, std::size_t changed);
 
   std::string DeviceName;
   // Declared before the buffers so that it outlives them.
