@@ -33,5 +33,5 @@ echo
 echo "== octoray CUDA check =="
 grep -E "tests? (ran|from)|PASSED|FAILED" "$out/tests.log" | tail -3
 grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/racecheck.log "$out"/initcheck.log
-grep -E "^(device|build|update|render)" "$out/bench.log"
+grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
 printf '%s\n' "${status[@]}"
