@@ -273,9 +273,11 @@ int Run(int argc, char** argv)
       std::vector<std::uint32_t> idx(moved);
       std::vector<float> xyz(3 * moved);
       std::mt19937_64 rng(3);
+      // Distinct points spread over the cloud (the engine refuses duplicates).
+      const std::size_t stride = n / moved;
       for (std::size_t k = 0; k < moved; ++k)
       {
-        idx[k] = static_cast<std::uint32_t>(fraction < 1 ? rng() % n : k);
+        idx[k] = static_cast<std::uint32_t>(k * stride + rng() % stride);
       }
       std::vector<double> times;
       UpdateStats last;
