@@ -3,6 +3,7 @@
 // builds the octree of a particle file and prints its statistics and costs;
 //   octoray render FILE -o OUT.png [options]
 // ray-traces it from a camera orbiting the data and writes the picture.
+#include "OrbitCamera.h"
 #include "PointFile.h"
 
 #include <octoray/Engine.h>
@@ -125,53 +126,9 @@ int main(int argc, char** argv)
 
 namespace
 {
-using Matrix = std::array<double, 16>;
-
 double Seconds(std::chrono::steady_clock::time_point since)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-Matrix Multiply(const Matrix& a, const Matrix& b)
-{
-  Matrix m{};
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      for (int k = 0; k < 4; ++k)
-        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
-  return m;
-}
-
-// The OpenGL camera VTK's composite projection transform gives (perspective,
-// row-major), so the tool drives the engine exactly as the VTK layer does.
-Matrix LookAtPerspective(const double eye[3], const double target[3], const double up[3], double fovyDegrees,
-  double aspect, double zNear, double zFar)
-{
-  double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
-  const double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  for (double& v : f)
-    v /= fl;
-  double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
-  const double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-  for (double& v : s)
-    v /= sl;
-  const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
-  const Matrix view = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
-    -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2],
-    f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 0, 0, 0, 1 };
-  const double t = 1.0 / std::tan(fovyDegrees * M_PI / 360.0);
-  const Matrix proj = { t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, -(zFar + zNear) / (zFar - zNear),
-    -2 * zFar * zNear / (zFar - zNear), 0, 0, -1, 0 };
-  return Multiply(proj, view);
-}
-
-// Direction at azimuth (about +z, from +x) and elevation (above xy).
-void Direction(double azimuthDeg, double elevationDeg, double d[3])
-{
-  const double a = azimuthDeg * M_PI / 180, e = elevationDeg * M_PI / 180;
-  d[0] = std::cos(e) * std::cos(a);
-  d[1] = std::cos(e) * std::sin(a);
-  d[2] = std::sin(e);
 }
 
 // 8-bit RGB, top row first, the premultiplied picture composited over a
@@ -325,42 +282,26 @@ int Render(int argc, char** argv)
     const octoray::PointCloudView points = file.View();
     const octoray::BuildStats build = engine->Build(points, options);
 
-    // Frame the data's bounding box: its centre is the orbit's target, and
-    // the distance puts the bounding sphere inside the vertical field of view.
+    // Orbit the centre of the data's bounding box; its bounding sphere
+    // fits the vertical field of view at zoom 1.
     double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      lo[k] = std::numeric_limits<double>::infinity();
-      hi[k] = -lo[k];
-    }
-    for (std::size_t i = 0; i < points.count; ++i)
-      for (int k = 0; k < 3; ++k)
-      {
-        lo[k] = std::min(lo[k], points.Coordinate(i, k));
-        hi[k] = std::max(hi[k], points.Coordinate(i, k));
-      }
-    const double centre[3] = { 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]) };
-    const double radius = std::max(1e-9, 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-      (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2])));
-    const double fovy = 30;
-    const double distance = radius / std::sin(fovy * M_PI / 360) / zoom;
-    double d[3];
-    Direction(azimuth, elevation, d);
-    const double eye[3] = { centre[0] + distance * d[0], centre[1] + distance * d[1], centre[2] + distance * d[2] };
-    const double up[3] = { 0, 0, std::cos(elevation * M_PI / 180) >= 0 ? 1.0 : -1.0 };
-    const double zNear = std::max(distance - 1.01 * radius, 1e-3 * distance);
-    const double zFar = distance + 1.01 * radius;
-    const Matrix vp = LookAtPerspective(eye, centre, up, fovy, double(width) / height, zNear, zFar);
-    if (!octoray::Invert4x4(vp.data(), s.inverseViewProjection))
+    octoray::Bounds(points, lo, hi);
+    octoray::OrbitCamera camera;
+    camera.azimuth = azimuth;
+    camera.elevation = elevation;
+    camera.zoom = zoom;
+    if (!camera.Apply(lo, hi, s))
     {
       throw octoray::Error("octoray: the camera matrix is singular");
     }
+    const double radius = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+      (hi[2] - lo[2]) * (hi[2] - lo[2]));
     if (shadows)
     {
       // Shadows need a light other than the headlight: a sun above and to
       // the left of the camera, so shadows fall visibly down and right.
       octoray::Light sun;
-      Direction(azimuth + 40, std::min(80.0, elevation + 35), sun.position);
+      octoray::OrbitCamera::Direction(azimuth + 40, std::min(80.0, elevation + 35), sun.position);
       sun.position[3] = 0;
       s.lights.push_back(sun);
     }
