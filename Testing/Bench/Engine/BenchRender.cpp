@@ -1,0 +1,354 @@
+// octoray_bench_render: how fast the engine ray-traces, per shading and
+// blend mode, and what level of detail and the bounce limit trade in error
+// for time.
+//
+//   octoray_bench_render [--size 1920x1080] [--repeats 3] [--threads N]
+//                        [--backend cpu|cuda|all] [--lidar PATH]
+//                        [--sphere-points N] [--table-size WxH] [--json PATH]
+//
+// Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
+// thesis's x y z r g b reflectivity refraction columns) and a synthetic
+// field of spheres (points on their surfaces, radial normals, reflectivity
+// 0.4). Mrays/s counts primary and secondary (shadow, mirror) rays; the
+// time is the median of the repeats after one warm-up frame.
+#include "BenchUtil.h"
+#include "OrbitCamera.h"
+#include "PointFile.h"
+
+#include <octoray/Engine.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#ifndef OCTORAY_LIDAR_FILE
+#define OCTORAY_LIDAR_FILE "Data/Particles/lidar_simple.particles"
+#endif
+
+namespace
+{
+using namespace octoray;
+using namespace octoray::bench;
+
+int Usage()
+{
+  std::fprintf(stderr,
+    "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
+    "                            [--lidar PATH] [--sphere-points N] [--table-size WxH] [--json PATH]\n");
+  return 2;
+}
+
+// Points on the surfaces of `spheres` spheres in the unit cube, their
+// count per sphere proportional to its area; radial normals.
+struct SphereField
+{
+  std::vector<double> xyz;
+  std::vector<std::uint8_t> rgb;
+  std::vector<float> normal, reflectivity;
+  PointCloudView View(bool withReflectivity, bool withNormals) const
+  {
+    PointCloudView v;
+    v.count = xyz.size() / 3;
+    v.xyzDouble = xyz.data();
+    v.color8 = rgb.data();
+    v.colorComponents = 3;
+    v.normal = withNormals ? normal.data() : nullptr;
+    v.reflectivity = withReflectivity ? reflectivity.data() : nullptr;
+    return v;
+  }
+};
+
+SphereField MakeSphereField(std::size_t points, int spheres = 48)
+{
+  Random random(kDefaultSeed);
+  std::vector<double> c(3 * spheres), r(spheres), area(spheres);
+  std::vector<std::uint8_t> colour(3 * spheres);
+  double total = 0;
+  for (int s = 0; s < spheres; ++s)
+  {
+    r[s] = 0.03 + 0.09 * random.Uniform();
+    for (int a = 0; a < 3; ++a)
+    {
+      c[3 * s + a] = r[s] + (1 - 2 * r[s]) * random.Uniform();
+      colour[3 * s + a] = static_cast<std::uint8_t>(60 + random.Next() % 196);
+    }
+    total += area[s] = r[s] * r[s];
+  }
+  SphereField f;
+  for (int s = 0; s < spheres; ++s)
+  {
+    const std::size_t n = static_cast<std::size_t>(points * area[s] / total);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      // Uniform on the sphere: z uniform in [-1, 1], angle uniform.
+      const double z = 2 * random.Uniform() - 1, phi = 6.283185307179586 * random.Uniform();
+      const double q = std::sqrt(1 - z * z);
+      const double d[3] = { q * std::cos(phi), q * std::sin(phi), z };
+      for (int a = 0; a < 3; ++a)
+      {
+        f.xyz.push_back(c[3 * s + a] + r[s] * d[a]);
+        f.normal.push_back(static_cast<float>(d[a]));
+        f.rgb.push_back(colour[3 * s + a]);
+      }
+      f.reflectivity.push_back(0.4f);
+    }
+  }
+  return f;
+}
+
+struct Mode
+{
+  const char* name;
+  BlendMode blend;
+  ShadeMode shade;
+  bool shadows;
+  int bounces;
+};
+
+const Mode kModes[] = { { "surface-flat", BlendMode::Surface, ShadeMode::Flat, false, 0 },
+  { "depth-cue", BlendMode::Surface, ShadeMode::DepthCue, false, 0 },
+  { "phong", BlendMode::Surface, ShadeMode::Phong, false, 0 },
+  { "phong-shadows", BlendMode::Surface, ShadeMode::Phong, true, 0 },
+  { "reflections", BlendMode::Surface, ShadeMode::Phong, true, 2 },
+  { "composite", BlendMode::Composite, ShadeMode::Flat, false, 0 },
+  { "mip", BlendMode::Maximum, ShadeMode::Flat, false, 0 },
+  { "minip", BlendMode::Minimum, ShadeMode::Flat, false, 0 },
+  { "average", BlendMode::Average, ShadeMode::Flat, false, 0 },
+  { "additive", BlendMode::Additive, ShadeMode::Flat, false, 0 } };
+
+RenderSettings MakeSettings(const PointCloudView& points, int w, int h, const Mode& m, int depth)
+{
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  double lo[3], hi[3];
+  Bounds(points, lo, hi);
+  OrbitCamera camera;
+  camera.zoom = 1.3;
+  camera.Apply(lo, hi, s);
+  s.blend = m.blend;
+  s.shade = m.shade;
+  s.shadows = m.shadows;
+  s.maxBounces = m.bounces;
+  if (m.shadows)
+  {
+    Light sun;
+    OrbitCamera::Direction(camera.azimuth + 40, camera.elevation + 35, sun.position);
+    sun.position[3] = 0;
+    s.lights.push_back(sun);
+  }
+  if (m.blend == BlendMode::Composite)
+  {
+    // Node colours are opaque; a grey ramp at 30% opacity per 4 leaves of
+    // length (over luminance, through the transfer function's scalar-less
+    // path is not available, so opacity per unit distance does the work).
+    double extent = 0;
+    for (int a = 0; a < 3; ++a)
+      extent = std::max(extent, hi[a] - lo[a]);
+    s.opacityUnitDistance = static_cast<float>(4 * std::ldexp(extent, -depth));
+  }
+  if (m.blend == BlendMode::Additive)
+  {
+    s.transfer.range[1] = 0.05f; // path integrals in the unit cube are small
+    for (int i = 0; i < 64; ++i)
+      s.transfer.table.push_back(Rgba{ i / 63.0f, i / 63.0f, i / 63.0f, 1.0f });
+  }
+  return s;
+}
+
+double MraysPerSecond(const RenderStats& stats, double seconds)
+{
+  return static_cast<double>(stats.primaryRays + stats.secondaryRays) / seconds * 1e-6;
+}
+
+// RMSE over the premultiplied RGB of two pictures, values clamped to [0, 1].
+double Rmse(const Image& a, const Image& b)
+{
+  double sum = 0;
+  const std::size_t n = a.depth.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+    {
+      const double x = std::min(1.0f, std::max(0.0f, a.rgba[4 * i + c]));
+      const double y = std::min(1.0f, std::max(0.0f, b.rgba[4 * i + c]));
+      sum += (x - y) * (x - y);
+    }
+  return std::sqrt(sum / (3.0 * n));
+}
+
+struct Scene
+{
+  std::string name;
+  PointCloudView points;
+  int depth;
+};
+}
+
+int main(int argc, char** argv)
+{
+  int w = 1920, h = 1080, tw = 0, th = 0, repeats = 3, threads = 0;
+  std::size_t spherePoints = 1000000;
+  std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json;
+  for (int a = 1; a < argc; ++a)
+  {
+    const std::string arg = argv[a];
+    if (a + 1 >= argc)
+      return Usage();
+    const char* v = argv[++a];
+    if (arg == "--size")
+    {
+      if (std::sscanf(v, "%dx%d", &w, &h) != 2)
+        return Usage();
+    }
+    else if (arg == "--table-size")
+    {
+      if (std::sscanf(v, "%dx%d", &tw, &th) != 2)
+        return Usage();
+    }
+    else if (arg == "--repeats")
+      repeats = std::atoi(v);
+    else if (arg == "--threads")
+      threads = std::atoi(v);
+    else if (arg == "--backend")
+      backend = v;
+    else if (arg == "--lidar")
+      lidar = v;
+    else if (arg == "--sphere-points")
+      spherePoints = std::strtoull(v, nullptr, 10);
+    else if (arg == "--json")
+      json = v;
+    else
+      return Usage();
+  }
+  if (tw == 0)
+    tw = w, th = h;
+
+  std::vector<Backend> backends;
+  if (backend == "cpu" || backend == "all")
+    backends.push_back(Backend::CPU);
+  if (backend == "cuda" || backend == "all")
+  {
+    std::string why;
+    if (CudaAvailable(&why))
+      backends.push_back(Backend::CUDA);
+    else
+      std::printf("CUDA skipped: %s\n", why.c_str());
+  }
+
+  try
+  {
+    const PointFile file = PointFile::Load(lidar);
+    const SphereField spheres = MakeSphereField(spherePoints);
+    const Scene scenes[] = { { "lidar", file.View(), 0 }, { "spheres", spheres.View(true, true), 8 } };
+    std::vector<Record> records;
+    for (Backend b : backends)
+    {
+      auto engine = CreateEngine(b);
+      if (threads > 0)
+        engine->SetThreadCount(threads);
+      const std::string backendName = b == Backend::CPU ? "cpu" : "cuda";
+      std::printf("\n%s, %dx%d, median of %d after a warm-up frame\n", engine->Description().c_str(), w, h,
+        repeats);
+      for (const Scene& scene : scenes)
+      {
+        BuildOptions options;
+        options.depth = scene.depth;
+        const BuildStats build = engine->Build(scene.points, options);
+        std::printf("\nscene %s: %zu points, depth %d, %zu nodes\n", scene.name.c_str(), build.points, build.depth,
+          build.nodes);
+        std::printf("| mode | ms / frame | Mrays/s (all rays) | Mrays/s (primary) | secondary rays / pixel |\n");
+        std::printf("| --- | ---: | ---: | ---: | ---: |\n");
+        for (const Mode& m : kModes)
+        {
+          const RenderSettings s = MakeSettings(scene.points, w, h, m, build.depth);
+          Image image;
+          RenderStats stats;
+          const Timing t = Measure([&] { stats = engine->Render(s, image); }, 1, repeats);
+          std::printf("| %s | %.1f | %.2f | %.2f | %.2f |\n", m.name, t.median * 1e3, MraysPerSecond(stats, t.median),
+            stats.primaryRays / t.median * 1e-6, double(stats.secondaryRays) / stats.primaryRays);
+          std::fflush(stdout);
+          records.push_back(Record{ "render." + scene.name + "." + m.name, backendName + "-" + engine->Description(),
+            std::size_t(w) * h, build.depth, t.median, "", 0.0 });
+        }
+      }
+
+      // Everything off: the sphere field without reflectivity, rendered
+      // with settings that ask for bounces and shadows but give no light,
+      // against the plain primary-ray path (flat, nothing asked for).
+      {
+        const PointCloudView plainPoints = spheres.View(false, true);
+        engine->Build(plainPoints, BuildOptions{ 8 });
+        const Mode flat = kModes[0];
+        RenderSettings plain = MakeSettings(plainPoints, w, h, flat, 8);
+        RenderSettings asked = plain;
+        asked.maxBounces = 4;
+        asked.shadows = true;
+        Image image;
+        const Timing tp = Measure([&] { engine->Render(plain, image); }, 1, repeats);
+        const Timing ta = Measure([&] { engine->Render(asked, image); }, 1, repeats);
+        // The same points with reflectivity present but zero everywhere:
+        // the per-hit read of a zero weight.
+        SphereField zero = spheres;
+        std::fill(zero.reflectivity.begin(), zero.reflectivity.end(), 0.0f);
+        engine->Build(zero.View(true, true), BuildOptions{ 8 });
+        const Timing tz = Measure([&] { engine->Render(asked, image); }, 1, repeats);
+        std::printf("\neverything off (spheres, flat, %dx%d):\n", w, h);
+        std::printf("| frame | ms / frame |\n| --- | ---: |\n");
+        std::printf("| plain primary rays (bounces 0, no shadows) | %.1f |\n", tp.median * 1e3);
+        std::printf("| bounces 4 + shadows asked, no reflectivity attribute, no lights | %.1f |\n", ta.median * 1e3);
+        std::printf("| bounces 4 + shadows asked, reflectivity attribute all 0, no lights | %.1f |\n", tz.median * 1e3);
+        records.push_back(Record{ "render.spheres.everything-off", backendName + "-" + engine->Description(),
+          std::size_t(w) * h, 8, ta.median, "render.spheres.plain-primary", tp.median });
+      }
+
+      // Error against time: level-of-detail threshold k and bounce limit,
+      // Phong with shadows and reflections on the sphere field, against the
+      // k = 0, 4-bounce picture.
+      {
+        engine->Build(spheres.View(true, true), BuildOptions{ 8 });
+        Mode m = kModes[4];
+        RenderSettings s = MakeSettings(spheres.View(true, true), tw, th, m, 8);
+        s.lodPixels = 0;
+        s.maxBounces = 4;
+        Image reference;
+        engine->Render(s, reference);
+        std::printf("\nerror against time (spheres, Phong + shadows + reflections, %dx%d, reference k = 0, 4 bounces):\n",
+          tw, th);
+        std::printf("| k (pixels) | bounces | ms / frame | RMSE | PSNR (dB) |\n| ---: | ---: | ---: | ---: | ---: |\n");
+        for (float k : { 0.0f, 0.5f, 1.0f, 2.0f, 4.0f, 8.0f })
+          for (int bounces : { 0, 1, 2, 4 })
+          {
+            s.lodPixels = k;
+            s.maxBounces = bounces;
+            Image image;
+            const Timing t = Measure([&] { engine->Render(s, image); }, 0, std::max(1, repeats / 2));
+            const double rmse = Rmse(image, reference);
+            if (rmse > 0)
+              std::printf("| %g | %d | %.1f | %.5f | %.1f |\n", k, bounces, t.median * 1e3, rmse,
+                20 * std::log10(1.0 / rmse));
+            else
+              std::printf("| %g | %d | %.1f | 0 | inf |\n", k, bounces, t.median * 1e3);
+            std::fflush(stdout);
+            char name[64];
+            std::snprintf(name, sizeof name, "render.spheres.lod%g.bounces%d", k, bounces);
+            records.push_back(Record{ name, backendName + "-" + engine->Description(), std::size_t(tw) * th, 8,
+              t.median, "", 0.0 });
+          }
+      }
+    }
+    if (!json.empty())
+    {
+      MergeRecords(json, records);
+      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
+    }
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

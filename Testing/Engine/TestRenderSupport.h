@@ -1,0 +1,252 @@
+// Shared pieces of the rendering tests: an OpenGL-style camera (what VTK's
+// composite projection transform gives), pixel rays in world coordinates,
+// and brute-force references that intersect every leaf box in double
+// precision, written independently of the engine's traversal.
+#pragma once
+
+#include "TestSupport.h"
+
+#include <octoray/Frame.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <limits>
+
+namespace octoray::test
+{
+using Matrix = std::array<double, 16>;
+
+inline Matrix Multiply(const Matrix& a, const Matrix& b)
+{
+  Matrix m{};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k)
+        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
+  return m;
+}
+
+// OpenGL-style camera, as VTK's composite projection transform gives it.
+// Parallel projection: parallelScale is half the viewport's height.
+inline Matrix ViewProjection(const double eye[3], const double target[3], const double up[3], double fovyDegrees,
+  double aspect, double zNear, double zFar, bool parallel = false, double parallelScale = 1.0)
+{
+  double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
+  const double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  for (double& v : f)
+    v /= fl;
+  double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
+  const double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  for (double& v : s)
+    v /= sl;
+  const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
+  const Matrix view = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
+    -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2],
+    f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 0, 0, 0, 1 };
+  Matrix proj{};
+  if (parallel)
+  {
+    proj = { 1 / (parallelScale * aspect), 0, 0, 0, 0, 1 / parallelScale, 0, 0, 0, 0, -2 / (zFar - zNear),
+      -(zFar + zNear) / (zFar - zNear), 0, 0, 0, 1 };
+  }
+  else
+  {
+    const double t = 1.0 / std::tan(fovyDegrees * M_PI / 360.0);
+    proj = { t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, -(zFar + zNear) / (zFar - zNear),
+      -2 * zFar * zNear / (zFar - zNear), 0, 0, -1, 0 };
+  }
+  return Multiply(proj, view);
+}
+
+inline RenderSettings Settings(const Matrix& vp, int w, int h)
+{
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  double inv[16];
+  EXPECT_TRUE(Invert4x4(vp.data(), inv));
+  std::copy(inv, inv + 16, s.inverseViewProjection);
+  return s;
+}
+
+// A pixel's ray in world coordinates: o on the near plane, o + d on the far
+// plane, so the clipping range is t in [0, 1].
+struct WorldRay
+{
+  double o[3], d[3];
+};
+
+inline WorldRay PixelRay(const Matrix& vp, int w, int h, double x, double y)
+{
+  double inv[16];
+  Invert4x4(vp.data(), inv);
+  auto unproject = [&](double z, double p[3]) {
+    const double ndc[4] = { 2.0 * (x + 0.5) / w - 1, 2.0 * (y + 0.5) / h - 1, z, 1 };
+    double r[4] = {};
+    for (int i = 0; i < 4; ++i)
+      for (int k = 0; k < 4; ++k)
+        r[i] += inv[4 * i + k] * ndc[k];
+    for (int a = 0; a < 3; ++a)
+      p[a] = r[a] / r[3];
+  };
+  WorldRay ray;
+  double e[3];
+  unproject(-1, ray.o);
+  unproject(1, e);
+  for (int a = 0; a < 3; ++a)
+    ray.d[a] = e[a] - ray.o[a];
+  return ray;
+}
+
+// Slab interval of a ray through the closed box [lo, hi], clipped to
+// [t0, t1]; false on a miss.
+inline bool Slab(const WorldRay& r, const double lo[3], const double hi[3], double& t0, double& t1)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (r.d[a] == 0)
+    {
+      if (r.o[a] < lo[a] || r.o[a] > hi[a])
+        return false;
+      continue;
+    }
+    double ta = (lo[a] - r.o[a]) / r.d[a], tb = (hi[a] - r.o[a]) / r.d[a];
+    if (ta > tb)
+      std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 <= t1;
+}
+
+// World box of node n at `level` of a host octree.
+inline void NodeBox(const HostOctree& t, std::uint32_t n, int level, double lo[3], double hi[3])
+{
+  std::uint32_t c[3];
+  DecodeMorton(t.key[n], c[0], c[1], c[2]);
+  const double voxel = t.cube.size / double(1u << level);
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = t.cube.origin[a] + c[a] * voxel;
+    hi[a] = lo[a] + voxel;
+  }
+}
+
+// Window point (pixel coordinates, the pixel (x, y) covering [x, x+1)) of a
+// world point.
+inline void ProjectToPixel(const Matrix& vp, int w, int h, const double p[3], double& px, double& py)
+{
+  double clip[4] = {};
+  const double in[4] = { p[0], p[1], p[2], 1 };
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k)
+      clip[i] += vp[4 * i + k] * in[k];
+  px = (clip[0] / clip[3] * 0.5 + 0.5) * w;
+  py = (clip[1] / clip[3] * 0.5 + 0.5) * h;
+}
+
+struct BruteHit
+{
+  bool hit = false;
+  std::uint32_t node = 0;
+  double t = 0;
+  double depth = 1;
+  double p[3] = {}; // world point where the ray enters the voxel
+};
+
+// Every leaf box against the pixel's ray, in double; world coordinates.
+inline BruteHit BruteForceFirstHit(const HostOctree& t, const Matrix& vp, int w, int h, int x, int y)
+{
+  const WorldRay r = PixelRay(vp, w, h, x, y);
+  BruteHit best;
+  best.t = std::numeric_limits<double>::infinity();
+  for (std::uint32_t n = t.levelBegin[t.depth]; n < t.levelBegin[t.depth + 1]; ++n)
+  {
+    double lo[3], hi[3], t0 = 0, t1 = 1; // the clipping range is t in [0, 1]
+    NodeBox(t, n, t.depth, lo, hi);
+    // Half-open boxes where the ray runs along a face plane, as the engine
+    // defines them (a ray on a shared face belongs to exactly one voxel).
+    bool miss = false;
+    for (int a = 0; a < 3; ++a)
+      miss = miss || (r.d[a] == 0 && !(r.o[a] >= lo[a] && r.o[a] < hi[a]));
+    if (!miss && Slab(r, lo, hi, t0, t1) && t0 < best.t)
+    {
+      best.hit = true;
+      best.node = n;
+      best.t = t0;
+    }
+  }
+  if (best.hit)
+  {
+    double clip[4] = {};
+    for (int a = 0; a < 3; ++a)
+      best.p[a] = r.o[a] + best.t * r.d[a];
+    const double p[4] = { best.p[0], best.p[1], best.p[2], 1 };
+    for (int i = 0; i < 4; ++i)
+      for (int k = 0; k < 4; ++k)
+        clip[i] += vp[4 * i + k] * p[k];
+    best.depth = 0.5 * clip[2] / clip[3] + 0.5;
+  }
+  return best;
+}
+
+inline std::size_t Pixel(const Image& image, int x, int y)
+{
+  return std::size_t(y) * image.width + x;
+}
+
+// Every image a test makes: the right size, and no NaN or infinity in
+// colour or depth anywhere.
+inline void ExpectFiniteImage(const Image& image, int w, int h)
+{
+  ASSERT_EQ(image.width, w);
+  ASSERT_EQ(image.height, h);
+  ASSERT_EQ(image.rgba.size(), 4 * std::size_t(w) * h);
+  ASSERT_EQ(image.depth.size(), std::size_t(w) * h);
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < image.rgba.size(); ++i)
+  {
+    if (!std::isfinite(image.rgba[i]) && bad++ == 0)
+      first = i / 4;
+  }
+  for (std::size_t i = 0; i < image.depth.size(); ++i)
+  {
+    if (!(image.depth[i] >= 0.0f && image.depth[i] <= 1.0f) && bad++ == 0)
+      first = i;
+  }
+  EXPECT_EQ(bad, 0u) << "non-finite values, the first at pixel " << first % w << "," << first / w;
+}
+
+// Renders and checks the image for size and finiteness.
+inline Image RenderChecked(Engine& engine, const RenderSettings& s, RenderStats* stats = nullptr)
+{
+  Image image;
+  const RenderStats st = engine.Render(s, image);
+  if (stats)
+    *stats = st;
+  ExpectFiniteImage(image, s.width, s.height);
+  return image;
+}
+
+// Bit-for-bit equality of two images (NaN payloads included).
+inline bool BitIdentical(const Image& a, const Image& b)
+{
+  return a.width == b.width && a.height == b.height && a.rgba.size() == b.rgba.size() &&
+    a.depth.size() == b.depth.size() &&
+    std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * sizeof(float)) == 0 &&
+    std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0;
+}
+
+// Build options for a scene laid out on the unit cube's grid: points placed
+// at voxel centres land where the test says, whatever their bounds.
+inline BuildOptions UnitCubeOptions(int depth)
+{
+  BuildOptions o;
+  o.depth = depth;
+  o.fixedCube = true;
+  o.cube.origin[0] = o.cube.origin[1] = o.cube.origin[2] = 0.0;
+  o.cube.size = 1.0;
+  return o;
+}
+}
