@@ -29,6 +29,8 @@ packages=(
   python3-pytest python3-numpy xvfb
   # reader benchmarks compare against pandas (pyarrow engine when present)
   python3-pandas
+  # independent reference values for the DICOM tests
+  python3-pydicom
 )
 
 missing=()

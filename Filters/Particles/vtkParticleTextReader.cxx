@@ -398,11 +398,11 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
       {
         names.push_back(t.first);
       }
-      bool namesXYZ = allNames &&
-        std::count_if(names.begin(), names.end(), [](const std::string& n) {
-          std::string l = Lower(n);
-          return l == "x" || l == "y" || l == "z";
-        }) == 3;
+      auto named = [&](const char* want) {
+        return std::any_of(
+          names.begin(), names.end(), [&](const std::string& n) { return Lower(n) == want; });
+      };
+      const bool namesXYZ = allNames && named("x") && named("y") && named("z");
       if (!haveHeader && namesXYZ)
       {
         std::string why;
