@@ -269,8 +269,11 @@ void ParallelChunks(int n, int threads, Work&& work, Progress&& progress)
       cv.notify_one();
     }
   };
+  // The calling thread only waits and reports, so `threads` workers parse;
+  // with one thread (or one chunk) it parses itself.
   std::vector<std::thread> pool;
-  for (int t = 1; t < std::min(threads, n); ++t)
+  const int workers = std::min(threads, n);
+  for (int t = 0; workers > 1 && t < workers; ++t)
   {
     pool.emplace_back(worker);
   }
