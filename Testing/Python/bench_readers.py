@@ -115,9 +115,22 @@ def bench_particles(workdir, mb, vtk_mb, repeats):
                         bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
     try:
         import pyarrow  # noqa: F401
+        import pyarrow.csv as pacsv
         secs, m = best_of(lambda: pandas_read("pyarrow"), 1)
+        assert m == n, (m, n)
         records.append(dict(name="reader/particle_text",
                             backend="pandas-%s-pyarrow-%s" % (pd.__version__, pyarrow.__version__),
+                            n=n, bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
+
+        def arrow_read():
+            return pacsv.read_csv(path, read_options=pacsv.ReadOptions(
+                skip_rows=1, autogenerate_column_names=True),
+                parse_options=pacsv.ParseOptions(delimiter=" ")).num_rows
+
+        secs, m = best_of(arrow_read, repeats)
+        assert m == n, (m, n)
+        records.append(dict(name="reader/particle_text",
+                            backend="pyarrow-%s-csv" % pyarrow.__version__,
                             n=n, bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
     except ImportError:
         records.append(dict(name="reader/particle_text", backend="pandas-pyarrow", n=n,
