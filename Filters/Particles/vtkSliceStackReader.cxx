@@ -749,10 +749,75 @@ bool vtkSliceStackReader::ReadDICOM(const std::vector<std::string>& files, vtkIm
 
 //------------------------------------------------------------------------------
 int vtkSliceStackReader::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector*)
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  // The stack's extent is known only after the slices are read; the volume
-  // output is produced whole in RequestData.
+  // The volume's extent, from the headers (first DICOM file, or every
+  // picture's page count), so that pipelines downstream (and ParaView) see a
+  // whole extent before any pixel is read.
+  this->ErrorMessage.clear();
+  std::vector<std::string> files;
+  if (!this->CollectFiles(files))
+  {
+    return 0;
+  }
+  int dims[3] = { 0, 0, 0 };
+  const bool dicom = IsDICOMFile(files.front());
+  if (dicom)
+  {
+    std::error_code ec;
+    if (!fs::exists(files.front(), ec))
+    {
+      this->Fail("DICOM slice '" + files.front() + "' does not exist");
+      return 0;
+    }
+    gdcm::ImageReader reader;
+    reader.SetFileName(files.front().c_str());
+    if (!reader.Read())
+    {
+      this->Fail(
+        "cannot read DICOM slice '" + files.front() + "': not a DICOM image GDCM can decode");
+      return 0;
+    }
+    const unsigned int* d = reader.GetImage().GetDimensions();
+    dims[0] = static_cast<int>(d[0]);
+    dims[1] = static_cast<int>(d[1]);
+    dims[2] = files.size() > 1 || reader.GetImage().GetNumberOfDimensions() < 3
+      ? static_cast<int>(files.size())
+      : static_cast<int>(d[2]);
+  }
+  else
+  {
+    for (const auto& f : files)
+    {
+      std::error_code ec;
+      if (!fs::exists(f, ec))
+      {
+        this->Fail("slice file '" + f + "' does not exist");
+        return 0;
+      }
+      auto in = OIIO::ImageInput::open(f);
+      if (!in)
+      {
+        this->Fail("cannot read slice '" + f + "': " + OIIO::geterror());
+        return 0;
+      }
+      if (dims[2] == 0)
+      {
+        dims[0] = in->spec().width;
+        dims[1] = in->spec().height;
+      }
+      OIIO::ImageSpec spec;
+      for (int s = 0; in->seek_subimage(s, 0, spec); ++s)
+      {
+        ++dims[2];
+      }
+    }
+  }
+  const int extent[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
+  vtkInformation* info = outputVector->GetInformationObject(1);
+  info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  info->Set(vtkDataObject::SPACING(), this->Spacing, 3);
+  info->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
   return 1;
 }
 

@@ -29,6 +29,7 @@
  *
  * Output 1 (vtkImageData): the whole stack with the slices' own pixel type
  * (or float for rescaled DICOM), so VTK's volume mappers can draw the same data.
+ * Its whole extent is announced in RequestInformation (from the headers).
  *
  * Errors name the slice: a missing or unreadable file, slices of different
  * size or type (both named, with both sizes), an empty directory, a pattern

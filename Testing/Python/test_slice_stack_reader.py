@@ -314,3 +314,25 @@ def test_progress_per_slice(tmp_path):
     r.Update()
     assert len(progress) >= 7  # start, one per slice, end
     assert progress[-1] == 1.0
+
+
+def test_volume_port_in_a_pipeline(tmp_path):
+    """Output 1 announces its whole extent before reading, and a VTK image
+    filter downstream gets the whole stack (as VTK's volume mappers would)."""
+    vol = np.random.default_rng(3).integers(0, 100, size=(4, 6, 5)).astype(np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "v%d.png", vol)
+    r = octoray.vtkSliceStackReader()
+    for f in files:
+        r.AddFileName(f)
+    r.UpdateInformation()
+    info = r.GetOutputInformation(1)
+    assert info.Get(vtk.vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()) == (0, 4, 0, 5, 0, 3)
+    shift = vtk.vtkImageShiftScale()
+    shift.SetInputConnection(r.GetOutputPort(1))
+    shift.SetShift(1)
+    shift.SetOutputScalarTypeToUnsignedShort()
+    shift.Update()
+    out = shift.GetOutput()
+    assert out.GetDimensions() == (5, 6, 4)
+    got = vtk_to_numpy(out.GetPointData().GetScalars()).reshape(4, 6, 5)[:, ::-1]
+    np.testing.assert_array_equal(got, vol.astype(np.uint16) + 1)
