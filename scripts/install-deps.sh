@@ -13,11 +13,12 @@ packages=(
   paraview paraview-dev python3-paraview
   qtbase5-dev qttools5-dev libqt5svg5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev libopenmpi-dev python3-dev
-  # find_package(ParaView) loads the find-package files of every VTK module
-  # ParaView was built with; these are the -dev packages paraview-dev lacks
-  libutfcpp-dev libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
-  libgdal-dev libgl2ps-dev libnetcdf-dev libglew-dev libdouble-conversion-dev
-  libtiff-dev
+  # find_package(ParaView) without components makes VTK's config find every
+  # third-party library its modules were built with; paraview-dev does not
+  # depend on these -dev packages, so configuring fails without them
+  libutfcpp-dev libogg-dev libtheora-dev libavformat-dev libavcodec-dev
+  libavutil-dev libswscale-dev libgdal-dev libgl2ps-dev libglew-dev
+  libnetcdf-dev libtiff-dev libdouble-conversion-dev
   # point-cloud algorithms and the comparison octree (runtime libraries only)
   libpcl-common1.13 libpcl-octree1.13 libpcl-kdtree1.13 libpcl-search1.13
   libpcl-features1.13 libeigen3-dev libflann-dev libboost-dev
