@@ -818,7 +818,8 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
         {
           for (int k = 0; k < 3; ++k)
           {
-            sinks.Colors[3 * pt + k] = static_cast<unsigned char>(std::lround(rgb[k]));
+            // rgb is in [0, 255] (checked above): adding 0.5 rounds half up.
+            sinks.Colors[3 * pt + k] = static_cast<unsigned char>(rgb[k] + Real(0.5));
           }
         }
         ++pt;
