@@ -24,10 +24,11 @@ test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench
 
 demo: build
-	$(BUILD)/bin/octoray stats Data/Particles/bunny.xyzrgb
+	$(BUILD)/bin/octoray stats Data/Particles/lidar_simple.particles
 
+# --verbose: the benchmarks' tables are the output wanted, pass or fail.
 bench: build
-	cd $(BUILD) && ctest --output-on-failure -L bench
+	cd $(BUILD) && ctest --verbose -L bench
 
 clean:
 	rm -rf $(BUILD)

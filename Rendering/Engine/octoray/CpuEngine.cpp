@@ -4,6 +4,7 @@
 #include "CpuEngine.h"
 
 #include "DepthChoice.h"
+#include "Frame.h"
 #include "OctreeKernels.h"
 #include "Parallel.h"
 #include "RadixSort.h"
@@ -98,20 +99,17 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
   const std::size_t n = points.count;
 
   // Bounds, and the first non-finite point, before anything is replaced.
+  constexpr double inf = std::numeric_limits<double>::infinity();
   struct ChunkBounds
   {
-    double lo[3], hi[3];
-    std::size_t firstBad;
+    double lo[3] = { inf, inf, inf };
+    double hi[3] = { -inf, -inf, -inf };
+    std::size_t firstBad = std::numeric_limits<std::size_t>::max();
   };
+  // One entry per thread; a small input may use fewer chunks.
   std::vector<ChunkBounds> chunkBounds(Threads);
   ParallelChunks(n, Threads, [&](std::size_t begin, std::size_t end, int c) {
     ChunkBounds b;
-    for (int a = 0; a < 3; ++a)
-    {
-      b.lo[a] = std::numeric_limits<double>::infinity();
-      b.hi[a] = -std::numeric_limits<double>::infinity();
-    }
-    b.firstBad = std::numeric_limits<std::size_t>::max();
     for (std::size_t i = begin; i < end; ++i)
     {
       const double p[3] = { points.Coordinate(i, 0), points.Coordinate(i, 1), points.Coordinate(i, 2) };
@@ -146,6 +144,23 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
     {
       lo[a] = std::min(lo[a], b.lo[a]);
       hi[a] = std::max(hi[a], b.hi[a]);
+    }
+  }
+
+  if (options.fixedCube)
+  {
+    // Checked before anything is replaced, like the coordinates.
+    std::uint32_t cell[3];
+    if (!options.cube.GridCell(lo[0], lo[1], lo[2], cell) || !options.cube.GridCell(hi[0], hi[1], hi[2], cell))
+    {
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const double p[3] = { points.Coordinate(i, 0), points.Coordinate(i, 1), points.Coordinate(i, 2) };
+        if (!options.cube.GridCell(p[0], p[1], p[2], cell))
+        {
+          throw Error(OutsideCubeMessage(i, p));
+        }
+      }
     }
   }
 
@@ -202,7 +217,8 @@ BuildStats CpuEngine::Build(const PointCloudView& points, const BuildOptions& op
   }
   Attributes = points.Attributes();
 
-  BuildStats stats = BuildFromPointState(RootCube::FromBounds(lo, hi), options.depth);
+  BuildStats stats =
+    BuildFromPointState(options.fixedCube ? options.cube : RootCube::FromBounds(lo, hi), options.depth);
   stats.seconds = SecondsSince(start);
   return stats;
 }
@@ -221,7 +237,7 @@ BuildStats CpuEngine::BuildFromPointState(const RootCube& cube, int requestedDep
     {
       double p[3];
       pts.Position(i, p);
-      throw Error(NonFinitePointMessage(i, p) + " or lies outside the root cube");
+      throw Error(OutsideCubeMessage(i, p));
     }
   });
   stats.keySeconds = SecondsSince(phase);
@@ -519,6 +535,44 @@ UpdateStats CpuEngine::Update(const PositionsView& positions)
     RadixSortPairs(SortedKey.data(), SortedIndex.data(), Count, 3 * depth, Threads, ScratchKey, ScratchIndex);
     BuildLevels(Tree.cube, depth);
     stats.path = UpdateStats::Path::Relevel;
+  }
+  stats.seconds = SecondsSince(start);
+  return stats;
+}
+
+RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
+{
+  if (Count == 0)
+  {
+    throw Error("octoray: render before any build");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const OctreeView view = Tree.View();
+  const FrameConstants frame = MakeFrame(settings, Tree.cube, view.reflectivity != nullptr || view.refraction != nullptr);
+  image.width = settings.width;
+  image.height = settings.height;
+  const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
+  image.rgba.resize(4 * pixels);
+  image.depth.resize(pixels);
+  // Rows are interleaved over threads so that costly regions are shared.
+  std::vector<std::size_t> secondary(Threads, 0);
+  ParallelChunks(static_cast<std::size_t>(Threads), Threads, [&](std::size_t, std::size_t, int t) {
+    std::size_t rays = 0;
+    for (int y = t; y < settings.height; y += Threads)
+    {
+      for (int x = 0; x < settings.width; ++x)
+      {
+        const std::size_t i = static_cast<std::size_t>(y) * settings.width + x;
+        RenderPixel(frame, view, x, y, &image.rgba[4 * i], image.depth[i], rays);
+      }
+    }
+    secondary[t] = rays;
+  });
+  RenderStats stats;
+  stats.primaryRays = pixels;
+  for (std::size_t r : secondary)
+  {
+    stats.secondaryRays += r;
   }
   stats.seconds = SecondsSince(start);
   return stats;

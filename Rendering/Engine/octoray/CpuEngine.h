@@ -16,6 +16,7 @@ public:
   std::string Description() const override;
   BuildStats Build(const PointCloudView& points, const BuildOptions& options) override;
   UpdateStats Update(const PositionsView& positions) override;
+  RenderStats Render(const RenderSettings& settings, Image& image) override;
   std::size_t PointCount() const override { return Count; }
   void CopyToHost(HostOctree& out) const override;
   MemoryReport Memory() const override;

@@ -5,6 +5,7 @@
 
 #include "Octree.h"
 #include "PointCloud.h"
+#include "Render.h"
 
 #include <memory>
 #include <string>
@@ -35,12 +36,22 @@ public:
   virtual BuildStats Build(const PointCloudView& points, const BuildOptions& options) = 0;
 
   // Moves points (all, or those listed in positions.indices). The result is
-  // the octree a Build from the new positions would give: the same nodes and
-  // counts, the same means within float rounding. While every point stays
-  // in the root cube the cube is kept; when one leaves, the octree is
-  // rebuilt around the new bounds (UpdateStats::Path::NewCube) at the same
-  // depth. Throws Error for a non-finite coordinate or an index out of range.
+  // the octree a Build from the new positions in the same root cube would
+  // give: the same nodes and counts, the same means within float rounding.
+  // Points that stay in their leaf cost nothing; when points change leaf
+  // but no node appears or empties, counts and means are adjusted along
+  // their paths (cost proportional to the points moved); otherwise the
+  // stored keys are re-sorted and the levels rebuilt in the same buffers.
+  // Indices must be distinct. When a point leaves
+  // the root cube, the octree is rebuilt around the new bounds
+  // (UpdateStats::Path::NewCube) at the same depth. Throws Error for a
+  // non-finite coordinate, an index out of range or listed twice, before
+  // changing anything.
   virtual UpdateStats Update(const PositionsView& positions) = 0;
+
+  // Ray-traces the octree into `image` (resized to the viewport). Throws
+  // Error for settings that cannot make a picture or before any build.
+  virtual RenderStats Render(const RenderSettings& settings, Image& image) = 0;
 
   virtual std::size_t PointCount() const = 0;
   virtual void CopyToHost(HostOctree& out) const = 0;
@@ -48,6 +59,11 @@ public:
 
   // Threads the CPU backend uses (ignored by CUDA); default: all cores.
   virtual void SetThreadCount(int threads) { (void)threads; }
+
+  // Device bytes the CUDA backend may hold (ignored by the CPU backend); an
+  // allocation past it fails with the out-of-memory error, as a full GPU
+  // would. Default: no limit but the device's.
+  virtual void SetMemoryBudget(std::size_t bytes) { (void)bytes; }
 };
 
 // The backend's engine. Throws Error when the backend is not available here

@@ -129,8 +129,13 @@ struct MemoryReport
 
 struct BuildOptions
 {
-  // Leaf level 1..21, or 0 to choose it from the data (see ChooseDepth).
+  // Leaf level 1..21, or 0 to choose it from the data (DepthChoice.h).
   int depth = 0;
+  // Build inside this root cube instead of one fitted to the points: keeps
+  // nodes comparable across frames of an animation and across the pieces of
+  // data split over parallel ranks. Every point must lie inside it.
+  bool fixedCube = false;
+  RootCube cube;
 };
 
 struct BuildStats

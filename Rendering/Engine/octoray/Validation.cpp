@@ -1,6 +1,7 @@
 #include "Validation.h"
 
 #include <sstream>
+#include <vector>
 
 namespace octoray
 {
@@ -55,13 +56,23 @@ void ValidateUpdate(const PositionsView& positions, std::size_t pointCount)
   }
   if (positions.indices)
   {
+    // A point listed twice would get whichever position a backend wrote
+    // last: refused, as the GPU gives no order.
+    std::vector<bool> listed(pointCount, false);
     for (std::size_t k = 0; k < positions.count; ++k)
     {
-      if (positions.indices[k] >= pointCount)
+      const std::uint32_t i = positions.indices[k];
+      if (i >= pointCount)
       {
-        throw Error("octoray: update index " + std::to_string(k) + " names point " +
-          std::to_string(positions.indices[k]) + " of an octree of " + std::to_string(pointCount) + " points");
+        throw Error("octoray: update index " + std::to_string(k) + " names point " + std::to_string(i) +
+          " of an octree of " + std::to_string(pointCount) + " points");
       }
+      if (listed[i])
+      {
+        throw Error("octoray: update index " + std::to_string(k) + " names point " + std::to_string(i) +
+          " a second time");
+      }
+      listed[i] = true;
     }
   }
 }
@@ -71,6 +82,13 @@ std::string NonFinitePointMessage(std::size_t index, const double p[3])
   std::ostringstream s;
   s << "octoray: point " << index << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2]
     << ")";
+  return s.str();
+}
+
+std::string OutsideCubeMessage(std::size_t index, const double p[3])
+{
+  std::ostringstream s;
+  s << "octoray: point " << index << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") lies outside the root cube";
   return s.str();
 }
 

@@ -20,5 +20,6 @@ void ValidateDepth(int depth);
 void ValidateUpdate(const PositionsView& positions, std::size_t pointCount);
 
 std::string NonFinitePointMessage(std::size_t index, const double p[3]);
+std::string OutsideCubeMessage(std::size_t index, const double p[3]);
 std::string OutOfMemoryMessage(const char* what, std::size_t bytesNeeded, std::size_t bytesFree);
 }

@@ -1,0 +1,195 @@
+#include "Frame.h"
+
+#include <cmath>
+#include <string>
+
+namespace octoray
+{
+bool Invert4x4(const double m[16], double inverse[16])
+{
+  double a[4][8];
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      a[r][c] = m[4 * r + c];
+      a[r][c + 4] = r == c ? 1.0 : 0.0;
+    }
+  }
+  for (int c = 0; c < 4; ++c)
+  {
+    int pivot = c;
+    for (int r = c + 1; r < 4; ++r)
+    {
+      if (std::fabs(a[r][c]) > std::fabs(a[pivot][c]))
+      {
+        pivot = r;
+      }
+    }
+    if (!(std::fabs(a[pivot][c]) > 0.0))
+    {
+      return false;
+    }
+    for (int k = 0; k < 8; ++k)
+    {
+      std::swap(a[c][k], a[pivot][k]);
+    }
+    const double inv = 1.0 / a[c][c];
+    for (int k = 0; k < 8; ++k)
+    {
+      a[c][k] *= inv;
+    }
+    for (int r = 0; r < 4; ++r)
+    {
+      if (r != c)
+      {
+        const double factor = a[r][c];
+        for (int k = 0; k < 8; ++k)
+        {
+          a[r][k] -= factor * a[c][k];
+        }
+      }
+    }
+  }
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      inverse[4 * r + c] = a[r][c + 4];
+    }
+  }
+  return true;
+}
+
+namespace
+{
+void Multiply(const double a[16], const double b[16], double out[16])
+{
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      double s = 0.0;
+      for (int k = 0; k < 4; ++k)
+      {
+        s += a[4 * r + k] * b[4 * k + c];
+      }
+      out[4 * r + c] = s;
+    }
+  }
+}
+
+double Distance(const double a[3], const double b[3])
+{
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+}
+
+FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool secondaryRays)
+{
+  if (s.width <= 0 || s.height <= 0)
+  {
+    throw Error("octoray: the viewport must be at least 1x1, got " + std::to_string(s.width) + "x" +
+      std::to_string(s.height));
+  }
+  if (!s.depthBuffer.empty() && s.depthBuffer.size() != static_cast<std::size_t>(s.width) * s.height)
+  {
+    throw Error("octoray: the depth buffer has " + std::to_string(s.depthBuffer.size()) + " values for a " +
+      std::to_string(s.width) + "x" + std::to_string(s.height) + " viewport");
+  }
+  if (s.lights.size() > static_cast<std::size_t>(kMaxLights))
+  {
+    throw Error("octoray: at most " + std::to_string(kMaxLights) + " lights, got " + std::to_string(s.lights.size()));
+  }
+  if (!s.transfer.table.empty() && !(s.transfer.range[1] > s.transfer.range[0]))
+  {
+    throw Error("octoray: the transfer function's scalar range is empty");
+  }
+  FrameConstants f;
+  f.width = s.width;
+  f.height = s.height;
+
+  // unit <- world: u = (p - origin) / size; world <- unit: its inverse.
+  const double unitFromWorld[16] = { 1 / cube.size, 0, 0, -cube.origin[0] / cube.size, 0, 1 / cube.size, 0,
+    -cube.origin[1] / cube.size, 0, 0, 1 / cube.size, -cube.origin[2] / cube.size, 0, 0, 0, 1 };
+  const double worldFromUnit[16] = { cube.size, 0, 0, cube.origin[0], 0, cube.size, 0, cube.origin[1], 0, 0,
+    cube.size, cube.origin[2], 0, 0, 0, 1 };
+  double ndcFromWorld[16];
+  if (!Invert4x4(s.inverseViewProjection, ndcFromWorld))
+  {
+    throw Error("octoray: the inverse view-projection matrix is singular");
+  }
+  Multiply(unitFromWorld, s.inverseViewProjection, f.unitFromNdc);
+  Multiply(ndcFromWorld, worldFromUnit, f.ndcFromUnit);
+
+  f.blend = s.blend;
+  f.shade = s.shade;
+  f.ambient = s.ambient;
+  f.diffuse = s.diffuse;
+  f.specular = s.specular;
+  f.specularPower = s.specularPower;
+  f.depthCue = s.depthCue;
+  f.shadows = s.shadows && !s.lights.empty() && s.shade == ShadeMode::Phong;
+  f.maxBounces = secondaryRays ? s.maxBounces : 0;
+  f.lodPixels = s.lodPixels;
+  f.opacityUnitDistance = s.opacityUnitDistance > 0 ? s.opacityUnitDistance / static_cast<float>(cube.size) : 1.0f;
+
+  f.lightCount = static_cast<int>(s.lights.size());
+  for (int i = 0; i < f.lightCount; ++i)
+  {
+    const Light& l = s.lights[i];
+    UnitLight& u = f.lights[i];
+    u.directional = l.position[3] == 0.0;
+    double len = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      len += l.position[a] * l.position[a];
+    }
+    len = std::sqrt(len);
+    for (int a = 0; a < 3; ++a)
+    {
+      u.position[a] = static_cast<float>(u.directional ? l.position[a] / (len > 0 ? len : 1.0)
+                                                       : (l.position[a] - cube.origin[a]) / cube.size);
+      u.color[a] = l.color[a] * l.intensity;
+    }
+  }
+
+  // Pixel footprint at the near and far planes through the image centre,
+  // for level of detail, and the cube's distance range for depth cue.
+  const int cx = s.width / 2, cy = s.height / 2;
+  auto ndcX = [&](int x) { return 2.0 * (x + 0.5) / s.width - 1.0; };
+  auto ndcY = [&](int y) { return 2.0 * (y + 0.5) / s.height - 1.0; };
+  double n0[3], n1[3], f0[3], f1[3];
+  Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), -1.0, n0);
+  Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), -1.0, n1);
+  Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), 1.0, f0);
+  Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), 1.0, f1);
+  const double length = Distance(n0, f0);
+  f.footprint0 = static_cast<float>(Distance(n0, n1));
+  f.footprintSlope = static_cast<float>((Distance(f0, f1) - Distance(n0, n1)) / (length > 0 ? length : 1.0));
+  double nearest = INFINITY, farthest = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const double c[3] = { double(corner & 1), double((corner >> 1) & 1), double((corner >> 2) & 1) };
+    double along = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      along += (c[a] - n0[a]) * (f0[a] - n0[a]) / (length > 0 ? length : 1.0);
+    }
+    nearest = std::fmin(nearest, along);
+    farthest = std::fmax(farthest, along);
+  }
+  f.cueNear = static_cast<float>(std::fmax(nearest, 0.0));
+  f.cueFar = static_cast<float>(std::fmax(farthest, f.cueNear + 1e-6));
+
+  if (!s.transfer.table.empty())
+  {
+    f.transfer = s.transfer.table.data();
+    f.transferSize = static_cast<int>(s.transfer.table.size());
+    f.transferRange[0] = s.transfer.range[0];
+    f.transferRange[1] = s.transfer.range[1];
+  }
+  f.depthBuffer = s.depthBuffer.empty() ? nullptr : s.depthBuffer.data();
+  return f;
+}
+}

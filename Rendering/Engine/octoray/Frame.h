@@ -1,0 +1,20 @@
+// Host-side preparation of a frame: RenderSettings in world coordinates ->
+// FrameConstants in the octree's unit cube. Shared by both backends.
+#pragma once
+
+#include "RenderKernels.h"
+#include "RootCube.h"
+
+namespace octoray
+{
+// Throws Error for settings that cannot make a picture (empty viewport, a
+// singular camera matrix, a depth buffer of the wrong size, too many lights).
+// Table and depth-buffer pointers are the host vectors of `settings`; a
+// device backend replaces them with device copies.
+// `secondaryRays`: whether any node reflects or refracts; without, the
+// frame casts no mirror or refracted rays whatever the bounce limit.
+FrameConstants MakeFrame(const RenderSettings& settings, const RootCube& cube, bool secondaryRays);
+
+// Inverse of a row-major 4x4 matrix; false when it is singular.
+bool Invert4x4(const double m[16], double inverse[16]);
+}

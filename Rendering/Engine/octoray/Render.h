@@ -1,0 +1,87 @@
+// What a frame asks of the engine and what it gets back.
+#pragma once
+
+#include "Types.h"
+
+#include <vector>
+
+namespace octoray
+{
+// How a ray turns the voxels it meets into a colour.
+enum class BlendMode
+{
+  Surface,   // the first occupied voxel (the thesis's first-hit rendering), shaded
+  Composite, // front-to-back alpha through the transfer function, early termination
+  Maximum,   // maximum intensity projection of the scalar
+  Minimum,   // minimum intensity projection
+  Average,   // length-weighted mean of the scalar along the ray
+  Additive   // integral of the scalar along the ray
+};
+
+// How a surface hit is lit (BlendMode::Surface only).
+enum class ShadeMode
+{
+  Flat,     // the voxel's colour as it is
+  DepthCue, // darkened with distance across the octree's depth range
+  Phong     // ambient + diffuse + specular from every light
+};
+
+struct Light
+{
+  // w = 0: directional, xyz points towards the light; w = 1: positional.
+  double position[4] = { 0, 0, 1, 0 };
+  float color[3] = { 1, 1, 1 };
+  float intensity = 1.0f;
+};
+
+// A colour and opacity lookup over a scalar range (VTK's colour transfer
+// function and scalar opacity, sampled by the VTK layer).
+struct TransferFunction
+{
+  float range[2] = { 0.0f, 1.0f };
+  std::vector<Rgba> table; // non-premultiplied; empty = node colours, opaque
+};
+
+struct RenderSettings
+{
+  int width = 0, height = 0;
+  // World <- normalised device coordinates: the inverse of VTK's
+  // GetCompositeProjectionTransformMatrix(aspect, -1, 1), row-major.
+  double inverseViewProjection[16] = {};
+
+  BlendMode blend = BlendMode::Surface;
+  ShadeMode shade = ShadeMode::Flat;
+  float ambient = 0.1f, diffuse = 0.7f, specular = 0.2f, specularPower = 10.0f;
+  float depthCue = 0.7f; // fraction of brightness lost at the far side
+  // Lights in world coordinates; none = a headlight at the camera.
+  std::vector<Light> lights;
+  bool shadows = false;
+  int maxBounces = 2;          // reflections and refractions together
+  float lodPixels = 0.0f;      // stop descending at voxels smaller than this many pixels; 0 = leaves
+  float opacityUnitDistance = 1.0f / 256; // composite: opacity is per this length (unit cube)
+  TransferFunction transfer;
+  // Window depth ([0,1], OpenGL convention, row-major from the bottom row) of
+  // opaque geometry already drawn; rays stop there. Empty = none.
+  std::vector<float> depthBuffer;
+  // CUDA: copy the picture to the host Image. Off, it stays in device memory
+  // (CudaEngine::DeviceImage) for a caller that draws it from there.
+  bool copyToHost = true;
+};
+
+// Premultiplied RGBA and window depth (1 where nothing was hit), rows from
+// the bottom, as OpenGL reads them back.
+struct Image
+{
+  int width = 0, height = 0;
+  std::vector<float> rgba;
+  std::vector<float> depth;
+};
+
+struct RenderStats
+{
+  double seconds = 0.0;     // the frame, up to the picture in the backend's memory
+  double copySeconds = 0.0; // CUDA: the copy of the picture to the host
+  std::size_t primaryRays = 0;
+  std::size_t secondaryRays = 0; // shadow, reflected and refracted
+};
+}

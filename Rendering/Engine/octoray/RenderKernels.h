@@ -1,0 +1,693 @@
+// Per-pixel rendering, written once for both backends: primary rays from
+// the inverse view-projection, surface shading (flat, depth cue, Phong,
+// shadows, reflections) and the volume blend modes.
+#pragma once
+
+#include "Render.h"
+#include "Traversal.h"
+
+namespace octoray
+{
+constexpr int kMaxLights = 8;
+
+struct UnitLight
+{
+  float position[3]; // unit-cube position, or direction towards the light
+  bool directional;
+  float color[3];    // colour x intensity
+};
+
+// Everything a frame's rays share, in the unit cube; passed by value.
+struct FrameConstants
+{
+  int width = 0, height = 0;
+  double unitFromNdc[16];
+  double ndcFromUnit[16];
+  BlendMode blend = BlendMode::Surface;
+  ShadeMode shade = ShadeMode::Flat;
+  float ambient, diffuse, specular, specularPower, depthCue;
+  float cueNear = 0, cueFar = 1; // distances from the near plane across which depth cue fades
+  int lightCount = 0;            // 0: headlight
+  UnitLight lights[kMaxLights];
+  bool shadows = false;
+  int maxBounces = 0;            // 0 when no node reflects
+  float footprint0 = 0, footprintSlope = 0, lodPixels = 0;
+  float opacityUnitDistance = 1.0f / 256;
+  const Rgba* transfer = nullptr; // colour and opacity by scalar; null = node colours
+  int transferSize = 0;
+  float transferRange[2] = { 0, 1 };
+  const float* depthBuffer = nullptr;
+};
+
+OCTORAY_HD void Transform(const double m[16], const double in[4], double out[4])
+{
+  for (int r = 0; r < 4; ++r)
+  {
+    out[r] = m[4 * r] * in[0] + m[4 * r + 1] * in[1] + m[4 * r + 2] * in[2] + m[4 * r + 3] * in[3];
+  }
+}
+
+OCTORAY_HD void Unproject(const double m[16], double x, double y, double z, double p[3])
+{
+  const double ndc[4] = { x, y, z, 1.0 };
+  double h[4];
+  Transform(m, ndc, h);
+  for (int a = 0; a < 3; ++a)
+  {
+    p[a] = h[a] / h[3];
+  }
+}
+
+// Window depth (OpenGL convention, [0,1]) of a unit-cube point.
+OCTORAY_HD float WindowDepth(const FrameConstants& f, const double p[3])
+{
+  const double in[4] = { p[0], p[1], p[2], 1.0 };
+  double clip[4];
+  Transform(f.ndcFromUnit, in, clip);
+  const double z = 0.5 * clip[2] / clip[3] + 0.5;
+  return static_cast<float>(z < 0.0 ? 0.0 : (z > 1.0 ? 1.0 : z));
+}
+
+// A pixel's primary ray, its origin moved to where it enters the root cube
+// (computed in double). `tBase` is that entry's distance from the near plane.
+// False when the ray misses the cube, or the clipping range or opaque
+// geometry ends it before.
+OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase, double origin[3],
+  double direction[3])
+{
+  const double nx = 2.0 * (x + 0.5) / f.width - 1.0;
+  const double ny = 2.0 * (y + 0.5) / f.height - 1.0;
+  double nearPoint[3], farPoint[3];
+  Unproject(f.unitFromNdc, nx, ny, -1.0, nearPoint);
+  Unproject(f.unitFromNdc, nx, ny, 1.0, farPoint);
+  double d[3] = { farPoint[0] - nearPoint[0], farPoint[1] - nearPoint[1], farPoint[2] - nearPoint[2] };
+  const double length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(length > 0.0))
+  {
+    return false;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    d[a] /= length;
+  }
+  double tEnd = length;
+  if (f.depthBuffer)
+  {
+    const float w = f.depthBuffer[static_cast<std::size_t>(y) * f.width + x];
+    if (w < 1.0f)
+    {
+      double opaque[3];
+      Unproject(f.unitFromNdc, nx, ny, 2.0 * w - 1.0, opaque);
+      tEnd = (opaque[0] - nearPoint[0]) * d[0] + (opaque[1] - nearPoint[1]) * d[1] + (opaque[2] - nearPoint[2]) * d[2];
+    }
+  }
+  // The root cube's slab interval, in double.
+  double t0 = 0.0, t1 = tEnd;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (d[a] == 0.0)
+    {
+      if (!(nearPoint[a] >= 0.0 && nearPoint[a] < 1.0))
+      {
+        return false;
+      }
+      continue;
+    }
+    double ta = (0.0 - nearPoint[a]) / d[a];
+    double tb = (1.0 - nearPoint[a]) / d[a];
+    if (ta > tb)
+    {
+      const double s = ta;
+      ta = tb;
+      tb = s;
+    }
+    t0 = ta > t0 ? ta : t0;
+    t1 = tb < t1 ? tb : t1;
+  }
+  if (!(t0 <= t1))
+  {
+    return false;
+  }
+  tBase = t0;
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] = nearPoint[a] + t0 * d[a];
+    direction[a] = d[a];
+    ray.origin[a] = static_cast<float>(origin[a]);
+  }
+  const float df[3] = { static_cast<float>(d[0]), static_cast<float>(d[1]), static_cast<float>(d[2]) };
+  SetDirection(ray, df);
+  ray.tMin = 0.0f;
+  ray.tMax = static_cast<float>(t1 - t0);
+  return true;
+}
+
+// b^e for b > 0 from +, -, *, / and exact exponent manipulation only, so
+// that the CPU and CUDA backends round it alike (their libm powf do not
+// agree to the last bit, and a composite ray compounds that over hundreds of
+// voxels). Accurate to a few float ulps.
+OCTORAY_HD float PortablePow(float b, float e)
+{
+  if (!(b > 0.0f))
+  {
+    return 0.0f;
+  }
+  int exponent;
+  const float m = frexpf(b, &exponent); // b = m 2^exponent, m in [0.5, 1)
+  // log2(m) = 2 atanh(s) / ln 2 with s = (m - 1) / (m + 1) in [-1/3, 0).
+  const float s = (m - 1.0f) / (m + 1.0f);
+  const float s2 = s * s;
+  const float series =
+    s * (1.0f + s2 * (1.0f / 3 + s2 * (1.0f / 5 + s2 * (1.0f / 7 + s2 * (1.0f / 9 + s2 * (1.0f / 11 + s2 / 13))))));
+  const float x = e * (static_cast<float>(exponent) + 2.0f * series * 1.44269504f); // e log2(b)
+  if (x < -149.0f)
+  {
+    return 0.0f;
+  }
+  if (x > 128.0f)
+  {
+    return INFINITY;
+  }
+  const float whole = floorf(x);
+  const float y = (x - whole) * 0.693147181f; // 2^f = e^y, y in [0, ln 2)
+  const float p =
+    1.0f + y * (1.0f + y * (0.5f + y * (1.0f / 6 + y * (1.0f / 24 + y * (1.0f / 120 + y * (1.0f / 720 + y / 5040))))));
+  return ldexpf(p, static_cast<int>(whole));
+}
+
+OCTORAY_HD float Dot(const float a[3], const float b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+OCTORAY_HD void Normalize(float v[3])
+{
+  const float len = sqrtf(Dot(v, v));
+  if (len > 0.0f)
+  {
+    v[0] /= len, v[1] /= len, v[2] /= len;
+  }
+}
+
+// Colour and opacity of a node: through the transfer function when the
+// frame has one and the node a scalar, else its averaged colour, else white.
+OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::uint32_t node)
+{
+  if (f.transfer && tree.scalar)
+  {
+    const float s = tree.scalar[node];
+    float u = (s - f.transferRange[0]) / (f.transferRange[1] - f.transferRange[0]);
+    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+    if (!(u == u))
+    {
+      u = 0.0f;
+    }
+    int i = static_cast<int>(u * (f.transferSize - 1) + 0.5f);
+    return f.transfer[i];
+  }
+  if (tree.color)
+  {
+    return tree.color[node];
+  }
+  return Rgba{ 1.0f, 1.0f, 1.0f, 1.0f };
+}
+
+// Surface normal at a hit, facing the viewer. Averaged point normals where
+// the data has them; otherwise the occupancy gradient of the six neighbours
+// at the hit's level (it follows the shape, not the voxel's blocky faces);
+// the entry face where the gradient vanishes (e.g. inside a solid block).
+OCTORAY_HD void SurfaceNormal(const OctreeView& tree, const Ray& ray, const NodeHit& hit, float n[3])
+{
+  n[0] = n[1] = n[2] = 0.0f;
+  if (tree.normal)
+  {
+    const Vec3f v = tree.normal[hit.node];
+    n[0] = v.x, n[1] = v.y, n[2] = v.z;
+  }
+  if (Dot(n, n) < 1e-6f)
+  {
+    n[0] = n[1] = n[2] = 0.0f;
+    for (int a = 0; a < 3; ++a)
+    {
+      float p[3] = { hit.lo[0] + 0.5f * hit.size, hit.lo[1] + 0.5f * hit.size, hit.lo[2] + 0.5f * hit.size };
+      p[a] -= hit.size;
+      const float below = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
+      p[a] += 2.0f * hit.size;
+      const float above = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
+      n[a] = below - above;
+    }
+  }
+  if (Dot(n, n) < 1e-6f)
+  {
+    n[0] = n[1] = n[2] = 0.0f;
+    const int axis = hit.axis >= 0 ? hit.axis : 2;
+    n[axis] = ray.direction[axis] > 0.0f ? -1.0f : 1.0f;
+  }
+  Normalize(n);
+  if (Dot(n, ray.direction) > 0.0f)
+  {
+    n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
+  }
+}
+
+// The point where the ray enters the hit voxel, nudged back out of it along
+// the entry face so that secondary rays do not start inside the voxel.
+OCTORAY_HD void EntryPoint(const Ray& ray, const NodeHit& hit, float p[3])
+{
+  const float t = hit.tEnter > ray.tMin ? hit.tEnter : ray.tMin;
+  for (int a = 0; a < 3; ++a)
+  {
+    p[a] = ray.origin[a] + t * ray.direction[a];
+  }
+  if (hit.axis >= 0)
+  {
+    p[hit.axis] += (ray.direction[hit.axis] > 0.0f ? -1.0f : 1.0f) * 1e-3f * hit.size;
+  }
+}
+
+// Lit colour of a surface hit (before reflection).
+OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit,
+  float tFromNear, const LevelOfDetail& lod, float rgb[3], std::size_t& secondaryRays)
+{
+  const Rgba base = NodeColor(f, tree, hit.node);
+  rgb[0] = base.r, rgb[1] = base.g, rgb[2] = base.b;
+  if (f.shade == ShadeMode::DepthCue)
+  {
+    float u = (tFromNear - f.cueNear) / (f.cueFar - f.cueNear);
+    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+    const float k = 1.0f - f.depthCue * u;
+    rgb[0] *= k, rgb[1] *= k, rgb[2] *= k;
+    return;
+  }
+  if (f.shade != ShadeMode::Phong)
+  {
+    return;
+  }
+  float n[3];
+  SurfaceNormal(tree, ray, hit, n);
+  float p[3];
+  EntryPoint(ray, hit, p);
+  const float view[3] = { -ray.direction[0], -ray.direction[1], -ray.direction[2] };
+  float lit[3] = { f.ambient * base.r, f.ambient * base.g, f.ambient * base.b };
+  const int lights = f.lightCount > 0 ? f.lightCount : 1;
+  for (int i = 0; i < lights; ++i)
+  {
+    float l[3], color[3] = { 1.0f, 1.0f, 1.0f };
+    float distance = INFINITY;
+    if (f.lightCount == 0)
+    {
+      l[0] = view[0], l[1] = view[1], l[2] = view[2]; // headlight
+    }
+    else
+    {
+      const UnitLight& light = f.lights[i];
+      for (int a = 0; a < 3; ++a)
+      {
+        l[a] = light.directional ? light.position[a] : light.position[a] - p[a];
+        color[a] = light.color[a];
+      }
+      distance = light.directional ? INFINITY : sqrtf(Dot(l, l));
+      Normalize(l);
+    }
+    const float nl = Dot(n, l);
+    if (nl <= 0.0f)
+    {
+      continue;
+    }
+    if (f.shadows && f.lightCount > 0)
+    {
+      Ray shadow;
+      for (int a = 0; a < 3; ++a)
+      {
+        shadow.origin[a] = p[a];
+      }
+      SetDirection(shadow, l);
+      shadow.tMin = 0.0f;
+      shadow.tMax = distance;
+      FirstHitVisitor blocker;
+      Traverse(tree, shadow, lod, blocker);
+      ++secondaryRays;
+      if (blocker.found)
+      {
+        continue;
+      }
+    }
+    const float r[3] = { 2.0f * nl * n[0] - l[0], 2.0f * nl * n[1] - l[1], 2.0f * nl * n[2] - l[2] };
+    const float rv = Dot(r, view);
+    const float spec = rv > 0.0f ? f.specular * PortablePow(rv, f.specularPower) : 0.0f;
+    for (int a = 0; a < 3; ++a)
+    {
+      lit[a] += color[a] * (f.diffuse * nl * (&base.r)[a] + spec);
+    }
+  }
+  rgb[0] = lit[0], rgb[1] = lit[1], rgb[2] = lit[2];
+}
+
+// Accumulates the volume blend modes over the voxels a ray passes.
+struct BlendVisitor
+{
+  const FrameConstants* f;
+  const OctreeView* tree;
+  float rgba[4] = { 0, 0, 0, 0 };
+  float value = 0.0f;  // max, min, or the running integral
+  float length = 0.0f; // path length through voxels
+  bool any = false;
+  float firstT = 0.0f;
+
+  OCTORAY_HD bool Visit(const NodeHit& hit)
+  {
+    const float t0 = hit.tEnter > 0.0f ? hit.tEnter : 0.0f;
+    const float dt = hit.tExit - t0;
+    if (!any)
+    {
+      firstT = t0;
+    }
+    const float s = tree->scalar ? tree->scalar[hit.node] : NodeLuminance(hit.node);
+    switch (f->blend)
+    {
+      case BlendMode::Composite:
+      {
+        const Rgba c = NodeColor(*f, *tree, hit.node);
+        // Opacity is given per unit distance; correct it for this length.
+        const float alpha = 1.0f - PortablePow(1.0f - fminf(fmaxf(c.a, 0.0f), 1.0f), dt / f->opacityUnitDistance);
+        const float w = (1.0f - rgba[3]) * alpha;
+        rgba[0] += w * c.r, rgba[1] += w * c.g, rgba[2] += w * c.b, rgba[3] += w;
+        any = true;
+        return rgba[3] > 0.995f; // early ray termination
+      }
+      case BlendMode::Maximum:
+        value = any ? fmaxf(value, s) : s;
+        break;
+      case BlendMode::Minimum:
+        value = any ? fminf(value, s) : s;
+        break;
+      case BlendMode::Average:
+      case BlendMode::Additive:
+        value += s * dt;
+        length += dt;
+        break;
+      default:
+        break;
+    }
+    any = true;
+    return false;
+  }
+
+  OCTORAY_HD float NodeLuminance(std::uint32_t node) const
+  {
+    const Rgba c = tree->color ? tree->color[node] : Rgba{ 1, 1, 1, 1 };
+    return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+  }
+};
+
+// Colour of a projected scalar (MIP, MinIP, average, additive).
+OCTORAY_HD Rgba ProjectedColor(const FrameConstants& f, float value)
+{
+  if (f.transfer)
+  {
+    float u = (value - f.transferRange[0]) / (f.transferRange[1] - f.transferRange[0]);
+    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+    if (!(u == u))
+    {
+      u = 0.0f;
+    }
+    return f.transfer[static_cast<int>(u * (f.transferSize - 1) + 0.5f)];
+  }
+  const float v = value < 0.0f ? 0.0f : (value > 1.0f ? 1.0f : value);
+  return Rgba{ v, v, v, 1.0f };
+}
+
+// A ray still to be traced and the weight of its colour in the pixel.
+struct PendingRay
+{
+  Ray ray;
+  float weight[3];
+  int bounces;
+  float tFromNear;
+};
+// Enough for every path of 2 bounces (each hit spawns at most 2 rays).
+constexpr int kMaxPendingRays = 8;
+// Voxels a refracted ray may cross inside one medium before it is dropped.
+constexpr int kMaxMediumSteps = 1 << 12;
+
+OCTORAY_HD void Reflect(const float d[3], const float n[3], float r[3])
+{
+  const float dn = Dot(d, n);
+  for (int a = 0; a < 3; ++a)
+  {
+    r[a] = d[a] - 2.0f * dn * n[a];
+  }
+}
+
+// Snell's law: d enters through a surface with normal n (facing against d)
+// from index n1 into n2, eta = n1 / n2. False on total internal reflection.
+OCTORAY_HD bool Refract(const float d[3], const float n[3], float eta, float t[3])
+{
+  const float cosIn = -Dot(d, n);
+  const float sin2Out = eta * eta * (1.0f - cosIn * cosIn);
+  if (sin2Out > 1.0f)
+  {
+    return false;
+  }
+  const float cosOut = sqrtf(1.0f - sin2Out);
+  for (int a = 0; a < 3; ++a)
+  {
+    t[a] = eta * d[a] + (eta * cosIn - cosOut) * n[a];
+  }
+  Normalize(t);
+  return true;
+}
+
+// A secondary ray from p; tMin skips the surface it starts on.
+OCTORAY_HD void StartRay(Ray& ray, const float p[3], const float d[3], float tMin)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    ray.origin[a] = p[a];
+  }
+  SetDirection(ray, d);
+  ray.tMin = tMin;
+  ray.tMax = INFINITY;
+}
+
+// A ray that entered the refracting voxel `hit` through the shading normal n
+// crosses the occupied voxels of the hit's level (the medium) voxel by
+// voxel, reflecting totally inside where Snell allows no exit, until it
+// leaves through a face, where it refracts back into air. The emerging ray
+// goes into `out` (its weight and bounces set by the caller; each internal
+// reflection costs a bounce). False when the bounces run out inside.
+OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const NodeHit& hit, const float n[3],
+  float ior, int maxBounces, PendingRay& out)
+{
+  float d[3];
+  if (!Refract(in.direction, n, 1.0f / ior, d))
+  {
+    return false; // an index below 1 seen at a grazing angle: all reflected
+  }
+  const float tEnter = hit.tEnter > in.tMin ? hit.tEnter : in.tMin;
+  float p[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    p[a] = in.origin[a] + tEnter * in.direction[a];
+  }
+  const int level = hit.level;
+  const std::uint32_t cells = 1u << level;
+  const float size = hit.size;
+  std::uint32_t cell[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cell[a] = static_cast<std::uint32_t>(hit.lo[a] * static_cast<float>(cells));
+  }
+  for (int step = 0; step < kMaxMediumSteps; ++step)
+  {
+    // Where the ray leaves the current cell, and through which face.
+    float tExit = INFINITY;
+    int axis = -1;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (d[a] != 0.0f)
+      {
+        const float plane = (static_cast<float>(cell[a]) + (d[a] > 0.0f ? 1.0f : 0.0f)) * size;
+        const float t = (plane - p[a]) / d[a];
+        if (t < tExit)
+        {
+          tExit = t;
+          axis = a;
+        }
+      }
+    }
+    if (axis < 0)
+    {
+      return false;
+    }
+    tExit = tExit > 0.0f ? tExit : 0.0f;
+    for (int a = 0; a < 3; ++a)
+    {
+      p[a] += tExit * d[a];
+    }
+    p[axis] = (static_cast<float>(cell[axis]) + (d[axis] > 0.0f ? 1.0f : 0.0f)) * size; // exactly on the face
+    const int stepDir = d[axis] > 0.0f ? 1 : -1;
+    const long long next = static_cast<long long>(cell[axis]) + stepDir;
+    bool medium = false;
+    if (next >= 0 && next < static_cast<long long>(cells))
+    {
+      std::uint32_t c[3] = { cell[0], cell[1], cell[2] };
+      c[axis] = static_cast<std::uint32_t>(next);
+      const std::uint32_t node = tree.Find(level, EncodeMorton(c[0], c[1], c[2]));
+      medium = node != kInvalidIndex && (!tree.refraction || tree.refraction[node] > 0.0f);
+    }
+    if (medium)
+    {
+      cell[axis] = static_cast<std::uint32_t>(next);
+      continue;
+    }
+    // At the medium's boundary: out into air, or totally reflected inside.
+    float inward[3] = { 0.0f, 0.0f, 0.0f };
+    inward[axis] = -static_cast<float>(stepDir);
+    float outDir[3];
+    if (Refract(d, inward, ior, outDir))
+    {
+      StartRay(out.ray, p, outDir, 1e-4f * size);
+      return true;
+    }
+    if (out.bounces >= maxBounces)
+    {
+      return false;
+    }
+    ++out.bounces;
+    d[axis] = -d[axis];
+  }
+  return false;
+}
+
+// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
+  rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
+  depth = 1.0f;
+  Ray ray;
+  double tBase, origin[3], direction[3];
+  if (!PrimaryRay(f, x, y, ray, tBase, origin, direction))
+  {
+    return;
+  }
+  LevelOfDetail lod;
+  lod.pixels = f.lodPixels;
+  lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(tBase);
+  lod.footprintSlope = f.footprintSlope;
+
+  if (f.blend != BlendMode::Surface)
+  {
+    BlendVisitor blend;
+    blend.f = &f;
+    blend.tree = &tree;
+    Traverse(tree, ray, lod, blend);
+    if (!blend.any)
+    {
+      return;
+    }
+    Rgba c;
+    if (f.blend == BlendMode::Composite)
+    {
+      for (int k = 0; k < 4; ++k)
+      {
+        rgba[k] = blend.rgba[k];
+      }
+    }
+    else
+    {
+      float v = blend.value;
+      if (f.blend == BlendMode::Average)
+      {
+        v = blend.length > 0.0f ? blend.value / blend.length : 0.0f;
+      }
+      c = ProjectedColor(f, v);
+      rgba[0] = c.r * c.a, rgba[1] = c.g * c.a, rgba[2] = c.b * c.a, rgba[3] = c.a;
+    }
+    const double p[3] = { origin[0] + blend.firstT * direction[0], origin[1] + blend.firstT * direction[1],
+      origin[2] + blend.firstT * direction[2] };
+    depth = WindowDepth(f, p);
+    return;
+  }
+
+  // Surface: the first voxel, then the mirror and refracted rays it spawns,
+  // each carrying its weight in the pixel, until the bounce limit.
+  PendingRay pending[kMaxPendingRays];
+  int top = 0;
+  pending[top++] = PendingRay{ ray, { 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(tBase) };
+  bool primary = true;
+  while (top > 0)
+  {
+    const PendingRay path = pending[--top];
+    FirstHitVisitor first;
+    Traverse(tree, path.ray, lod, first);
+    if (!first.found)
+    {
+      primary = false;
+      continue;
+    }
+    const NodeHit& hit = first.hit;
+    const float tHit = hit.tEnter > path.ray.tMin ? hit.tEnter : path.ray.tMin;
+    if (primary)
+    {
+      const double p[3] = { origin[0] + tHit * direction[0], origin[1] + tHit * direction[1],
+        origin[2] + tHit * direction[2] };
+      depth = WindowDepth(f, p);
+      rgba[3] = 1.0f;
+      primary = false;
+    }
+    float rgb[3];
+    ShadeSurface(f, tree, path.ray, hit, path.tFromNear + tHit, lod, rgb, secondaryRays);
+    const bool canBounce = path.bounces < f.maxBounces;
+    float reflectivity = canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f;
+    reflectivity = reflectivity < 0.0f ? 0.0f : (reflectivity > 1.0f ? 1.0f : reflectivity);
+    const float ior = canBounce && tree.refraction ? tree.refraction[hit.node] : 0.0f;
+    // A refracting voxel is clear: it tints what is seen through it instead
+    // of showing its own lit colour.
+    const float opaque = (1.0f - reflectivity) * (ior > 0.0f ? 0.0f : 1.0f);
+    for (int a = 0; a < 3; ++a)
+    {
+      rgba[a] += path.weight[a] * opaque * rgb[a];
+    }
+    if (!(reflectivity > 0.0f || ior > 0.0f))
+    {
+      continue;
+    }
+    float n[3];
+    SurfaceNormal(tree, path.ray, hit, n);
+    if (reflectivity > 0.0f && top < kMaxPendingRays)
+    {
+      PendingRay mirror;
+      float p[3], r[3];
+      EntryPoint(path.ray, hit, p);
+      Reflect(path.ray.direction, n, r);
+      StartRay(mirror.ray, p, r, 0.0f);
+      for (int a = 0; a < 3; ++a)
+      {
+        mirror.weight[a] = path.weight[a] * reflectivity;
+      }
+      mirror.bounces = path.bounces + 1;
+      mirror.tFromNear = path.tFromNear + tHit;
+      pending[top++] = mirror;
+      ++secondaryRays;
+    }
+    if (ior > 0.0f && top < kMaxPendingRays)
+    {
+      const Rgba tint = NodeColor(f, tree, hit.node);
+      PendingRay through;
+      for (int a = 0; a < 3; ++a)
+      {
+        through.weight[a] = path.weight[a] * (1.0f - reflectivity) * (&tint.r)[a];
+      }
+      through.bounces = path.bounces + 1;
+      through.tFromNear = path.tFromNear + tHit;
+      if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
+      {
+        pending[top++] = through;
+        ++secondaryRays;
+      }
+    }
+  }
+}
+}

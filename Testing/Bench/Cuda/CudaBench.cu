@@ -1,0 +1,419 @@
+// octoray_bench_cuda: the CUDA backend measured against what the hardware
+// allows, in one run on one GPU:
+//  - octree build of 1 M / 10 M / 100 M points beside a bare CUB radix sort
+//    of the same 63-bit keys with 32-bit indices (the build's floor);
+//  - update of 1% and 100% of 10 M points beside a full rebuild;
+//  - primary rays and shadow + one-bounce rays at 1920x1080, depth 10 and 16;
+//  - GPU bytes per point at depth 10 and 21.
+// Times are medians of repeated runs after a warm-up; device work is timed
+// with CUDA events (the sort) or synchronised wall clock (whole engine calls).
+#include <octoray/Engine.h>
+#include <octoray/Frame.h>
+#include <octoray/Morton.h>
+
+#include <cub/device/device_radix_sort.cuh>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace octoray;
+
+namespace
+{
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double TimeMedian(int repeats, const std::function<void()>& work)
+{
+  work(); // warm-up: allocations, module load
+  std::vector<double> t;
+  for (int r = 0; r < repeats; ++r)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    cudaDeviceSynchronize();
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return Median(t);
+}
+
+// Gaussian clusters with colours and reflectivity: a cloud like scanned or
+// simulated data, not uniform noise.
+struct Cloud
+{
+  std::vector<float> xyz;
+  std::vector<std::uint8_t> rgb;
+  std::vector<float> reflectivity;
+  PointCloudView View() const
+  {
+    PointCloudView v;
+    v.count = xyz.size() / 3;
+    v.xyzFloat = xyz.data();
+    v.color8 = rgb.data();
+    v.colorComponents = 3;
+    v.reflectivity = reflectivity.data();
+    return v;
+  }
+};
+
+Cloud MakeCloud(std::size_t n, std::uint64_t seed)
+{
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Cloud c;
+  c.xyz.resize(3 * n);
+  c.rgb.resize(3 * n);
+  c.reflectivity.resize(n);
+  const float centres[8][3] = { { 0, 0, 0 }, { 4, 1, -2 }, { -3, 3, 1 }, { 2, -4, 3 }, { -2, -2, -3 }, { 3, 3, 3 },
+    { -4, 0, 2 }, { 0, 4, -4 } };
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const int k = static_cast<int>(i & 7);
+    const float s = 0.3f + 0.2f * k;
+    for (int a = 0; a < 3; ++a)
+    {
+      c.xyz[3 * i + a] = centres[k][a] + s * g(rng);
+      c.rgb[3 * i + a] = static_cast<std::uint8_t>(60 + 25 * k + 20 * a);
+    }
+    c.reflectivity[i] = k == 0 ? 0.5f : 0.0f;
+  }
+  return c;
+}
+
+// The sort the build cannot beat: CUB's radix sort of (63-bit key, index).
+double SortFloorSeconds(const Cloud& c, int bits)
+{
+  const std::size_t n = c.xyz.size() / 3;
+  std::vector<std::uint64_t> keys(n);
+  std::mt19937_64 rng(7);
+  for (auto& k : keys)
+  {
+    k = rng() >> (64 - bits);
+  }
+  std::uint64_t *k0, *k1;
+  std::uint32_t *v0, *v1;
+  cudaMalloc(&k0, n * 8);
+  cudaMalloc(&k1, n * 8);
+  cudaMalloc(&v0, n * 4);
+  cudaMalloc(&v1, n * 4);
+  cudaMemcpy(k0, keys.data(), n * 8, cudaMemcpyHostToDevice);
+  std::vector<std::uint32_t> idx(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    idx[i] = static_cast<std::uint32_t>(i);
+  }
+  cudaMemcpy(v0, idx.data(), n * 4, cudaMemcpyHostToDevice);
+  cub::DoubleBuffer<std::uint64_t> kb(k0, k1);
+  cub::DoubleBuffer<std::uint32_t> vb(v0, v1);
+  std::size_t bytes = 0;
+  cub::DeviceRadixSort::SortPairs(nullptr, bytes, kb, vb, n, 0, bits);
+  void* temp;
+  cudaMalloc(&temp, bytes);
+  cudaEvent_t start, stop;
+  cudaEventCreate(&start);
+  cudaEventCreate(&stop);
+  std::vector<double> times;
+  for (int r = 0; r < 11; ++r)
+  {
+    cudaMemcpy(kb.Current(), keys.data(), n * 8, cudaMemcpyHostToDevice);
+    cudaEventRecord(start);
+    cub::DeviceRadixSort::SortPairs(temp, bytes, kb, vb, n, 0, bits);
+    cudaEventRecord(stop);
+    cudaEventSynchronize(stop);
+    float ms = 0;
+    cudaEventElapsedTime(&ms, start, stop);
+    if (r > 0)
+    {
+      times.push_back(ms * 1e-3);
+    }
+  }
+  cudaFree(temp);
+  cudaFree(k0);
+  cudaFree(k1);
+  cudaFree(v0);
+  cudaFree(v1);
+  return Median(times);
+}
+
+RenderSettings Camera(const HostOctree& t, int w, int h)
+{
+  // Looking at the cube's centre from outside, 30 degrees vertical view.
+  const double c[3] = { t.cube.origin[0] + t.cube.size / 2, t.cube.origin[1] + t.cube.size / 2,
+    t.cube.origin[2] + t.cube.size / 2 };
+  const double eye[3] = { c[0] + 1.2 * t.cube.size, c[1] - 1.5 * t.cube.size, c[2] + 0.8 * t.cube.size };
+  double f[3] = { c[0] - eye[0], c[1] - eye[1], c[2] - eye[2] };
+  double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  for (double& v : f)
+    v /= fl;
+  const double up[3] = { 0, 0, 1 };
+  double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
+  double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  for (double& v : s)
+    v /= sl;
+  const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
+  const double view[16] = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
+    -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2], f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2],
+    0, 0, 0, 1 };
+  const double zn = 0.1 * t.cube.size, zf = 10 * t.cube.size, tn = 1 / std::tan(15 * M_PI / 180), aspect = double(w) / h;
+  const double proj[16] = { tn / aspect, 0, 0, 0, 0, tn, 0, 0, 0, 0, -(zf + zn) / (zf - zn), -2 * zf * zn / (zf - zn), 0,
+    0, -1, 0 };
+  double vp[16] = {};
+  for (int r = 0; r < 4; ++r)
+    for (int col = 0; col < 4; ++col)
+      for (int k = 0; k < 4; ++k)
+        vp[4 * r + col] += proj[4 * r + k] * view[4 * k + col];
+  RenderSettings rs;
+  rs.width = w;
+  rs.height = h;
+  Invert4x4(vp, rs.inverseViewProjection);
+  return rs;
+}
+
+struct Record
+{
+  std::string name;
+  std::size_t n;
+  int depth;
+  double seconds;
+  std::string peer;
+  double peerSeconds;
+};
+}
+
+int Run(int argc, char** argv);
+
+int main(int argc, char** argv)
+{
+  try
+  {
+    return Run(argc, argv);
+  }
+  catch (const std::exception& e)
+  {
+    std::printf("error: %s\n", e.what());
+    return 1;
+  }
+}
+
+int Run(int argc, char** argv)
+{
+  std::string json;
+  std::vector<std::size_t> sizes = { 1000000, 10000000, 100000000 };
+  for (int a = 1; a < argc; ++a)
+  {
+    if (!std::strcmp(argv[a], "--json") && a + 1 < argc)
+      json = argv[++a];
+    else if (!std::strcmp(argv[a], "--small"))
+      sizes = { 1000000, 10000000 };
+  }
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    std::printf("no usable GPU: %s\n", why.c_str());
+    return 0;
+  }
+  auto engine = CreateEngine(Backend::CUDA);
+  std::printf("device: %s\n", engine->Description().c_str());
+  std::vector<Record> records;
+
+  // Build against the sort floor.
+  Cloud ten;
+  for (std::size_t n : sizes)
+  {
+    Cloud c = MakeCloud(n, 1);
+    // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
+    // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
+    for (int depth : { 10, 16, 21 })
+    {
+      if (depth == 21 && n > 10000000)
+      {
+        continue;
+      }
+      BuildOptions o;
+      o.depth = depth;
+      BuildStats last;
+      const int repeats = n >= 100000000 ? 3 : 7;
+      const double t = TimeMedian(repeats, [&] { last = engine->Build(c.View(), o); });
+      const double floor = SortFloorSeconds(c, 3 * depth);
+      const double bytesPerPoint = double(engine->Memory().Total()) / n;
+      std::printf("build n=%zu depth=%d: %.3f ms (keys %.3f, sort %.3f, levels %.3f ms; incl. upload), bare CUB "
+                  "sort %.3f ms, ratio %.2f, %zu nodes, %.1f GPU bytes/point\n",
+        n, depth, t * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3, last.levelSeconds * 1e3, floor * 1e3,
+        t / floor, last.nodes, bytesPerPoint);
+      records.push_back({ "octree build", n, depth, t, "cub radix sort", floor });
+      records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0 });
+    }
+    if (n == 10000000)
+    {
+      ten = c;
+    }
+  }
+
+  // Update of 1% and 100% of 10 M points against a rebuild.
+  {
+    BuildOptions o;
+    o.depth = 10;
+    const std::size_t n = ten.xyz.size() / 3;
+    const double rebuild = TimeMedian(5, [&] { engine->Build(ten.View(), o); });
+    for (double fraction : { 0.01, 1.0 })
+    {
+      const std::size_t moved = static_cast<std::size_t>(n * fraction);
+      std::vector<std::uint32_t> idx(moved);
+      std::vector<float> xyz(3 * moved);
+      std::mt19937_64 rng(3);
+      for (std::size_t k = 0; k < moved; ++k)
+      {
+        idx[k] = static_cast<std::uint32_t>(fraction < 1 ? rng() % n : k);
+      }
+      std::vector<double> times;
+      UpdateStats last;
+      for (int r = 0; r < 6; ++r)
+      {
+        engine->Build(ten.View(), o);
+        // A small contraction towards the origin (inside the clusters' box):
+        // every point moves, none leaves the root cube.
+        const float factor = r % 2 ? 0.9995f : 0.999f;
+        for (std::size_t k = 0; k < moved; ++k)
+          for (int a = 0; a < 3; ++a)
+            xyz[3 * k + a] = ten.xyz[3 * idx[k] + a] * factor;
+        PositionsView p;
+        p.count = moved;
+        p.xyzFloat = xyz.data();
+        p.indices = fraction < 1 ? idx.data() : nullptr;
+        cudaDeviceSynchronize();
+        const auto start = std::chrono::steady_clock::now();
+        last = engine->Update(p);
+        cudaDeviceSynchronize();
+        if (r > 0)
+          times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      }
+      const double t = Median(times);
+      std::printf("update %.0f%% of %zu: %.3f ms (%s, %zu left their leaf), rebuild %.3f ms, ratio %.2f\n",
+        fraction * 100, n, t * 1e3, ToString(last.path), last.changedLeaf, rebuild * 1e3, t / rebuild);
+      records.push_back({ fraction < 1 ? "update 1%" : "update 100%", n, 10, t, "rebuild", rebuild });
+    }
+  }
+
+  // Rendering at 1920x1080.
+  for (int depth : { 10, 16 })
+  {
+    BuildOptions o;
+    o.depth = depth;
+    engine->Build(ten.View(), o);
+    HostOctree t;
+    engine->CopyToHost(t);
+    RenderSettings s = Camera(t, 1920, 1080);
+    s.maxBounces = 0;
+    Image image;
+    RenderStats stats;
+    const double withCopy = TimeMedian(9, [&] { stats = engine->Render(s, image); });
+    std::size_t hit = 0;
+    for (std::size_t i = 0; i < image.depth.size(); ++i)
+      hit += image.depth[i] < 1;
+    // Device time of the frame alone, picture left on the device (as the
+    // VTK mapper will draw it), from RenderStats.
+    s.copyToHost = false;
+    std::vector<double> frames;
+    for (int r = 0; r < 10; ++r)
+    {
+      stats = engine->Render(s, image);
+      if (r)
+        frames.push_back(stats.seconds);
+    }
+    const double primary = Median(frames);
+    std::printf("render depth %d, primary: %.3f ms on the device, %.0f Mrays/s; %.3f ms with the copy to the host; "
+                "%.1f%% of pixels hit\n",
+      depth, primary * 1e3, 1920.0 * 1080 / primary / 1e6, withCopy * 1e3, 100.0 * hit / (1920.0 * 1080));
+    records.push_back({ "render primary 1920x1080", ten.xyz.size() / 3, depth, primary, "", 0 });
+    s.shade = ShadeMode::Phong;
+    Light sun;
+    sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
+    s.lights.push_back(sun);
+    s.shadows = true;
+    s.maxBounces = 1;
+    std::vector<double> fullFrames;
+    for (int r = 0; r < 10; ++r)
+    {
+      stats = engine->Render(s, image);
+      if (r)
+        fullFrames.push_back(stats.seconds);
+    }
+    const double full = Median(fullFrames);
+    const double rays = double(stats.primaryRays + stats.secondaryRays);
+    std::printf("render depth %d, Phong + shadows + 1 bounce: %.3f ms, %.0f Mrays/s (%zu secondary rays)\n", depth,
+      full * 1e3, rays / full / 1e6, stats.secondaryRays);
+    records.push_back({ "render shadows+bounce 1920x1080", ten.xyz.size() / 3, depth, full, "", 0 });
+  }
+
+  // The thesis's table 2 again (2015, GTX Titan): clouds like a thresholded
+  // slice stack (grid points inside an ellipsoid, slice by slice), depth 7,
+  // 800x600 rays. Thesis figures, for all five sizes: build 0.02-6.1 s
+  // (almost all allocation), ray tracing 24-45 ms per image, 2.4-2.5 GB.
+  std::printf("thesis table 2 (depth 7, 800x600): points, build ms, trace ms/image, GPU MB\n");
+  for (std::size_t n : { 30641ul, 303374ul, 951879ul, 1076596ul, 3283639ul })
+  {
+    // Grid spacing such that the ellipsoid (semi-axes 1, 0.8, 0.6) holds
+    // about n points; the first n in slice order are kept.
+    const double volume = 4.0 / 3.0 * M_PI * 1.0 * 0.8 * 0.6;
+    const double h = std::cbrt(volume / (n * 1.02));
+    Cloud c;
+    for (double z = -0.6; z <= 0.6 && c.xyz.size() < 3 * n; z += h)
+      for (double y = -0.8; y <= 0.8 && c.xyz.size() < 3 * n; y += h)
+        for (double x = -1.0; x <= 1.0 && c.xyz.size() < 3 * n; x += h)
+          if (x * x + y * y / 0.64 + z * z / 0.36 <= 1.0)
+          {
+            c.xyz.insert(c.xyz.end(), { float(x), float(y), float(z) });
+            c.rgb.insert(c.rgb.end(), { 200, 180, 160 });
+            c.reflectivity.push_back(0.0f);
+          }
+    const std::size_t count = c.xyz.size() / 3;
+    BuildOptions o;
+    o.depth = 7;
+    const double build = TimeMedian(7, [&] { engine->Build(c.View(), o); });
+    HostOctree t;
+    engine->CopyToHost(t);
+    RenderSettings s = Camera(t, 800, 600);
+    s.shade = ShadeMode::Phong;
+    s.copyToHost = false;
+    Image image;
+    std::vector<double> frames;
+    for (int r = 0; r < 10; ++r)
+    {
+      const RenderStats stats = engine->Render(s, image);
+      if (r)
+        frames.push_back(stats.seconds);
+    }
+    const double trace = Median(frames);
+    std::printf("  %zu points: build %.2f ms, trace %.3f ms/image, %.1f MB\n", count, build * 1e3, trace * 1e3,
+      engine->Memory().Total() / 1e6);
+    records.push_back({ "thesis table 2 build", count, 7, build, "", 0 });
+    records.push_back({ "thesis table 2 trace 800x600", count, 7, trace, "", 0 });
+  }
+
+  if (!json.empty())
+  {
+    std::ofstream out(json);
+    out << "[\n";
+    for (std::size_t i = 0; i < records.size(); ++i)
+    {
+      const Record& r = records[i];
+      out << "  {\"name\": \"" << r.name << "\", \"backend\": \"CUDA\", \"n\": " << r.n << ", \"depth\": " << r.depth
+          << ", \"seconds\": " << r.seconds << ", \"peer\": \"" << r.peer << "\", \"peer_seconds\": " << r.peerSeconds
+          << "}" << (i + 1 < records.size() ? "," : "") << "\n";
+    }
+    out << "]\n";
+  }
+  return 0;
+}

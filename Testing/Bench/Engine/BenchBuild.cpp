@@ -1,0 +1,268 @@
+// octoray_bench_build: how long the engine takes to build the octree, on the
+// CPU with one thread and with all of them, and on CUDA where a GPU is
+// usable. Engine only (no VTK, no PCL), so it runs on a GPU machine too; the
+// comparison with PCL and VTK is octoray_bench_peers.
+//
+//   octoray_bench_build [--points 1000000,10000000] [--sets uniform,clustered]
+//                       [--depth 0] [--backend cpu|cuda|all] [--threads N]
+//                       [--repeats 5] [--json PATH]
+#include "BenchUtil.h"
+
+#include <octoray/Engine.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+namespace
+{
+using namespace octoray;
+using namespace octoray::bench;
+
+int Usage()
+{
+  std::fprintf(stderr,
+    "usage: octoray_bench_build [--points N[,N...]] [--sets uniform,clustered] [--depth L (0: automatic)]\n"
+    "                           [--backend cpu|cuda|all] [--threads N] [--repeats R] [--json PATH]\n");
+  return 2;
+}
+
+std::vector<std::string> Split(const std::string& list)
+{
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ','))
+  {
+    if (!item.empty())
+    {
+      items.push_back(item);
+    }
+  }
+  return items;
+}
+
+std::string CpuBackendName(int threads)
+{
+  return "cpu-" + std::to_string(threads) + (threads == 1 ? "thread" : "threads");
+}
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size();
+  return m == 0 ? 0.0 : m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+}
+
+struct Run
+{
+  std::string backend;
+  std::string description;
+  Timing timing;
+  BuildStats stats;                 // of the last timed build
+  double keySeconds = 0.0;          // medians over the timed builds
+  double sortSeconds = 0.0;
+  double levelSeconds = 0.0;
+  std::size_t engineBytes = 0;      // everything the engine holds
+  std::size_t nodeBytes = 0;        // the octree's node arrays alone
+};
+
+Run Time(Engine& engine, const std::string& backend, const PointCloudView& cloud, const BuildOptions& options,
+  int repeats)
+{
+  Run run;
+  run.backend = backend;
+  run.description = engine.Description();
+  std::vector<double> keys, sorts, levels;
+  bool warm = false;
+  run.timing = Measure(
+    [&] {
+      run.stats = engine.Build(cloud, options);
+      if (warm)
+      {
+        keys.push_back(run.stats.keySeconds);
+        sorts.push_back(run.stats.sortSeconds);
+        levels.push_back(run.stats.levelSeconds);
+      }
+      warm = true; // the first call is Measure's warm-up
+    },
+    1, repeats);
+  run.keySeconds = Median(keys);
+  run.sortSeconds = Median(sorts);
+  run.levelSeconds = Median(levels);
+  const MemoryReport memory = engine.Memory();
+  run.engineBytes = memory.Total();
+  for (const auto& array : memory.arrays)
+  {
+    if (array.first.rfind("node ", 0) == 0)
+    {
+      run.nodeBytes += array.second;
+    }
+  }
+  return run;
+}
+}
+
+int main(int argc, char** argv)
+{
+  std::vector<std::size_t> counts = { 1000000, 10000000 };
+  std::vector<std::string> sets = { "uniform", "clustered" };
+  int depth = 0;
+  std::string backend = "all";
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int repeats = 5;
+  std::string json;
+  for (int a = 1; a < argc; ++a)
+  {
+    const std::string arg = argv[a];
+    if (a + 1 >= argc)
+    {
+      return Usage();
+    }
+    const std::string value = argv[++a];
+    if (arg == "--points")
+    {
+      counts.clear();
+      for (const std::string& c : Split(value))
+      {
+        counts.push_back(static_cast<std::size_t>(std::strtod(c.c_str(), nullptr))); // 1e7 works too
+      }
+    }
+    else if (arg == "--sets")
+    {
+      sets = Split(value);
+    }
+    else if (arg == "--depth")
+    {
+      depth = std::atoi(value.c_str());
+    }
+    else if (arg == "--backend")
+    {
+      backend = value;
+    }
+    else if (arg == "--threads")
+    {
+      threads = std::max(1, std::atoi(value.c_str()));
+    }
+    else if (arg == "--repeats")
+    {
+      repeats = std::max(1, std::atoi(value.c_str()));
+    }
+    else if (arg == "--json")
+    {
+      json = value;
+    }
+    else
+    {
+      return Usage();
+    }
+  }
+  if (backend != "cpu" && backend != "cuda" && backend != "all")
+  {
+    return Usage();
+  }
+  for (const std::string& set : sets)
+  {
+    if (set != "uniform" && set != "clustered")
+    {
+      return Usage();
+    }
+  }
+
+  std::string why;
+  const bool cuda = backend != "cpu" && CudaAvailable(&why);
+  std::printf("octoray_bench_build: median of %d builds after 1 warm-up; depth %s; %u hardware threads\n",
+    repeats, depth ? std::to_string(depth).c_str() : "automatic", std::thread::hardware_concurrency());
+  if (backend != "cpu" && !cuda)
+  {
+    std::printf("CUDA skipped: %s\n", why.c_str());
+  }
+  std::printf("\n%-10s %-9s %-13s %5s %10s %10s %9s %9s %8s %20s %8s %8s %10s\n", "points", "set", "backend", "depth",
+    "leaves", "nodes", "median s", "min s", "Mpts/s", "keys/sort/levels s", "B/pt", "nodeB/pt", "dense");
+
+  std::vector<Record> records;
+  try
+  {
+    for (const std::size_t n : counts)
+    {
+      for (const std::string& set : sets)
+      {
+        const std::vector<float> xyz = set == "uniform" ? UniformCube(n) : GaussianClusters(n);
+        PointCloudView cloud;
+        cloud.count = n;
+        cloud.xyzFloat = xyz.data();
+        BuildOptions options;
+        options.depth = depth;
+
+        std::vector<Run> runs;
+        if (backend != "cuda")
+        {
+          auto engine = CreateEngine(Backend::CPU);
+          engine->SetThreadCount(1);
+          runs.push_back(Time(*engine, CpuBackendName(1), cloud, options, repeats));
+          if (threads > 1)
+          {
+            engine->SetThreadCount(threads);
+            runs.push_back(Time(*engine, CpuBackendName(threads), cloud, options, repeats));
+          }
+        }
+        if (cuda)
+        {
+          auto engine = CreateEngine(Backend::CUDA);
+          runs.push_back(Time(*engine, "cuda", cloud, options, repeats));
+        }
+
+        const Run* single = runs.empty() || runs[0].backend != CpuBackendName(1) ? nullptr : &runs[0];
+        for (const Run& run : runs)
+        {
+          const BuildStats& s = run.stats;
+          const std::size_t leaves = s.nodesPerLevel.empty() ? 0 : s.nodesPerLevel.back();
+          char phases[64];
+          std::snprintf(phases, sizeof phases, "%.3f/%.3f/%.3f", run.keySeconds, run.sortSeconds, run.levelSeconds);
+          std::printf("%-10zu %-9s %-13s %5d %10zu %10zu %9.4f %9.4f %8.1f %20s %8.1f %8.1f %10s\n", n, set.c_str(),
+            run.backend.c_str(), s.depth, leaves, s.nodes, run.timing.median, run.timing.min,
+            n / run.timing.median * 1e-6, phases, double(run.engineBytes) / n, double(run.nodeBytes) / n,
+            HumanBytes(DenseSkeletonBytes(s.depth)).c_str());
+
+          Record r;
+          r.name = "octree_build/" + set;
+          r.backend = run.backend;
+          r.n = n;
+          r.depth = s.depth;
+          r.seconds = run.timing.median;
+          if (single && &run != single)
+          {
+            // Speed-ups are read against the single-threaded CPU build.
+            r.peer = "octoray " + single->backend;
+            r.peerSeconds = single->timing.median;
+          }
+          records.push_back(r);
+        }
+        for (const Run& run : runs)
+        {
+          if (single && &run != single)
+          {
+            std::printf("%-10s %-9s %-13s speed-up over 1 thread: %.2fx (%s)\n", "", "", run.backend.c_str(),
+              single->timing.median / run.timing.median, run.description.c_str());
+          }
+        }
+      }
+    }
+    std::printf("\nB/pt: all the engine holds (points, keys, sort buffers, nodes) per point; nodeB/pt: the node "
+                "arrays alone;\ndense: the thesis's pointer skeleton of the same depth, 8 B x (8^(L+1)-1)/7.\n");
+    if (!json.empty())
+    {
+      MergeRecords(json, records);
+      std::printf("%zu records merged into %s\n", records.size(), json.c_str());
+    }
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "octoray_bench_build: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Builds, tests and benchmarks the CUDA backend in one go on a GPU machine
+# that has only the CUDA toolkit, CMake and a compiler. GoogleTest comes as
+# Debian's sources copied to .deps/googletest (scripts/install-deps.sh
+# installs the googletest package; cp -r /usr/src/googletest .deps/).
+#   Testing/Bench/gpu-check.sh [OUTDIR]
+# Prints a short table last; full logs go to OUTDIR (default build-gpu/logs).
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+out=${1:-build-gpu/logs}
+mkdir -p "$out"
+status=()
+step() { # name, command...
+  local name=$1; shift
+  local t0=$(date +%s%N)
+  if "$@" >"$out/$name.log" 2>&1; then r=pass; else r=FAIL; fi
+  local t1=$(date +%s%N)
+  status+=("$(printf '%-22s %-5s %6d ms' "$name" "$r" "$(( (t1 - t0) / 1000000 ))")")
+  tail -n 5 "$out/$name.log"
+}
+
+nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+step configure cmake -S Rendering/Engine -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DOCTORAY_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DOCTORAY_GTEST_SOURCE_DIR="$PWD/.deps/googletest"
+step build cmake --build build-gpu -j 16
+step tests build-gpu/bin/octoray_engine_tests
+step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*'
+step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
+step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
+step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
+
+echo
+echo "== octoray CUDA check =="
+grep -E "tests? (ran|from)|PASSED|FAILED" "$out/tests.log" | tail -3
+grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/racecheck.log "$out"/initcheck.log
+grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
+printf '%s\n' "${status[@]}"

@@ -1,0 +1,96 @@
+#include <octoray/DepthChoice.h>
+#include <octoray/Morton.h>
+#include <octoray/RootCube.h>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace octoray;
+
+TEST(Morton, RoundTripsRandomAndExtremeCells)
+{
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<std::uint32_t> cell(0, (1u << 21) - 1);
+  for (int i = 0; i < 100000; ++i)
+  {
+    const std::uint32_t x = cell(rng), y = cell(rng), z = cell(rng);
+    std::uint32_t dx, dy, dz;
+    DecodeMorton(EncodeMorton(x, y, z), dx, dy, dz);
+    ASSERT_EQ(dx, x);
+    ASSERT_EQ(dy, y);
+    ASSERT_EQ(dz, z);
+  }
+  const std::uint32_t top = (1u << 21) - 1;
+  EXPECT_EQ(EncodeMorton(top, top, top), (1ull << 63) - 1);
+  EXPECT_EQ(EncodeMorton(0, 0, 0), 0u);
+  EXPECT_EQ(EncodeMorton(1, 0, 0), 1u);
+  EXPECT_EQ(EncodeMorton(0, 1, 0), 2u);
+  EXPECT_EQ(EncodeMorton(0, 0, 1), 4u);
+  EXPECT_EQ(EncodeMorton(2, 0, 0), 8u);
+}
+
+TEST(Morton, KeysOrderLikeTheOctree)
+{
+  // A parent's key is its children's keys without their last triple.
+  const std::uint64_t k = EncodeMorton(123456, 654321, 2000000);
+  EXPECT_EQ(AncestorKey(k, 21), k);
+  EXPECT_EQ(AncestorKey(k, 20), k >> 3);
+  EXPECT_EQ(AncestorKey(k, 0), 0u);
+  EXPECT_EQ(OctantOf(EncodeMorton(1, 1, 0)), 3);
+}
+
+TEST(RootCube, HoldsTheBoundsAndKeepsFarOffsetDetail)
+{
+  const double lo[3] = { 1e7, 1e7 + 5, 1e7 - 2 };
+  const double hi[3] = { 1e7 + 1, 1e7 + 5.001, 1e7 - 2 };
+  const RootCube cube = RootCube::FromBounds(lo, hi);
+  std::uint32_t cl[3], ch[3];
+  ASSERT_TRUE(cube.GridCell(lo[0], lo[1], lo[2], cl));
+  ASSERT_TRUE(cube.GridCell(hi[0], hi[1], hi[2], ch));
+  EXPECT_NEAR(cube.size, 1.0, 1e-5);
+  // One millimetre at 1e7 is still ~2000 cells of 2^-21.
+  std::uint32_t cm[3];
+  ASSERT_TRUE(cube.GridCell(lo[0] + 0.001, lo[1], lo[2], cm));
+  EXPECT_NEAR(static_cast<double>(cm[0] - cl[0]), 2097.152, 1.0);
+  std::uint32_t out[3];
+  EXPECT_FALSE(cube.GridCell(hi[0] + 0.01, hi[1], hi[2], out));
+  EXPECT_FALSE(cube.GridCell(std::nan(""), hi[1], hi[2], out));
+}
+
+TEST(RootCube, DegenerateBoundsGetAUsableCube)
+{
+  const double p[3] = { 3, 4, 5 };
+  const RootCube cube = RootCube::FromBounds(p, p);
+  EXPECT_GT(cube.size, 0.0);
+  std::uint32_t c[3];
+  EXPECT_TRUE(cube.GridCell(3, 4, 5, c));
+}
+
+TEST(DepthChoice, SharedLevelsOfNeighbouringKeys)
+{
+  EXPECT_EQ(SharedLevels(5, 5), 21);
+  // Keys that differ only in the last triple share levels 0..20.
+  EXPECT_EQ(SharedLevels(8, 9), 20);
+  // Keys that differ in the top triple share only the root.
+  EXPECT_EQ(SharedLevels(0, 1ull << 62), 0);
+}
+
+#include <octoray/RenderKernels.h>
+
+TEST(PortablePow, AgreesWithLibmToAFewUlps)
+{
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<float> base(1e-6f, 1.0f), exponent(0.0f, 200.0f);
+  for (int i = 0; i < 100000; ++i)
+  {
+    const float b = base(rng), e = exponent(rng);
+    const double exact = std::pow(double(b), double(e));
+    if (exact < 1e-30)
+      continue;
+    EXPECT_NEAR(PortablePow(b, e) / exact, 1.0, 2e-5) << b << "^" << e;
+  }
+  EXPECT_EQ(PortablePow(0.0f, 2.0f), 0.0f);
+  EXPECT_NEAR(PortablePow(0.5f, 1.0f), 0.5f, 1e-7f);
+  EXPECT_NEAR(PortablePow(1.0f, 1e4f), 1.0f, 1e-6f);
+}

@@ -1,0 +1,313 @@
+// The octree against the brute-force reference, on every backend.
+#include "TestSupport.h"
+
+using namespace octoray;
+using namespace octoray::test;
+
+using OctreeBuild = BackendTest;
+
+namespace
+{
+void BuildAndCompare(Engine& engine, const Cloud& c, int depth)
+{
+  BuildOptions options;
+  options.depth = depth;
+  const BuildStats stats = engine.Build(c.View(), options);
+  HostOctree t;
+  engine.CopyToHost(t);
+  if (depth)
+  {
+    EXPECT_EQ(t.depth, depth);
+  }
+  EXPECT_EQ(stats.depth, t.depth);
+  EXPECT_EQ(stats.nodes, t.NodeCount());
+  EXPECT_EQ(stats.points, c.Size());
+  ExpectMatchesReference(t, c);
+}
+}
+
+// The automatic depth rule (DepthChoice.h): at the chosen depth at least
+// half of the non-empty leaves hold one point, one level up fewer do, unless
+// deeper levels would separate nothing more.
+void ExpectDepthRule(const HostOctree& t, const Cloud& c)
+{
+  const auto levels = ReferenceLevels(c, t.cube, 21);
+  auto singles = [&](int l) {
+    std::size_t s = 0;
+    for (const auto& [key, node] : levels[l])
+    {
+      s += node.count == 1;
+    }
+    return s;
+  };
+  const bool separatesNothingDeeper = levels[t.depth].size() == levels[21].size();
+  EXPECT_TRUE(2 * singles(t.depth) >= levels[t.depth].size() || separatesNothingDeeper) << "depth " << t.depth;
+  if (t.depth > 1)
+  {
+    EXPECT_LT(2 * singles(t.depth - 1), levels[t.depth - 1].size()) << "depth " << t.depth;
+    EXPECT_LT(levels[t.depth - 1].size(), levels[21].size());
+  }
+}
+
+TEST_P(OctreeBuild, UniformRandom)
+{
+  BuildAndCompare(*engine, UniformCloud(20000, 11), 6);
+  const Cloud c = UniformCloud(20000, 12);
+  BuildAndCompare(*engine, c, 0);
+  HostOctree t;
+  engine->CopyToHost(t);
+  ExpectDepthRule(t, c);
+}
+
+TEST_P(OctreeBuild, GaussianClusters)
+{
+  BuildAndCompare(*engine, GaussianClusters(20000, 13), 9);
+  const Cloud c = GaussianClusters(20000, 14);
+  BuildAndCompare(*engine, c, 0);
+  HostOctree t;
+  engine->CopyToHost(t);
+  ExpectDepthRule(t, c);
+}
+
+TEST_P(OctreeBuild, PlaneAndLine)
+{
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> u(-3, 3);
+  Cloud plane, line;
+  for (int i = 0; i < 5000; ++i)
+  {
+    const double a = u(rng), b = u(rng);
+    plane.Add(a, 0.25 * a + 0.5 * b, 2.0, rng); // tilted in y, flat in z
+    line.Add(a, 2 * a + 1, -a, rng);
+  }
+  BuildAndCompare(*engine, plane, 8);
+  BuildAndCompare(*engine, line, 12);
+  BuildAndCompare(*engine, line, 0);
+}
+
+TEST_P(OctreeBuild, CoincidentPoints)
+{
+  std::mt19937_64 rng(16);
+  Cloud c;
+  for (int i = 0; i < 1000; ++i)
+  {
+    c.Add(1.5, -2.5, 1e3, rng);
+  }
+  BuildAndCompare(*engine, c, 5);
+  BuildAndCompare(*engine, c, 21);
+  // Deeper levels separate nothing, so the automatic depth stops at 1.
+  BuildAndCompare(*engine, c, 0);
+  HostOctree t;
+  engine->CopyToHost(t);
+  EXPECT_EQ(t.depth, 1);
+  EXPECT_EQ(t.pointCount.back(), 1000u);
+}
+
+TEST_P(OctreeBuild, OnePointAndTwoOppositeCorners)
+{
+  std::mt19937_64 rng(17);
+  Cloud one;
+  one.Add(7, 8, 9, rng);
+  BuildAndCompare(*engine, one, 3);
+  BuildAndCompare(*engine, one, 0);
+
+  Cloud two;
+  two.Add(-1, -1, -1, rng);
+  two.Add(1, 1, 1, rng);
+  for (int depth = 1; depth <= 21; depth += 4)
+  {
+    BuildAndCompare(*engine, two, depth);
+  }
+  // The corners fall in octants 0 and 7 of the root.
+  HostOctree t;
+  engine->CopyToHost(t);
+  EXPECT_EQ(t.childMask[0], 0x81);
+  BuildAndCompare(*engine, two, 0);
+  engine->CopyToHost(t);
+  EXPECT_EQ(t.depth, 1);
+}
+
+TEST_P(OctreeBuild, FarFromTheOriginKeepsMillimetres)
+{
+  // A 20 x 20 x 5 grid of points 1 mm apart at 1e7 m: at depth 16 the
+  // leaves are ~0.3 mm, so every point has a leaf of its own.
+  std::mt19937_64 rng(18);
+  Cloud c;
+  for (int i = 0; i < 20; ++i)
+  {
+    for (int j = 0; j < 20; ++j)
+    {
+      for (int k = 0; k < 5; ++k)
+      {
+        c.Add(1e7 + 0.001 * i, -1e7 + 0.001 * j, 5e6 + 0.001 * k, rng);
+      }
+    }
+  }
+  BuildAndCompare(*engine, c, 16);
+  HostOctree t;
+  engine->CopyToHost(t);
+  EXPECT_EQ(t.levelBegin[17] - t.levelBegin[16], c.Size());
+  BuildAndCompare(*engine, c, 0);
+  engine->CopyToHost(t);
+  ExpectDepthRule(t, c);
+}
+
+TEST_P(OctreeBuild, EveryDepth)
+{
+  const Cloud c = GaussianClusters(3000, 19);
+  for (int depth = 1; depth <= 21; ++depth)
+  {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    BuildAndCompare(*engine, c, depth);
+  }
+}
+
+TEST_P(OctreeBuild, FloatPositionsAndFloatRgbaColours)
+{
+  const Cloud c = UniformCloud(5000, 20);
+  std::vector<float> xyz(c.xyz.begin(), c.xyz.end());
+  std::vector<float> rgba;
+  for (std::size_t i = 0; i < c.Size(); ++i)
+  {
+    rgba.insert(rgba.end(), { c.rgb[3 * i] / 255.0f, c.rgb[3 * i + 1] / 255.0f, c.rgb[3 * i + 2] / 255.0f, 0.5f });
+  }
+  PointCloudView v;
+  v.count = c.Size();
+  v.xyzFloat = xyz.data();
+  v.colorFloat = rgba.data();
+  v.colorComponents = 4;
+  BuildOptions options;
+  options.depth = 7;
+  engine->Build(v, options);
+  HostOctree t;
+  engine->CopyToHost(t);
+  EXPECT_EQ(t.attributes, static_cast<unsigned>(kHasColor));
+  EXPECT_TRUE(t.scalar.empty());
+  EXPECT_TRUE(t.normal.empty());
+  EXPECT_NEAR(t.color[0].a, 0.5f, 1e-6f);
+  // Same keys as from the double positions they were rounded from, except
+  // where rounding crossed a cell face: compare counts per level loosely.
+  Cloud rounded = c;
+  for (std::size_t i = 0; i < rounded.xyz.size(); ++i)
+  {
+    rounded.xyz[i] = xyz[i];
+  }
+  const auto levels = ReferenceLevels(rounded, t.cube, 7);
+  EXPECT_EQ(t.NodeCount(), [&] {
+    std::size_t s = 0;
+    for (const auto& l : levels)
+    {
+      s += l.size();
+    }
+    return s;
+  }());
+}
+
+TEST_P(OctreeBuild, EmptyAndNonFiniteInputAreErrors)
+{
+  PointCloudView empty;
+  std::vector<double> none;
+  empty.xyzDouble = none.data();
+  try
+  {
+    engine->Build(empty, BuildOptions());
+    FAIL() << "no error for empty input";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_STREQ(e.what(), "octoray: cannot build an octree from 0 points");
+  }
+
+  Cloud c = UniformCloud(100, 21);
+  engine->Build(c.View(), BuildOptions());
+  HostOctree before;
+  engine->CopyToHost(before);
+
+  Cloud bad = c;
+  bad.xyz[3 * 42 + 1] = std::nan("");
+  bad.xyz[3 * 77 + 0] = INFINITY;
+  try
+  {
+    engine->Build(bad.View(), BuildOptions());
+    FAIL() << "no error for NaN input";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("point 42 has a non-finite coordinate"), std::string::npos) << e.what();
+  }
+  // The previous octree is untouched.
+  HostOctree after;
+  engine->CopyToHost(after);
+  EXPECT_EQ(after.key, before.key);
+  EXPECT_EQ(after.pointCount, before.pointCount);
+
+  BuildOptions deep;
+  deep.depth = 22;
+  EXPECT_THROW(engine->Build(c.View(), deep), Error);
+}
+
+TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
+{
+  const Cloud c = UniformCloud(20000, 22);
+  BuildOptions options;
+  options.depth = 10;
+  const BuildStats stats = engine->Build(c.View(), options);
+  const MemoryReport m = engine->Memory();
+  EXPECT_EQ(stats.bytes, m.Total());
+  std::size_t keyBytes = 0;
+  for (const auto& a : m.arrays)
+  {
+    if (a.first == "node keys")
+    {
+      keyBytes = a.second;
+    }
+  }
+  EXPECT_GE(keyBytes, stats.nodes * sizeof(std::uint64_t));
+  EXPECT_LE(keyBytes, 2 * stats.nodes * sizeof(std::uint64_t));
+  // Far below a dense skeleton of depth 10: (8^11 - 1) / 7 pointers.
+  EXPECT_LT(m.Total(), ((1ull << 33) - 1) / 7 * 8 / 100);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, OctreeBuild, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
+
+// Out of device memory: a clear error naming what did not fit, the previous
+// octree intact and still drawable, and a later build within budget works.
+TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
+{
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    GTEST_SKIP() << "CUDA backend not usable here: " << why;
+  }
+  auto engine = CreateEngine(Backend::CUDA);
+  const Cloud small = UniformCloud(1000, 51);
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(small.View(), options);
+  HostOctree before;
+  engine->CopyToHost(before);
+  const std::size_t held = engine->Memory().Total();
+
+  engine->SetMemoryBudget(held + 200000); // far too little for 100 k points
+  const Cloud big = UniformCloud(100000, 52);
+  try
+  {
+    engine->Build(big.View(), options);
+    FAIL() << "no error past the memory budget";
+  }
+  catch (const Error& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("octoray: out of memory for "), std::string::npos) << message;
+    EXPECT_NE(message.find("within the engine's budget"), std::string::npos) << message;
+  }
+  HostOctree after;
+  engine->CopyToHost(after);
+  EXPECT_EQ(after.key, before.key);
+  EXPECT_EQ(after.pointCount, before.pointCount);
+
+  engine->SetMemoryBudget(~std::size_t(0));
+  EXPECT_NO_THROW(engine->Build(big.View(), options));
+  engine->CopyToHost(after);
+  ExpectMatchesReference(after, big);
+}

@@ -1,0 +1,231 @@
+// Shared pieces of the engine tests: point generators, the backend fixture
+// and a brute-force reference octree written independently of the engine.
+#pragma once
+
+#include <octoray/Engine.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace octoray::test
+{
+// Points with every attribute, so that every average is checked.
+struct Cloud
+{
+  std::vector<double> xyz;
+  std::vector<std::uint8_t> rgb;
+  std::vector<float> scalar, reflectivity, refraction, normal;
+
+  std::size_t Size() const { return xyz.size() / 3; }
+
+  void Add(double x, double y, double z, std::mt19937_64& rng)
+  {
+    std::uniform_int_distribution<int> byte(0, 255);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    xyz.insert(xyz.end(), { x, y, z });
+    rgb.insert(rgb.end(), { static_cast<std::uint8_t>(byte(rng)), static_cast<std::uint8_t>(byte(rng)),
+                            static_cast<std::uint8_t>(byte(rng)) });
+    scalar.push_back(unit(rng) * 100.0f - 50.0f);
+    reflectivity.push_back(unit(rng));
+    refraction.push_back(unit(rng) < 0.5f ? 0.0f : 1.0f + unit(rng));
+    normal.insert(normal.end(), { unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f });
+  }
+
+  PointCloudView View() const
+  {
+    PointCloudView v;
+    v.count = Size();
+    v.xyzDouble = xyz.data();
+    v.color8 = rgb.data();
+    v.colorComponents = 3;
+    v.scalar = scalar.data();
+    v.reflectivity = reflectivity.data();
+    v.refraction = refraction.data();
+    v.normal = normal.data();
+    return v;
+  }
+};
+
+inline Cloud UniformCloud(std::size_t n, std::uint64_t seed, double lo = -1.0, double hi = 1.0)
+{
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  Cloud c;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    c.Add(u(rng), u(rng), u(rng), rng);
+  }
+  return c;
+}
+
+inline Cloud GaussianClusters(std::size_t n, std::uint64_t seed)
+{
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double centres[4][3] = { { 0, 0, 0 }, { 10, 2, -3 }, { -5, 8, 1 }, { 3, -7, 6 } };
+  const double sigma[4] = { 1.0, 0.2, 2.5, 0.05 };
+  Cloud c;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const int k = static_cast<int>(i % 4);
+    c.Add(centres[k][0] + sigma[k] * g(rng), centres[k][1] + sigma[k] * g(rng), centres[k][2] + sigma[k] * g(rng), rng);
+  }
+  return c;
+}
+
+// The fixture of every backend-parametrised suite: CUDA cases skip, saying
+// why, where no GPU is usable.
+class BackendTest : public ::testing::TestWithParam<Backend>
+{
+protected:
+  void SetUp() override
+  {
+    std::string why;
+    if (GetParam() == Backend::CUDA && !CudaAvailable(&why))
+    {
+      GTEST_SKIP() << "CUDA backend not usable here: " << why;
+    }
+    engine = CreateEngine(GetParam());
+  }
+  std::unique_ptr<Engine> engine;
+};
+
+inline std::string BackendName(const ::testing::TestParamInfo<Backend>& info)
+{
+  return ToString(info.param);
+}
+
+// Brute force: every point's cell computed here with a bit-by-bit Morton
+// interleave, then per level a map from key prefix to the points under it.
+struct ReferenceNode
+{
+  std::uint32_t count = 0;
+  double sum[10] = {}; // r g b a scalar reflectivity refraction nx ny nz
+  std::uint8_t childMask = 0;
+};
+
+inline std::uint64_t ReferenceKey(const RootCube& cube, const double p[3])
+{
+  std::uint64_t cell[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double g = std::floor((p[a] - cube.origin[a]) / cube.size * 2097152.0);
+    EXPECT_GE(g, 0.0) << "point outside the root cube";
+    EXPECT_LT(g, 2097152.0) << "point outside the root cube";
+    cell[a] = static_cast<std::uint64_t>(g);
+  }
+  std::uint64_t key = 0;
+  for (int bit = 0; bit < 21; ++bit)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      key |= ((cell[a] >> bit) & 1u) << (3 * bit + a);
+    }
+  }
+  return key;
+}
+
+inline std::vector<std::map<std::uint64_t, ReferenceNode>> ReferenceLevels(const Cloud& c, const RootCube& cube,
+  int depth)
+{
+  std::vector<std::map<std::uint64_t, ReferenceNode>> levels(depth + 1);
+  for (std::size_t i = 0; i < c.Size(); ++i)
+  {
+    const std::uint64_t key = ReferenceKey(cube, &c.xyz[3 * i]);
+    double v[10] = { c.rgb[3 * i] / 255.0, c.rgb[3 * i + 1] / 255.0, c.rgb[3 * i + 2] / 255.0, 1.0, c.scalar[i],
+      c.reflectivity[i], c.refraction[i], 0, 0, 0 };
+    const double nx = c.normal[3 * i], ny = c.normal[3 * i + 1], nz = c.normal[3 * i + 2];
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    if (len > 0)
+    {
+      v[7] = nx / len;
+      v[8] = ny / len;
+      v[9] = nz / len;
+    }
+    for (int l = 0; l <= depth; ++l)
+    {
+      const std::uint64_t prefix = key >> (3 * (21 - l));
+      ReferenceNode& node = levels[l][prefix];
+      ++node.count;
+      for (int s = 0; s < 10; ++s)
+      {
+        node.sum[s] += v[s];
+      }
+      if (l > 0)
+      {
+        levels[l - 1][prefix >> 3].childMask |= static_cast<std::uint8_t>(1u << (prefix & 7u));
+      }
+    }
+  }
+  return levels;
+}
+
+// Checks an engine's octree node by node against the brute-force reference.
+inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
+{
+  ASSERT_GE(t.depth, 1);
+  ASSERT_LE(t.depth, 21);
+  const auto levels = ReferenceLevels(c, t.cube, t.depth);
+  ASSERT_EQ(t.levelBegin.size(), 23u);
+  std::size_t total = 0;
+  for (int l = 0; l <= t.depth; ++l)
+  {
+    ASSERT_EQ(t.levelBegin[l + 1] - t.levelBegin[l], levels[l].size()) << "level " << l;
+    total += levels[l].size();
+  }
+  ASSERT_EQ(t.NodeCount(), total);
+  for (int l = 0; l <= t.depth; ++l)
+  {
+    std::uint32_t n = t.levelBegin[l];
+    for (const auto& [key, ref] : levels[l])
+    {
+      SCOPED_TRACE("level " + std::to_string(l) + " node " + std::to_string(n));
+      ASSERT_EQ(t.key[n], key);
+      ASSERT_EQ(t.pointCount[n], ref.count);
+      ASSERT_EQ(t.childMask[n], ref.childMask);
+      if (l == 0)
+      {
+        EXPECT_EQ(t.parent[n], kInvalidIndex);
+      }
+      else
+      {
+        const std::uint32_t p = t.parent[n];
+        ASSERT_GE(p, t.levelBegin[l - 1]);
+        ASSERT_LT(p, t.levelBegin[l]);
+        EXPECT_EQ(t.key[p], key >> 3);
+      }
+      if (l == t.depth)
+      {
+        EXPECT_EQ(t.firstChild[n], kInvalidIndex);
+      }
+      else
+      {
+        const std::uint32_t f = t.firstChild[n];
+        ASSERT_GE(f, t.levelBegin[l + 1]);
+        ASSERT_LT(f, t.levelBegin[l + 2]);
+        EXPECT_EQ(t.key[f] >> 3, key);
+        EXPECT_TRUE(f == t.levelBegin[l + 1] || (t.key[f - 1] >> 3) != key) << "first child is not the first";
+      }
+      const double inv = 1.0 / ref.count;
+      // Means of float data summed in double: relative error ~1e-7.
+      const float tol = 2e-6f;
+      EXPECT_NEAR(t.color[n].r, ref.sum[0] * inv, tol);
+      EXPECT_NEAR(t.color[n].g, ref.sum[1] * inv, tol);
+      EXPECT_NEAR(t.color[n].b, ref.sum[2] * inv, tol);
+      EXPECT_NEAR(t.color[n].a, 1.0, tol);
+      EXPECT_NEAR(t.scalar[n], ref.sum[4] * inv, 5e-5);
+      EXPECT_NEAR(t.reflectivity[n], ref.sum[5] * inv, tol);
+      EXPECT_NEAR(t.refraction[n], ref.sum[6] * inv, 4 * tol);
+      EXPECT_NEAR(t.normal[n].x, ref.sum[7] * inv, tol);
+      EXPECT_NEAR(t.normal[n].y, ref.sum[8] * inv, tol);
+      EXPECT_NEAR(t.normal[n].z, ref.sum[9] * inv, tol);
+      ++n;
+    }
+  }
+}
+}
