@@ -1,5 +1,6 @@
 // C++ use of vtkSliceStackReader on the bundled DICOM series, and of
 // vtkDepthMapReader + vtkParticleNormals on the bundled depth map.
+#include "octorayNaturalSort.h"
 #include "octorayTestCheck.h"
 
 #include "vtkDataArray.h"
@@ -11,8 +12,10 @@
 #include "vtkPolyData.h"
 #include "vtkSliceStackReader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 int main(int argc, char* argv[])
 {
@@ -22,6 +25,17 @@ int main(int argc, char* argv[])
     return EXIT_FAILURE;
   }
   const std::string data = argv[1];
+
+  // Natural order of slice names: numbers by value, leading zeros and numbers
+  // longer than 64 bits included.
+  {
+    std::vector<std::string> names = { "s10.png", "s2.png", "s1.png", "s02.png",
+      "s100000000000000000000.png", "s99999999999999999999.png", "a.png", "s.png" };
+    std::sort(names.begin(), names.end(), octoray::NaturalLess);
+    const std::vector<std::string> expected = { "a.png", "s.png", "s1.png", "s2.png", "s02.png",
+      "s10.png", "s99999999999999999999.png", "s100000000000000000000.png" };
+    CHECK(names == expected);
+  }
 
   {
     vtkNew<vtkSliceStackReader> r;
