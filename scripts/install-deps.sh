@@ -24,8 +24,14 @@ packages=(
   libpcl-features1.13 libeigen3-dev libflann-dev libboost-dev
   # image slices and picture output
   libopenimageio-dev openimageio-tools
+  # DICOM series: image position, orientation and rescale through GDCM
+  libgdcm-dev
   # Python tests, rendering without a display
   python3-pytest python3-numpy xvfb
+  # reader benchmarks compare against pandas (pyarrow engine when present)
+  python3-pandas
+  # independent reference values for the DICOM tests
+  python3-pydicom
 )
 
 missing=()

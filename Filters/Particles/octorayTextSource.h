@@ -1,0 +1,167 @@
+// The bytes of a text file: memory-mapped when plain, inflated into memory
+// when gzip-compressed (recognised by its magic bytes, not its name).
+// Private to the module; not wrapped.
+#ifndef octorayTextSource_h
+#define octorayTextSource_h
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <zlib.h>
+
+namespace octoray
+{
+class TextSource
+{
+public:
+  TextSource() = default;
+  TextSource(const TextSource&) = delete;
+  TextSource& operator=(const TextSource&) = delete;
+  ~TextSource() { this->Close(); }
+
+  const char* Data() const { return this->Inflated.empty() ? this->Map : this->Inflated.data(); }
+  size_t Size() const { return this->Inflated.empty() ? this->MapSize : this->Inflated.size(); }
+  bool IsCompressed() const { return this->Compressed; }
+
+  bool Open(const std::string& name, std::string& error)
+  {
+    this->Close();
+    int fd = ::open(name.c_str(), O_RDONLY);
+    if (fd < 0)
+    {
+      error = name + ": cannot open the file: " + std::strerror(errno);
+      return false;
+    }
+    struct stat st;
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+    {
+      error = name + ": not a regular file";
+      ::close(fd);
+      return false;
+    }
+    this->MapSize = static_cast<size_t>(st.st_size);
+    if (this->MapSize > 0)
+    {
+      void* m = ::mmap(nullptr, this->MapSize, PROT_READ, MAP_PRIVATE, fd, 0);
+      if (m == MAP_FAILED)
+      {
+        error = name + ": cannot map the file: " + std::strerror(errno);
+        ::close(fd);
+        this->MapSize = 0;
+        return false;
+      }
+      this->Map = static_cast<const char*>(m);
+      // The parse reads front to back; tell the kernel so it reads ahead.
+      ::madvise(m, this->MapSize, MADV_SEQUENTIAL);
+    }
+    ::close(fd);
+    if (this->MapSize >= 2 && static_cast<unsigned char>(this->Map[0]) == 0x1f &&
+      static_cast<unsigned char>(this->Map[1]) == 0x8b)
+    {
+      this->Compressed = true;
+      bool ok = this->Inflate(name, error);
+      ::munmap(const_cast<char*>(this->Map), this->MapSize);
+      this->Map = nullptr;
+      this->MapSize = 0;
+      if (ok && this->Inflated.empty())
+      {
+        // An empty member: report the text as empty (Data() must not be null).
+        this->Inflated.clear();
+      }
+      return ok;
+    }
+    return true;
+  }
+
+  void Close()
+  {
+    if (this->Map)
+    {
+      ::munmap(const_cast<char*>(this->Map), this->MapSize);
+    }
+    this->Map = nullptr;
+    this->MapSize = 0;
+    this->Inflated.clear();
+    this->Inflated.shrink_to_fit();
+    this->Compressed = false;
+  }
+
+private:
+  // Inflates every gzip member; a stream that ends before its end marker is
+  // reported as truncated rather than read as a shorter file.
+  bool Inflate(const std::string& name, std::string& error)
+  {
+    z_stream zs;
+    std::memset(&zs, 0, sizeof(zs));
+    if (inflateInit2(&zs, 15 + 16) != Z_OK)
+    {
+      error = name + ": cannot initialise zlib";
+      return false;
+    }
+    const unsigned char* in = reinterpret_cast<const unsigned char*>(this->Map);
+    size_t inLeft = this->MapSize;
+    this->Inflated.reserve(this->MapSize * 4);
+    const size_t block = 1 << 20;
+    int ret = Z_OK;
+    while (true)
+    {
+      const uInt feed = static_cast<uInt>(std::min<size_t>(inLeft, 1u << 30));
+      zs.next_in = const_cast<unsigned char*>(in);
+      zs.avail_in = feed;
+      size_t before = this->Inflated.size();
+      this->Inflated.resize(before + block);
+      zs.next_out = reinterpret_cast<unsigned char*>(this->Inflated.data() + before);
+      zs.avail_out = static_cast<uInt>(block);
+      ret = inflate(&zs, Z_NO_FLUSH);
+      this->Inflated.resize(before + (block - zs.avail_out));
+      const size_t used = feed - zs.avail_in;
+      in += used;
+      inLeft -= used;
+      if (ret == Z_STREAM_END)
+      {
+        // Concatenated members (gzip -c a b > c) form one text.
+        if (inLeft >= 2 && in[0] == 0x1f && in[1] == 0x8b)
+        {
+          inflateReset(&zs);
+          continue;
+        }
+        break;
+      }
+      if (ret == Z_NEED_DICT || ret == Z_DATA_ERROR || ret == Z_MEM_ERROR)
+      {
+        error = name + ": corrupt gzip data at compressed byte " +
+          std::to_string(this->MapSize - inLeft) + ": " + (zs.msg ? zs.msg : "inflate failed");
+        inflateEnd(&zs);
+        this->Inflated.clear();
+        return false;
+      }
+      if (inLeft == 0 && zs.avail_out != 0)
+      {
+        error = name + ": truncated gzip data: the compressed stream ends at byte " +
+          std::to_string(this->MapSize) + " before its end marker (" +
+          std::to_string(this->Inflated.size()) + " bytes of text were recovered)";
+        inflateEnd(&zs);
+        this->Inflated.clear();
+        return false;
+      }
+    }
+    inflateEnd(&zs);
+    return true;
+  }
+
+  const char* Map = nullptr;
+  size_t MapSize = 0;
+  std::vector<char> Inflated;
+  bool Compressed = false;
+};
+} // namespace octoray
+
+#endif

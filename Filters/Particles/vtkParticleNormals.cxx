@@ -1,0 +1,123 @@
+#include "vtkParticleNormals.h"
+
+#include "vtkFloatArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+
+#include <pcl/features/normal_3d_omp.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+
+#include <cmath>
+#include <thread>
+
+vtkStandardNewMacro(vtkParticleNormals);
+
+//------------------------------------------------------------------------------
+int vtkParticleNormals::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  output->ShallowCopy(input);
+  this->NumberOfInvalidNormals = 0;
+  const vtkIdType n = input->GetNumberOfPoints();
+  if (n == 0)
+  {
+    return 1;
+  }
+  if (n < 3)
+  {
+    vtkErrorMacro(<< "normals need at least 3 points; the input has " << n);
+    return 0;
+  }
+
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->resize(static_cast<size_t>(n));
+  double x[3];
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    input->GetPoint(i, x);
+    (*cloud)[i] = pcl::PointXYZ(static_cast<float>(x[0]), static_cast<float>(x[1]),
+      static_cast<float>(x[2]));
+  }
+  this->UpdateProgress(0.1);
+
+  pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> estimator(
+    this->NumberOfThreads > 0 ? static_cast<unsigned>(this->NumberOfThreads)
+                              : std::max(1u, std::thread::hardware_concurrency()));
+  estimator.setInputCloud(cloud);
+  estimator.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  if (this->Radius > 0)
+  {
+    estimator.setRadiusSearch(this->Radius);
+  }
+  else
+  {
+    estimator.setKSearch(std::min<int>(this->NumberOfNeighbors, static_cast<int>(n)));
+  }
+  estimator.setViewPoint(static_cast<float>(this->ViewPoint[0]),
+    static_cast<float>(this->ViewPoint[1]), static_cast<float>(this->ViewPoint[2]));
+  pcl::PointCloud<pcl::Normal> normals;
+  estimator.compute(normals);
+  this->UpdateProgress(0.9);
+  if (normals.size() != static_cast<size_t>(n))
+  {
+    vtkErrorMacro(<< "PCL returned " << normals.size() << " normals for " << n << " points");
+    return 0;
+  }
+
+  auto out = vtkSmartPointer<vtkFloatArray>::New();
+  out->SetName("Normals");
+  out->SetNumberOfComponents(3);
+  out->SetNumberOfTuples(n);
+  auto curvature = vtkSmartPointer<vtkFloatArray>::New();
+  curvature->SetName("Curvature");
+  curvature->SetNumberOfTuples(n);
+  float* o = out->GetPointer(0);
+  float* c = curvature->GetPointer(0);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    const pcl::Normal& nm = normals[i];
+    if (std::isfinite(nm.normal_x) && std::isfinite(nm.normal_y) && std::isfinite(nm.normal_z))
+    {
+      o[3 * i] = nm.normal_x;
+      o[3 * i + 1] = nm.normal_y;
+      o[3 * i + 2] = nm.normal_z;
+      c[i] = nm.curvature;
+    }
+    else
+    {
+      o[3 * i] = o[3 * i + 1] = o[3 * i + 2] = 0;
+      c[i] = 0;
+      ++this->NumberOfInvalidNormals;
+    }
+  }
+  if (this->NumberOfInvalidNormals)
+  {
+    vtkWarningMacro(<< this->NumberOfInvalidNormals << " of " << n
+                    << " points had too few neighbours for a normal and got (0, 0, 0)"
+                    << (this->Radius > 0 ? "; a larger Radius gives them more" : ""));
+  }
+  output->GetPointData()->SetNormals(out);
+  output->GetPointData()->AddArray(curvature);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkParticleNormals::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfNeighbors: " << this->NumberOfNeighbors << "\n";
+  os << indent << "Radius: " << this->Radius << "\n";
+  os << indent << "ViewPoint: " << this->ViewPoint[0] << " " << this->ViewPoint[1] << " "
+     << this->ViewPoint[2] << "\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "NumberOfInvalidNormals: " << this->NumberOfInvalidNormals << "\n";
+}

@@ -1,0 +1,133 @@
+/**
+ * @class   vtkParticleTextReader
+ * @brief   Reads particle text files (the thesis format and its subsets) into vtkPolyData.
+ *
+ * One particle a line. Without a header the column count decides the layout:
+ *
+ * | columns | meaning |
+ * | --- | --- |
+ * | 3 | x y z |
+ * | 4 | x y z scalar |
+ * | 6 | x y z r g b (colour 0-255) |
+ * | 8 | x y z r g b reflectivity refraction (the thesis format) |
+ *
+ * An optional header line names the columns in any order, e.g.
+ * `# x y z r g b reflectivity refraction` or `x,y,z,intensity`; the names
+ * x, y, z are required, r/g/b (or red/green/blue) become `Colors`,
+ * `reflectivity`, `refraction` and `scalar(s)` the arrays of those names and
+ * any other named column a point array of its own name.
+ *
+ * Fields are separated by spaces, tabs or one comma; `#` starts a comment;
+ * blank lines and CRLF line ends are accepted; a gzip file (by its magic
+ * bytes) is read as the text it holds.
+ *
+ * Output: points (float, or double with SetOutputPointsPrecision), one
+ * vertex cell per point (GenerateVertices), and the arrays `Colors`
+ * (unsigned char RGB), `Reflectivity`, `Refraction`, `Scalars` and the named
+ * extras, each only where the file has it.
+ *
+ * Errors name the file, line and column and what was expected:
+ * `particles.txt:12:9: expected a number for column 3 (z), found 'abc'`.
+ * Strict (the default): the first bad line (lowest line number) is an error
+ * and the output is empty. Lenient: bad lines are skipped and counted; a
+ * warning gives the count and the first line numbers, and so does the field
+ * data (`SkippedLineCount`, `SkippedLineNumbers`). Nothing is dropped silently.
+ *
+ * Large files are memory-mapped and parsed by several threads; progress
+ * events come from the calling thread.
+ *
+ * The C++ name differs from VTK's own vtkParticleReader (IOGeometry, a
+ * different format) so both can live in one process; the Python package
+ * `octoray` offers it as `octoray.vtkParticleReader` too.
+ */
+#ifndef vtkParticleTextReader_h
+#define vtkParticleTextReader_h
+
+#include "octorayFiltersParticlesModule.h" // for export macro
+#include "vtkPolyDataAlgorithm.h"
+
+#include <string> // for std::string
+
+class OCTORAYFILTERSPARTICLES_EXPORT vtkParticleTextReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkParticleTextReader* New();
+  vtkTypeMacro(vtkParticleTextReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The file to read (plain text or gzip-compressed text).
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /// vtkAlgorithm::SINGLE_PRECISION (default) or DOUBLE_PRECISION for the
+  /// points and the floating-point arrays.
+  vtkSetClampMacro(OutputPointsPrecision, int, SINGLE_PRECISION, DOUBLE_PRECISION);
+  vtkGetMacro(OutputPointsPrecision, int);
+  ///@}
+
+  ///@{
+  /// Make one VTK_VERTEX cell per point (default on), so that ordinary VTK
+  /// mappers draw the points.
+  vtkSetMacro(GenerateVertices, bool);
+  vtkGetMacro(GenerateVertices, bool);
+  vtkBooleanMacro(GenerateVertices, bool);
+  ///@}
+
+  ///@{
+  /// Skip bad lines instead of failing (default off: strict).
+  vtkSetMacro(Lenient, bool);
+  vtkGetMacro(Lenient, bool);
+  vtkBooleanMacro(Lenient, bool);
+  ///@}
+
+  ///@{
+  /// Threads used for parsing; 0 (default) means all hardware threads.
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
+  ///@{
+  /// How many line numbers of skipped lines are reported (default 10).
+  vtkSetClampMacro(MaximumReportedLines, int, 0, 100000);
+  vtkGetMacro(MaximumReportedLines, int);
+  ///@}
+
+  /// Lines skipped in lenient mode by the last update.
+  vtkGetMacro(NumberOfSkippedLines, vtkIdType);
+
+  /// The message of the last error (strict mode) or of the first skipped line
+  /// (lenient mode); empty when the last update read everything.
+  const char* GetErrorMessage() { return this->ErrorMessage.c_str(); }
+
+  /// Numeric column layout found by the last update, e.g. "x y z r g b".
+  const char* GetColumnNames() { return this->ColumnNames.c_str(); }
+
+protected:
+  vtkParticleTextReader();
+  ~vtkParticleTextReader() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* FileName = nullptr;
+  int OutputPointsPrecision = SINGLE_PRECISION;
+  bool GenerateVertices = true;
+  bool Lenient = false;
+  int NumberOfThreads = 0;
+  int MaximumReportedLines = 10;
+  vtkIdType NumberOfSkippedLines = 0;
+  std::string ErrorMessage;
+  std::string ColumnNames;
+
+private:
+  vtkParticleTextReader(const vtkParticleTextReader&) = delete;
+  void operator=(const vtkParticleTextReader&) = delete;
+
+  template <typename Real>
+  bool Parse(const char* data, size_t size, vtkPolyData* output);
+  void Fail(const std::string& message);
+};
+
+#endif

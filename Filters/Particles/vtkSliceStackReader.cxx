@@ -1,0 +1,922 @@
+#include "vtkSliceStackReader.h"
+
+#include "octorayNaturalSort.h"
+
+#include "vtkCellArray.h"
+#include "vtkFloatArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMatrix3x3.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+#include "vtkUnsignedCharArray.h"
+
+// GDCM before OpenImageIO: OIIO's headers leave <byteswap.h> half-seen for
+// GDCM's byte swapper.
+#include <gdcmImage.h>
+#include <gdcmImageReader.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+vtkStandardNewMacro(vtkSliceStackReader);
+
+namespace
+{
+namespace fs = std::filesystem;
+
+std::string Lower(std::string s)
+{
+  for (char& c : s)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return s;
+}
+
+// DICOM Part 10 files carry "DICM" after a 128-byte preamble.
+bool HasDICMMarker(const std::string& name)
+{
+  std::ifstream f(name, std::ios::binary);
+  char buf[132];
+  if (!f.read(buf, sizeof(buf)))
+  {
+    return false;
+  }
+  return std::memcmp(buf + 128, "DICM", 4) == 0;
+}
+
+bool IsDICOMFile(const std::string& name)
+{
+  return Lower(fs::path(name).extension().string()) == ".dcm" || HasDICMMarker(name);
+}
+
+bool IsPictureExtension(const std::string& name)
+{
+  static const char* known[] = { ".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".exr",
+    ".pgm", ".ppm", ".pnm", ".tga", ".hdr", ".gif", ".webp", ".jp2", ".sgi", ".rgb" };
+  const std::string ext = Lower(fs::path(name).extension().string());
+  return std::find(std::begin(known), std::end(known), ext) != std::end(known);
+}
+
+const char* TypeName(int vtkType)
+{
+  switch (vtkType)
+  {
+    case VTK_UNSIGNED_CHAR:
+      return "uint8";
+    case VTK_UNSIGNED_SHORT:
+      return "uint16";
+    case VTK_SHORT:
+      return "int16";
+    default:
+      return "float";
+  }
+}
+
+const char* ChannelName(int c)
+{
+  switch (c)
+  {
+    case 1:
+      return "grey";
+    case 2:
+      return "grey+alpha";
+    case 3:
+      return "RGB";
+    default:
+      return "RGBA";
+  }
+}
+
+std::string Describe(int w, int h, int c, int t)
+{
+  return std::to_string(w) + "x" + std::to_string(h) + " " + ChannelName(c) + " " + TypeName(t);
+}
+
+// Colour channel to 8 bits, by the type's full range (floats: 0..1).
+template <typename T>
+inline unsigned char ToByte(T v)
+{
+  if constexpr (std::is_same<T, unsigned char>::value)
+  {
+    return v;
+  }
+  else if constexpr (std::is_same<T, unsigned short>::value)
+  {
+    return static_cast<unsigned char>((static_cast<unsigned>(v) + 128) / 257);
+  }
+  else if constexpr (std::is_same<T, short>::value)
+  {
+    return static_cast<unsigned char>(std::clamp((static_cast<int>(v) + 128) / 257, 0, 255));
+  }
+  else
+  {
+    return static_cast<unsigned char>(std::lround(std::clamp(static_cast<double>(v), 0.0, 1.0) * 255));
+  }
+}
+
+struct Selection
+{
+  int Lo[3], Hi[3], Step[3];
+  vtkIdType Dims[3];
+};
+
+// Two passes over the slices: count the particles of each slice, then fill
+// them at their offsets, so the output keeps slice order and needs no locks.
+template <typename T>
+void Extract(const T* data, int comps, const Selection& sel, const double bg[2],
+  const double origin[3], const double spacing[3], const double dir[9], vtkPolyData* output,
+  bool vertices)
+{
+  const int nk = (sel.Hi[2] - sel.Lo[2]) / sel.Step[2] + 1;
+  auto intensity = [&](const T* px) -> double {
+    if (comps >= 3)
+    {
+      return (static_cast<double>(px[0]) + px[1] + px[2]) / 3.0;
+    }
+    return static_cast<double>(px[0]);
+  };
+  auto isParticle = [&](const T* px) -> bool {
+    if ((comps == 2 && px[1] == 0) || (comps == 4 && px[3] == 0))
+    {
+      return false;
+    }
+    const double v = intensity(px);
+    return !(v >= bg[0] && v <= bg[1]);
+  };
+  auto at = [&](int i, int j, int k) {
+    return data + comps * (i + sel.Dims[0] * (j + sel.Dims[1] * static_cast<vtkIdType>(k)));
+  };
+  std::vector<vtkIdType> counts(nk + 1, 0);
+  vtkSMPTools::For(0, nk, [&](vtkIdType b, vtkIdType e) {
+    for (vtkIdType s = b; s < e; ++s)
+    {
+      const int k = sel.Lo[2] + static_cast<int>(s) * sel.Step[2];
+      vtkIdType n = 0;
+      for (int j = sel.Lo[1]; j <= sel.Hi[1]; j += sel.Step[1])
+      {
+        for (int i = sel.Lo[0]; i <= sel.Hi[0]; i += sel.Step[0])
+        {
+          n += isParticle(at(i, j, k));
+        }
+      }
+      counts[s + 1] = n;
+    }
+  });
+  std::partial_sum(counts.begin(), counts.end(), counts.begin());
+  const vtkIdType total = counts[nk];
+
+  auto pts = vtkSmartPointer<vtkFloatArray>::New();
+  pts->SetNumberOfComponents(3);
+  pts->SetNumberOfTuples(total);
+  auto scalars = vtkSmartPointer<vtkFloatArray>::New();
+  scalars->SetName("Scalars");
+  scalars->SetNumberOfTuples(total);
+  vtkSmartPointer<vtkUnsignedCharArray> colors;
+  if (comps >= 3)
+  {
+    colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    colors->SetName("Colors");
+    colors->SetNumberOfComponents(3);
+    colors->SetNumberOfTuples(total);
+  }
+  float* p = pts->GetPointer(0);
+  float* sc = scalars->GetPointer(0);
+  unsigned char* co = colors ? colors->GetPointer(0) : nullptr;
+  vtkSMPTools::For(0, nk, [&](vtkIdType b, vtkIdType e) {
+    for (vtkIdType s = b; s < e; ++s)
+    {
+      const int k = sel.Lo[2] + static_cast<int>(s) * sel.Step[2];
+      vtkIdType n = counts[s];
+      for (int j = sel.Lo[1]; j <= sel.Hi[1]; j += sel.Step[1])
+      {
+        for (int i = sel.Lo[0]; i <= sel.Hi[0]; i += sel.Step[0])
+        {
+          const T* px = at(i, j, k);
+          if (!isParticle(px))
+          {
+            continue;
+          }
+          const double l[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
+          for (int a = 0; a < 3; ++a)
+          {
+            p[3 * n + a] =
+              static_cast<float>(origin[a] + dir[3 * a] * l[0] + dir[3 * a + 1] * l[1] + dir[3 * a + 2] * l[2]);
+          }
+          sc[n] = static_cast<float>(intensity(px));
+          if (co)
+          {
+            for (int c = 0; c < 3; ++c)
+            {
+              co[3 * n + c] = ToByte(px[c]);
+            }
+          }
+          ++n;
+        }
+      }
+    }
+  });
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetData(pts);
+  output->SetPoints(points);
+  output->GetPointData()->AddArray(scalars);
+  if (colors)
+  {
+    output->GetPointData()->SetScalars(colors);
+  }
+  else
+  {
+    output->GetPointData()->SetScalars(scalars);
+  }
+  if (vertices)
+  {
+    auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
+    offsets->SetNumberOfTuples(total + 1);
+    auto conn = vtkSmartPointer<vtkIdTypeArray>::New();
+    conn->SetNumberOfTuples(total);
+    std::iota(offsets->GetPointer(0), offsets->GetPointer(0) + total + 1, 0);
+    std::iota(conn->GetPointer(0), conn->GetPointer(0) + total, 0);
+    auto verts = vtkSmartPointer<vtkCellArray>::New();
+    verts->SetData(offsets, conn);
+    output->SetVerts(verts);
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkSliceStackReader::vtkSliceStackReader()
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetNumberOfOutputPorts(2);
+}
+
+//------------------------------------------------------------------------------
+vtkSliceStackReader::~vtkSliceStackReader()
+{
+  this->SetDirectoryName(nullptr);
+  this->SetFilePattern(nullptr);
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::AddFileName(const char* name)
+{
+  if (name)
+  {
+    this->FileNames.emplace_back(name);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::ClearFileNames()
+{
+  if (!this->FileNames.empty())
+  {
+    this->FileNames.clear();
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSliceStackReader::GetFileName(int i) const
+{
+  return i >= 0 && i < static_cast<int>(this->FileNames.size()) ? this->FileNames[i].c_str()
+                                                                : nullptr;
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::SetFileNames(vtkStringArray* names)
+{
+  this->FileNames.clear();
+  for (vtkIdType i = 0; names && i < names->GetNumberOfValues(); ++i)
+  {
+    this->FileNames.push_back(names->GetValue(i));
+  }
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSliceStackReader::GetSliceFileName(int k) const
+{
+  return k >= 0 && k < static_cast<int>(this->SliceFiles.size()) ? this->SliceFiles[k].c_str()
+                                                                 : nullptr;
+}
+
+//------------------------------------------------------------------------------
+vtkImageData* vtkSliceStackReader::GetImageOutput()
+{
+  return vtkImageData::SafeDownCast(this->GetOutputDataObject(1));
+}
+
+//------------------------------------------------------------------------------
+int vtkSliceStackReader::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 1)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkImageData");
+    return 1;
+  }
+  return this->Superclass::FillOutputPortInformation(port, info);
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::Fail(const std::string& message)
+{
+  this->ErrorMessage = message;
+  vtkErrorMacro(<< message);
+}
+
+//------------------------------------------------------------------------------
+bool vtkSliceStackReader::CollectFiles(std::vector<std::string>& files)
+{
+  files.clear();
+  if (!this->FileNames.empty())
+  {
+    files = this->FileNames;
+    return true;
+  }
+  if (this->FilePattern && *this->FilePattern)
+  {
+    const int first = this->FileNameRange[0];
+    const int last = this->FileNameRange[1];
+    std::vector<std::string> missing;
+    for (int n = first; n <= last; ++n)
+    {
+      char buf[4096];
+      std::snprintf(buf, sizeof(buf), this->FilePattern, n);
+      std::error_code ec;
+      (fs::is_regular_file(buf, ec) ? files : missing).emplace_back(buf);
+    }
+    if (files.empty())
+    {
+      this->Fail(std::string("the file pattern '") + this->FilePattern + "' with numbers " +
+        std::to_string(first) + " to " + std::to_string(last) + " matches no file");
+      return false;
+    }
+    if (!missing.empty())
+    {
+      this->Fail("slice file '" + missing.front() + "' is missing (file pattern '" +
+        this->FilePattern + "', numbers " + std::to_string(first) + " to " +
+        std::to_string(last) + "; " + std::to_string(missing.size()) + " missing)");
+      return false;
+    }
+    return true;
+  }
+  if (this->DirectoryName && *this->DirectoryName)
+  {
+    std::error_code ec;
+    if (!fs::is_directory(this->DirectoryName, ec))
+    {
+      this->Fail(std::string("'") + this->DirectoryName + "' is not a directory");
+      return false;
+    }
+    for (const auto& entry : fs::directory_iterator(this->DirectoryName, ec))
+    {
+      const std::string name = entry.path().filename().string();
+      // DICOMDIR is an index of a DICOM media, not a slice.
+      if (!entry.is_regular_file() || name.empty() || name[0] == '.' || name == "DICOMDIR")
+      {
+        continue;
+      }
+      const std::string path = entry.path().string();
+      if (IsPictureExtension(path) || IsDICOMFile(path))
+      {
+        files.push_back(path);
+      }
+    }
+    if (files.empty())
+    {
+      this->Fail(std::string("the directory '") + this->DirectoryName +
+        "' has no image or DICOM files");
+      return false;
+    }
+    std::sort(files.begin(), files.end(), octoray::NaturalLess);
+    return true;
+  }
+  this->Fail("no slices given: set file names, a directory or a file pattern");
+  return false;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSliceStackReader::ReadPictures(const std::vector<std::string>& files, vtkImageData* image)
+{
+  using namespace OIIO;
+  struct Page
+  {
+    std::string File;
+    int Subimage;
+  };
+  // Header pass: every page's size and type, so a mismatch is reported before
+  // any pixel is read and the volume is allocated once.
+  std::vector<Page> pages;
+  int w = 0, h = 0, c = 0, type = VTK_VOID;
+  std::string firstName;
+  for (const auto& f : files)
+  {
+    std::error_code ec;
+    if (!fs::exists(f, ec))
+    {
+      this->Fail("slice file '" + f + "' does not exist");
+      return false;
+    }
+    auto in = ImageInput::open(f);
+    if (!in)
+    {
+      this->Fail("cannot read slice '" + f + "': " + OIIO::geterror());
+      return false;
+    }
+    for (int s = 0;; ++s)
+    {
+      ImageSpec spec;
+      if (!in->seek_subimage(s, 0, spec))
+      {
+        break;
+      }
+      int t = VTK_FLOAT;
+      switch (spec.format.basetype)
+      {
+        case TypeDesc::UINT8:
+          t = VTK_UNSIGNED_CHAR;
+          break;
+        case TypeDesc::UINT16:
+          t = VTK_UNSIGNED_SHORT;
+          break;
+        case TypeDesc::INT16:
+          t = VTK_SHORT;
+          break;
+        default:
+          t = VTK_FLOAT;
+      }
+      const int sc = std::min(spec.nchannels, 4);
+      const std::string name = s == 0 ? f : f + " (page " + std::to_string(s + 1) + ")";
+      if (sc < 1 || spec.width < 1 || spec.height < 1)
+      {
+        this->Fail("slice '" + name + "' has no pixels");
+        return false;
+      }
+      if (pages.empty())
+      {
+        w = spec.width;
+        h = spec.height;
+        c = sc;
+        type = t;
+        firstName = name;
+      }
+      else if (spec.width != w || spec.height != h || sc != c || t != type)
+      {
+        this->Fail("slice '" + name + "' is " + Describe(spec.width, spec.height, sc, t) +
+          " but slice '" + firstName + "' is " + Describe(w, h, c, type) +
+          "; all slices must have one size and type");
+        return false;
+      }
+      pages.push_back({ f, s });
+    }
+  }
+
+  image->SetDimensions(w, h, static_cast<int>(pages.size()));
+  image->SetSpacing(this->Spacing);
+  image->SetOrigin(this->Origin);
+  image->AllocateScalars(type, c);
+  image->GetPointData()->GetScalars()->SetName("Scalars");
+  TypeDesc format = type == VTK_UNSIGNED_CHAR ? TypeDesc::UINT8
+    : type == VTK_UNSIGNED_SHORT              ? TypeDesc::UINT16
+    : type == VTK_SHORT                       ? TypeDesc::INT16
+                                              : TypeDesc::FLOAT;
+  const size_t pixelBytes = static_cast<size_t>(c) * format.size();
+  const stride_t rowBytes = static_cast<stride_t>(pixelBytes) * w;
+  char* base = static_cast<char*>(image->GetScalarPointer());
+  this->SliceFiles.clear();
+  std::unique_ptr<ImageInput> in;
+  std::string open;
+  for (size_t k = 0; k < pages.size(); ++k)
+  {
+    const Page& pg = pages[k];
+    if (open != pg.File)
+    {
+      in = ImageInput::open(pg.File);
+      open = pg.File;
+      if (!in)
+      {
+        this->Fail("cannot read slice '" + pg.File + "': " + OIIO::geterror());
+        return false;
+      }
+    }
+    // A negative row stride flips the rows while reading, so that j grows
+    // upwards as in VTK's own image readers.
+    char* slice = base + k * static_cast<size_t>(rowBytes) * h;
+    if (!in->read_image(pg.Subimage, 0, 0, c, format, slice + (h - 1) * rowBytes,
+          static_cast<stride_t>(pixelBytes), -rowBytes, AutoStride))
+    {
+      this->Fail("cannot read the pixels of slice '" + pg.File + "': " + in->geterror());
+      return false;
+    }
+    this->SliceFiles.push_back(
+      pg.Subimage ? pg.File + "#" + std::to_string(pg.Subimage + 1) : pg.File);
+    this->UpdateProgress(0.8 * (k + 1) / pages.size());
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSliceStackReader::ReadDICOM(const std::vector<std::string>& files, vtkImageData* image)
+{
+  struct Slice
+  {
+    std::string File;
+    std::vector<float> Values;            // rescaled grey values
+    std::vector<unsigned char> RGB;       // or colour
+    double Origin[3], Row[3], Col[3], Spacing[3];
+    double Position = 0;
+    unsigned int Frames = 1;
+  };
+  std::vector<Slice> slices;
+  unsigned int w = 0, h = 0;
+  int comps = 0;
+  for (size_t n = 0; n < files.size(); ++n)
+  {
+    const std::string& f = files[n];
+    std::error_code ec;
+    if (!fs::exists(f, ec))
+    {
+      this->Fail("DICOM slice '" + f + "' does not exist");
+      return false;
+    }
+    gdcm::ImageReader reader;
+    reader.SetFileName(f.c_str());
+    if (!reader.Read())
+    {
+      this->Fail("cannot read DICOM slice '" + f + "': not a DICOM image GDCM can decode");
+      return false;
+    }
+    const gdcm::Image& img = reader.GetImage();
+    Slice s;
+    s.File = f;
+    const unsigned int* dims = img.GetDimensions();
+    s.Frames = img.GetNumberOfDimensions() > 2 ? dims[2] : 1;
+    const gdcm::PixelFormat& pf = img.GetPixelFormat();
+    const int sc = pf.GetSamplesPerPixel();
+    const std::string desc = std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + " " +
+      (sc == 1 ? "grey" : "RGB");
+    if (slices.empty())
+    {
+      w = dims[0];
+      h = dims[1];
+      comps = sc;
+    }
+    else if (dims[0] != w || dims[1] != h || sc != comps)
+    {
+      this->Fail("DICOM slice '" + f + "' is " + desc + " but slice '" + slices[0].File + "' is " +
+        std::to_string(w) + "x" + std::to_string(h) + " " + (comps == 1 ? "grey" : "RGB") +
+        "; all slices must have one size and type");
+      return false;
+    }
+    if (sc != 1 && !(sc == 3 && pf.GetBitsAllocated() == 8))
+    {
+      this->Fail("DICOM slice '" + f + "' has " + std::to_string(sc) + " samples of " +
+        std::to_string(pf.GetBitsAllocated()) + " bits; only grey or 8-bit RGB is supported");
+      return false;
+    }
+    if (s.Frames > 1 && files.size() > 1)
+    {
+      this->Fail("DICOM slice '" + f + "' has " + std::to_string(s.Frames) +
+        " frames; a series of several files must have one frame per file");
+      return false;
+    }
+    const double* o = img.GetOrigin();
+    const double* dc = img.GetDirectionCosines();
+    const double* sp = img.GetSpacing();
+    for (int a = 0; a < 3; ++a)
+    {
+      s.Origin[a] = o[a];
+      s.Row[a] = dc[a];
+      s.Col[a] = dc[3 + a];
+      s.Spacing[a] = sp[a];
+    }
+    std::vector<char> buffer(img.GetBufferLength());
+    if (!img.GetBuffer(buffer.data()))
+    {
+      this->Fail("cannot decode the pixels of DICOM slice '" + f + "'");
+      return false;
+    }
+    const size_t count = static_cast<size_t>(w) * h * s.Frames;
+    if (sc == 3)
+    {
+      s.RGB.assign(buffer.begin(), buffer.begin() + std::min(buffer.size(), count * 3));
+    }
+    else
+    {
+      // Modality LUT: stored value * slope + intercept (e.g. CT numbers in HU).
+      const double slope = img.GetSlope();
+      const double intercept = img.GetIntercept();
+      s.Values.resize(count);
+      auto convert = [&](auto* src) {
+        for (size_t i = 0; i < count; ++i)
+        {
+          s.Values[i] = static_cast<float>(src[i] * slope + intercept);
+        }
+      };
+      switch (pf.GetScalarType())
+      {
+        case gdcm::PixelFormat::UINT8:
+          convert(reinterpret_cast<const uint8_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::INT8:
+          convert(reinterpret_cast<const int8_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::UINT16:
+          convert(reinterpret_cast<const uint16_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::INT16:
+          convert(reinterpret_cast<const int16_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::UINT32:
+          convert(reinterpret_cast<const uint32_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::INT32:
+          convert(reinterpret_cast<const int32_t*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::FLOAT32:
+          convert(reinterpret_cast<const float*>(buffer.data()));
+          break;
+        case gdcm::PixelFormat::FLOAT64:
+          convert(reinterpret_cast<const double*>(buffer.data()));
+          break;
+        default:
+          this->Fail("DICOM slice '" + f + "' has a pixel type that is not supported");
+          return false;
+      }
+    }
+    slices.push_back(std::move(s));
+    this->UpdateProgress(0.7 * (n + 1) / files.size());
+  }
+
+  // Order along the slice normal (row x column direction) by image position;
+  // the file names say nothing about it.
+  const Slice& s0 = slices[0];
+  double normal[3] = { s0.Row[1] * s0.Col[2] - s0.Row[2] * s0.Col[1],
+    s0.Row[2] * s0.Col[0] - s0.Row[0] * s0.Col[2], s0.Row[0] * s0.Col[1] - s0.Row[1] * s0.Col[0] };
+  for (auto& s : slices)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (std::abs(s.Row[a] - s0.Row[a]) > 1e-4 || std::abs(s.Col[a] - s0.Col[a]) > 1e-4)
+      {
+        this->Fail("DICOM slice '" + s.File + "' has another orientation than slice '" + s0.File +
+          "'; a stack needs parallel slices");
+        return false;
+      }
+    }
+    s.Position = s.Origin[0] * normal[0] + s.Origin[1] * normal[1] + s.Origin[2] * normal[2];
+  }
+  std::stable_sort(slices.begin(), slices.end(),
+    [](const Slice& a, const Slice& b) { return a.Position < b.Position; });
+  double sz = s0.Spacing[2] > 0 ? s0.Spacing[2] : this->Spacing[2];
+  if (slices.size() > 1)
+  {
+    double minGap = HUGE_VAL, maxGap = 0;
+    for (size_t k = 1; k < slices.size(); ++k)
+    {
+      const double gap = slices[k].Position - slices[k - 1].Position;
+      minGap = std::min(minGap, gap);
+      maxGap = std::max(maxGap, gap);
+      if (gap < 1e-6)
+      {
+        this->Fail("DICOM slices '" + slices[k - 1].File + "' and '" + slices[k].File +
+          "' are at the same position");
+        return false;
+      }
+    }
+    sz = (slices.back().Position - slices.front().Position) / (slices.size() - 1);
+    if (maxGap - minGap > 0.01 * sz)
+    {
+      vtkWarningMacro(<< "DICOM slice spacing varies from " << minGap << " to " << maxGap
+                      << "; the volume uses the mean, " << sz);
+    }
+  }
+
+  const int depth = static_cast<int>(slices.size() == 1 ? slices[0].Frames : slices.size());
+  image->SetDimensions(static_cast<int>(w), static_cast<int>(h), depth);
+  if (this->UseMetadata)
+  {
+    image->SetSpacing(slices[0].Spacing[0], slices[0].Spacing[1], sz);
+    image->SetOrigin(slices[0].Origin);
+    image->SetDirectionMatrix(slices[0].Row[0], slices[0].Col[0], normal[0], slices[0].Row[1],
+      slices[0].Col[1], normal[1], slices[0].Row[2], slices[0].Col[2], normal[2]);
+  }
+  else
+  {
+    image->SetSpacing(this->Spacing);
+    image->SetOrigin(this->Origin);
+  }
+  image->AllocateScalars(comps == 3 ? VTK_UNSIGNED_CHAR : VTK_FLOAT, comps);
+  image->GetPointData()->GetScalars()->SetName("Scalars");
+  const size_t sliceValues = static_cast<size_t>(w) * h * comps;
+  this->SliceFiles.clear();
+  for (size_t k = 0; k < slices.size(); ++k)
+  {
+    if (comps == 3)
+    {
+      std::copy(slices[k].RGB.begin(), slices[k].RGB.end(),
+        static_cast<unsigned char*>(image->GetScalarPointer()) + k * sliceValues);
+    }
+    else
+    {
+      std::copy(slices[k].Values.begin(), slices[k].Values.end(),
+        static_cast<float*>(image->GetScalarPointer()) + k * sliceValues);
+    }
+    this->SliceFiles.push_back(slices[k].File);
+  }
+  this->UpdateProgress(0.8);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int vtkSliceStackReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  // The volume's extent, from the headers (first DICOM file, or every
+  // picture's page count), so that pipelines downstream (and ParaView) see a
+  // whole extent before any pixel is read.
+  this->ErrorMessage.clear();
+  std::vector<std::string> files;
+  if (!this->CollectFiles(files))
+  {
+    return 0;
+  }
+  int dims[3] = { 0, 0, 0 };
+  const bool dicom = IsDICOMFile(files.front());
+  if (dicom)
+  {
+    std::error_code ec;
+    if (!fs::exists(files.front(), ec))
+    {
+      this->Fail("DICOM slice '" + files.front() + "' does not exist");
+      return 0;
+    }
+    gdcm::ImageReader reader;
+    reader.SetFileName(files.front().c_str());
+    if (!reader.Read())
+    {
+      this->Fail(
+        "cannot read DICOM slice '" + files.front() + "': not a DICOM image GDCM can decode");
+      return 0;
+    }
+    const unsigned int* d = reader.GetImage().GetDimensions();
+    dims[0] = static_cast<int>(d[0]);
+    dims[1] = static_cast<int>(d[1]);
+    dims[2] = files.size() > 1 || reader.GetImage().GetNumberOfDimensions() < 3
+      ? static_cast<int>(files.size())
+      : static_cast<int>(d[2]);
+  }
+  else
+  {
+    for (const auto& f : files)
+    {
+      std::error_code ec;
+      if (!fs::exists(f, ec))
+      {
+        this->Fail("slice file '" + f + "' does not exist");
+        return 0;
+      }
+      auto in = OIIO::ImageInput::open(f);
+      if (!in)
+      {
+        this->Fail("cannot read slice '" + f + "': " + OIIO::geterror());
+        return 0;
+      }
+      if (dims[2] == 0)
+      {
+        dims[0] = in->spec().width;
+        dims[1] = in->spec().height;
+      }
+      OIIO::ImageSpec spec;
+      for (int s = 0; in->seek_subimage(s, 0, spec); ++s)
+      {
+        ++dims[2];
+      }
+    }
+  }
+  const int extent[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
+  vtkInformation* info = outputVector->GetInformationObject(1);
+  info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  info->Set(vtkDataObject::SPACING(), this->Spacing, 3);
+  info->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::MakeParticles(vtkImageData* image, vtkPolyData* output)
+{
+  int dims[3];
+  image->GetDimensions(dims);
+  Selection sel;
+  for (int a = 0; a < 3; ++a)
+  {
+    int lo = this->RegionOfInterest[2 * a];
+    int hi = this->RegionOfInterest[2 * a + 1];
+    sel.Lo[a] = lo < 0 ? 0 : std::min(lo, dims[a] - 1);
+    sel.Hi[a] = hi < 0 ? dims[a] - 1 : std::min(hi, dims[a] - 1);
+    sel.Step[a] = std::max(1, this->Stride[a]);
+    sel.Dims[a] = dims[a];
+  }
+  double dir[9];
+  const double* m = image->GetDirectionMatrix()->GetData();
+  std::copy(m, m + 9, dir);
+  const int comps = image->GetNumberOfScalarComponents();
+  if (sel.Hi[0] < sel.Lo[0] || sel.Hi[1] < sel.Lo[1] || sel.Hi[2] < sel.Lo[2])
+  {
+    output->SetPoints(vtkSmartPointer<vtkPoints>::New());
+    return;
+  }
+  switch (image->GetScalarType())
+  {
+    vtkTemplateMacro(Extract(static_cast<const VTK_TT*>(image->GetScalarPointer()), comps, sel,
+      this->BackgroundRange, image->GetOrigin(), image->GetSpacing(), dir, output,
+      this->GenerateVertices));
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkSliceStackReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkImageData* image = vtkImageData::GetData(outputVector, 1);
+  this->ErrorMessage.clear();
+  this->SliceFiles.clear();
+  this->IsDICOM = false;
+  output->Initialize();
+  image->Initialize();
+
+  std::vector<std::string> files;
+  if (!this->CollectFiles(files))
+  {
+    return 0;
+  }
+  size_t dicom = 0;
+  for (const auto& f : files)
+  {
+    dicom += IsDICOMFile(f);
+  }
+  if (dicom && dicom != files.size())
+  {
+    this->Fail("the slices mix DICOM and other image files (e.g. '" + files.front() + "')");
+    return 0;
+  }
+  this->IsDICOM = dicom > 0;
+  this->UpdateProgress(0.0);
+  const bool ok = this->IsDICOM ? this->ReadDICOM(files, image) : this->ReadPictures(files, image);
+  if (!ok)
+  {
+    image->Initialize();
+    return 0;
+  }
+  this->MakeParticles(image, output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkSliceStackReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileNames: " << this->FileNames.size() << "\n";
+  os << indent << "DirectoryName: " << (this->DirectoryName ? this->DirectoryName : "(none)")
+     << "\n";
+  os << indent << "FilePattern: " << (this->FilePattern ? this->FilePattern : "(none)") << "\n";
+  os << indent << "FileNameRange: " << this->FileNameRange[0] << " " << this->FileNameRange[1]
+     << "\n";
+  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << " "
+     << this->Spacing[2] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
+     << this->Origin[2] << "\n";
+  os << indent << "UseMetadata: " << this->UseMetadata << "\n";
+  os << indent << "BackgroundRange: " << this->BackgroundRange[0] << " "
+     << this->BackgroundRange[1] << "\n";
+  os << indent << "RegionOfInterest:";
+  for (int v : this->RegionOfInterest)
+  {
+    os << " " << v;
+  }
+  os << "\n" << indent << "Stride: " << this->Stride[0] << " " << this->Stride[1] << " "
+     << this->Stride[2] << "\n";
+  os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
+  os << indent << "IsDICOM: " << this->IsDICOM << "\n";
+}

@@ -1,0 +1,164 @@
+/**
+ * @class   vtkSliceStackReader
+ * @brief   Reads a stack of image slices (incl. a DICOM series) as particles and as a volume.
+ *
+ * The slices come from a list of files (AddFileName), a directory
+ * (SetDirectoryName: every image or DICOM file in it, sorted naturally so
+ * that 2 comes before 10), or a printf-style pattern with a range of numbers
+ * (SetFilePattern + SetFileNameRange, as vtkImageReader2::SetFilePattern).
+ * A multi-page TIFF gives one slice per page.
+ *
+ * Pictures (PNG, TIFF, JPEG, BMP, EXR, ... with 8- or 16-bit grey, grey +
+ * alpha, RGB or RGBA) are read through OpenImageIO; their rows are flipped
+ * so that j grows upwards, as VTK's own image readers do. DICOM files
+ * (recognised by the "DICM" marker or the .dcm extension) are read through
+ * GDCM, because OpenImageIO's DICOM plugin does not report the image position
+ * and orientation: slices are ordered by their position along the slice
+ * normal (not by file name), the slice spacing is the distance between
+ * neighbouring positions, the pixel spacing, the first slice's position and
+ * the orientation become the spacing, origin and direction of the output,
+ * and the rescale slope/intercept are applied (output values are then float).
+ *
+ * Output 0 (vtkPolyData): one particle per pixel that is not background,
+ * at origin + direction * (i*sx, j*sy, k*sz), with a vertex cell each,
+ * `Scalars` (the pixel intensity: the grey value, or the mean of R, G, B) and,
+ * for colour images, `Colors` (unsigned char RGB). A pixel is background when
+ * its intensity lies in BackgroundRange (default [0, 0]) or its alpha is 0.
+ * A region of interest (in pixel indices of the stack) and a stride pick the
+ * pixels that are looked at.
+ *
+ * Output 1 (vtkImageData): the whole stack with the slices' own pixel type
+ * (or float for rescaled DICOM), so VTK's volume mappers can draw the same data.
+ * Its whole extent is announced in RequestInformation (from the headers).
+ *
+ * Errors name the slice: a missing or unreadable file, slices of different
+ * size or type (both named, with both sizes), an empty directory, a pattern
+ * that matches no file. Progress is reported per slice.
+ */
+#ifndef vtkSliceStackReader_h
+#define vtkSliceStackReader_h
+
+#include "octorayFiltersParticlesModule.h" // for export macro
+#include "vtkPolyDataAlgorithm.h"
+
+#include <string> // for std::string
+#include <vector> // for std::vector
+
+class vtkImageData;
+class vtkStringArray;
+
+class OCTORAYFILTERSPARTICLES_EXPORT vtkSliceStackReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkSliceStackReader* New();
+  vtkTypeMacro(vtkSliceStackReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// An explicit list of slice files, in the order given.
+  void AddFileName(const char* name);
+  void ClearFileNames();
+  int GetNumberOfFileNames() const { return static_cast<int>(this->FileNames.size()); }
+  const char* GetFileName(int i) const;
+  void SetFileNames(vtkStringArray* names);
+  ///@}
+
+  ///@{
+  /// A directory whose image (or DICOM) files form the stack, in natural order.
+  vtkSetStringMacro(DirectoryName);
+  vtkGetStringMacro(DirectoryName);
+  ///@}
+
+  ///@{
+  /// A printf-style pattern (e.g. "/data/slice_%03d.png") and the inclusive
+  /// range of numbers it is filled with.
+  vtkSetStringMacro(FilePattern);
+  vtkGetStringMacro(FilePattern);
+  vtkSetVector2Macro(FileNameRange, int);
+  vtkGetVector2Macro(FileNameRange, int);
+  ///@}
+
+  ///@{
+  /// Pixel spacing (x, y) and slice spacing (z); DICOM tags override them
+  /// when UseMetadata is on (default).
+  vtkSetVector3Macro(Spacing, double);
+  vtkGetVector3Macro(Spacing, double);
+  vtkSetVector3Macro(Origin, double);
+  vtkGetVector3Macro(Origin, double);
+  vtkSetMacro(UseMetadata, bool);
+  vtkGetMacro(UseMetadata, bool);
+  vtkBooleanMacro(UseMetadata, bool);
+  ///@}
+
+  ///@{
+  /// Intensities in [min, max] (inclusive) are background (default [0, 0]).
+  vtkSetVector2Macro(BackgroundRange, double);
+  vtkGetVector2Macro(BackgroundRange, double);
+  ///@}
+
+  ///@{
+  /// Region of interest as pixel indices (imin, imax, jmin, jmax, kmin, kmax)
+  /// of the stack (after ordering; j counted upwards for pictures); -1 for a
+  /// bound means "to the edge". Only the particles use it.
+  vtkSetVector6Macro(RegionOfInterest, int);
+  vtkGetVector6Macro(RegionOfInterest, int);
+  vtkSetVector3Macro(Stride, int);
+  vtkGetVector3Macro(Stride, int);
+  ///@}
+
+  ///@{
+  /// One VTK_VERTEX per particle (default on).
+  vtkSetMacro(GenerateVertices, bool);
+  vtkGetMacro(GenerateVertices, bool);
+  vtkBooleanMacro(GenerateVertices, bool);
+  ///@}
+
+  /// The stack as a volume (output port 1).
+  vtkImageData* GetImageOutput();
+
+  /// The message of the last error; empty after a successful update.
+  const char* GetErrorMessage() { return this->ErrorMessage.c_str(); }
+
+  /// The slice files in the order they were stacked by the last update
+  /// (for DICOM: by position along the slice normal).
+  int GetNumberOfSlices() const { return static_cast<int>(this->SliceFiles.size()); }
+  const char* GetSliceFileName(int k) const;
+
+  /// True when the last update read a DICOM series.
+  vtkGetMacro(IsDICOM, bool);
+
+protected:
+  vtkSliceStackReader();
+  ~vtkSliceStackReader() override;
+
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  std::vector<std::string> FileNames;
+  char* DirectoryName = nullptr;
+  char* FilePattern = nullptr;
+  int FileNameRange[2] = { 0, 0 };
+  double Spacing[3] = { 1, 1, 1 };
+  double Origin[3] = { 0, 0, 0 };
+  bool UseMetadata = true;
+  double BackgroundRange[2] = { 0, 0 };
+  int RegionOfInterest[6] = { -1, -1, -1, -1, -1, -1 };
+  int Stride[3] = { 1, 1, 1 };
+  bool GenerateVertices = true;
+  bool IsDICOM = false;
+  std::string ErrorMessage;
+  std::vector<std::string> SliceFiles;
+
+private:
+  vtkSliceStackReader(const vtkSliceStackReader&) = delete;
+  void operator=(const vtkSliceStackReader&) = delete;
+
+  bool CollectFiles(std::vector<std::string>& files);
+  bool ReadPictures(const std::vector<std::string>& files, vtkImageData* image);
+  bool ReadDICOM(const std::vector<std::string>& files, vtkImageData* image);
+  void MakeParticles(vtkImageData* image, vtkPolyData* output);
+  void Fail(const std::string& message);
+};
+
+#endif

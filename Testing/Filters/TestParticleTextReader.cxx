@@ -1,0 +1,165 @@
+// C++ use of vtkParticleTextReader/Writer: formats, strict and lenient errors,
+// parallel parsing equal to serial parsing, write/read round trip.
+#include "octorayTestCheck.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkNew.h"
+#include "vtkParticleTextReader.h"
+#include "vtkParticleTextWriter.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+
+namespace
+{
+std::string Dir;
+
+std::string Write(const std::string& name, const std::string& text)
+{
+  const std::string path = Dir + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// Swallows error and warning output; the tests check GetErrorMessage().
+void Quiet(vtkObject* o)
+{
+  vtkNew<vtkCallbackCommand> cb;
+  cb->SetCallback([](vtkObject*, unsigned long, void*, void*) {});
+  o->AddObserver(vtkCommand::ErrorEvent, cb);
+  o->AddObserver(vtkCommand::WarningEvent, cb);
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  Dir = argc > 1 ? argv[1] : ".";
+
+  // Thesis format with a header in another order and an extra column.
+  {
+    vtkNew<vtkParticleTextReader> r;
+    r->SetFileName(Write("a.txt", "# r g b x y z reflectivity refraction id\n"
+                                  "255 128 0 1.5 2.5 3.5 0.25 1.33 7\n"
+                                  "0 0 0 -1 -2 -3 1 0 8\n")
+                     .c_str());
+    r->Update();
+    vtkPolyData* out = r->GetOutput();
+    CHECK(out->GetNumberOfPoints() == 2);
+    CHECK(out->GetNumberOfVerts() == 2);
+    double p[3];
+    out->GetPoint(0, p);
+    CHECK(p[0] == 1.5 && p[1] == 2.5 && p[2] == 3.5);
+    auto* colors = vtkUnsignedCharArray::SafeDownCast(out->GetPointData()->GetArray("Colors"));
+    CHECK(colors && colors->GetValue(0) == 255 && colors->GetValue(1) == 128);
+    CHECK(out->GetPointData()->GetArray("Reflectivity")->GetComponent(0, 0) == 0.25);
+    CHECK(out->GetPointData()->GetArray("id")->GetComponent(1, 0) == 8);
+    CHECK(std::string(r->GetErrorMessage()).empty());
+  }
+
+  // Strict: the error names file, line, column and what was expected.
+  {
+    vtkNew<vtkParticleTextReader> r;
+    Quiet(r);
+    const std::string path = Write("bad.txt", "1 2 3\n4 5 6\n7 8 zz\n1 2\n");
+    r->SetFileName(path.c_str());
+    r->Update();
+    CHECK(r->GetOutput()->GetNumberOfPoints() == 0);
+    CHECK(std::string(r->GetErrorMessage()) ==
+      path + ":3:5: expected a number for column 3 (z), found 'zz'");
+    // Lenient: both bad lines skipped, counted and listed.
+    r->LenientOn();
+    r->Update();
+    CHECK(r->GetOutput()->GetNumberOfPoints() == 2);
+    CHECK(r->GetNumberOfSkippedLines() == 2);
+    auto* lines =
+      vtkIdTypeArray::SafeDownCast(r->GetOutput()->GetFieldData()->GetArray("SkippedLineNumbers"));
+    CHECK(lines && lines->GetNumberOfTuples() == 2 && lines->GetValue(0) == 3 &&
+      lines->GetValue(1) == 4);
+  }
+
+  // Parallel and serial parsing give the same points, in file order.
+  {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-100, 100);
+    std::string text;
+    for (int i = 0; i < 200000; ++i)
+    {
+      char line[128];
+      std::snprintf(line, sizeof line, "%.6f\t%.6f,%.6f %d\n", u(rng), u(rng), u(rng), i);
+      text += line;
+    }
+    const std::string path = Write("many.txt", text);
+    vtkNew<vtkParticleTextReader> serial, parallel;
+    serial->SetFileName(path.c_str());
+    serial->SetNumberOfThreads(1);
+    parallel->SetFileName(path.c_str());
+    parallel->SetNumberOfThreads(4);
+    serial->Update();
+    parallel->Update();
+    vtkPolyData* a = serial->GetOutput();
+    vtkPolyData* b = parallel->GetOutput();
+    CHECK(a->GetNumberOfPoints() == 200000 && b->GetNumberOfPoints() == 200000);
+    bool same = true;
+    vtkDataArray* sa = a->GetPointData()->GetArray("Scalars");
+    vtkDataArray* sb = b->GetPointData()->GetArray("Scalars");
+    for (vtkIdType i = 0; i < 200000 && same; ++i)
+    {
+      double pa[3], pb[3];
+      a->GetPoint(i, pa);
+      b->GetPoint(i, pb);
+      same = pa[0] == pb[0] && pa[1] == pb[1] && pa[2] == pb[2] &&
+        sa->GetComponent(i, 0) == i && sb->GetComponent(i, 0) == i;
+    }
+    CHECK(same);
+
+    // Round trip through the writer.
+    vtkNew<vtkParticleTextWriter> w;
+    w->SetInputData(a);
+    const std::string copy = Dir + "/copy.txt";
+    w->SetFileName(copy.c_str());
+    CHECK(w->Write() == 1);
+    vtkNew<vtkParticleTextReader> back;
+    back->SetFileName(copy.c_str());
+    back->Update();
+    CHECK(std::string(back->GetColumnNames()) == "x y z scalar");
+    bool equal = back->GetOutput()->GetNumberOfPoints() == 200000;
+    for (vtkIdType i = 0; i < 200000 && equal; i += 997)
+    {
+      double pa[3], pb[3];
+      a->GetPoint(i, pa);
+      back->GetOutput()->GetPoint(i, pb);
+      equal = pa[0] == pb[0] && pa[1] == pb[1] && pa[2] == pb[2];
+    }
+    CHECK(equal);
+  }
+
+  // Empty and missing files.
+  {
+    vtkNew<vtkParticleTextReader> r;
+    Quiet(r);
+    const std::string empty = Write("empty.txt", "");
+    r->SetFileName(empty.c_str());
+    r->Update();
+    CHECK_CONTAINS(r->GetErrorMessage(), empty + ": the file is empty (0 bytes)");
+    r->SetFileName((Dir + "/missing.txt").c_str());
+    r->Update();
+    CHECK_CONTAINS(r->GetErrorMessage(), "missing.txt: cannot open the file");
+  }
+
+  if (octorayTestFailures)
+  {
+    std::cerr << octorayTestFailures << " check(s) failed" << std::endl;
+    return EXIT_FAILURE;
+  }
+  return EXIT_SUCCESS;
+}

@@ -1,0 +1,338 @@
+"""vtkSliceStackReader: picture stacks through OpenImageIO, DICOM series
+through GDCM, background threshold against NumPy, errors by message."""
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pydicom
+import pytest
+import vtk
+import octoray
+from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+
+from conftest import Messages, array, points
+
+
+def vtk_image(slices):
+    """slices: (k, h, w[, c]) array, rows top to bottom as in a picture."""
+    k, h, w = slices.shape[:3]
+    comps = 1 if slices.ndim == 3 else slices.shape[3]
+    image = vtk.vtkImageData()
+    image.SetDimensions(w, h, k)
+    flat = np.ascontiguousarray(slices[:, ::-1]).reshape(-1, comps)  # VTK: bottom row first
+    image.GetPointData().SetScalars(numpy_to_vtk(flat, deep=1))
+    return image
+
+
+def write_slices(writer_class, folder, pattern, slices):
+    os.makedirs(folder, exist_ok=True)
+    paths = []
+    for k, s in enumerate(slices):
+        w = writer_class()
+        w.SetInputData(vtk_image(s[None]))
+        path = os.path.join(folder, pattern % k)
+        w.SetFileName(path)
+        w.Write()
+        paths.append(path)
+    return paths
+
+
+def stack_of(reader):
+    """The image output as (k, h, w[, c]) with rows top to bottom."""
+    im = reader.GetImageOutput()
+    w, h, k = im.GetDimensions()
+    c = im.GetNumberOfScalarComponents()
+    a = vtk_to_numpy(im.GetPointData().GetScalars()).reshape(k, h, w, c)[:, ::-1]
+    return a[..., 0] if c == 1 else a
+
+
+def reader_for(**options):
+    r = octoray.vtkSliceStackReader()
+    msgs = Messages(r)
+    for key, value in options.items():
+        if key == "Files":
+            for f in value:
+                r.AddFileName(f)
+        elif isinstance(value, tuple):
+            getattr(r, "Set" + key)(*value)
+        else:
+            getattr(r, "Set" + key)(value)
+    r.Update()
+    return r, r.GetOutput(), msgs
+
+
+def test_16bit_tiff_stack_pattern(tmp_path):
+    rng = np.random.default_rng(7)
+    vol = rng.integers(0, 4000, size=(6, 20, 30)).astype(np.uint16)
+    vol[vol < 1500] = 0  # a background of zeros
+    folder = os.path.join(str(tmp_path), "tif")
+    write_slices(vtk.vtkTIFFWriter, folder, "ct_%02d.tif", vol)
+    r, out, msgs = reader_for(FilePattern=os.path.join(folder, "ct_%02d.tif"),
+                              FileNameRange=(0, 5), Spacing=(0.5, 0.25, 2.0),
+                              Origin=(10.0, 20.0, 30.0))
+    assert not msgs.errors, msgs.errors
+    im = r.GetImageOutput()
+    assert im.GetDimensions() == (30, 20, 6)
+    assert im.GetScalarType() == vtk.VTK_UNSIGNED_SHORT
+    np.testing.assert_array_equal(stack_of(r), vol)
+    # Default background [0, 0]: every non-zero pixel is a particle.
+    assert out.GetNumberOfPoints() == np.count_nonzero(vol)
+    assert out.GetNumberOfVerts() == out.GetNumberOfPoints()
+    # Positions: origin + (i*sx, j*sy, k*sz), j counted from the bottom row.
+    k, row, i = np.nonzero(vol)
+    j = vol.shape[1] - 1 - row
+    expected = np.column_stack([10 + i * 0.5, 20 + j * 0.25, 30 + k * 2.0])
+    got = points(out)
+    order_got = np.lexsort(got.T[::-1])
+    order_exp = np.lexsort(expected.T[::-1])
+    np.testing.assert_allclose(got[order_got], expected[order_exp], rtol=0, atol=1e-5)
+    np.testing.assert_array_equal(np.sort(array(out, "Scalars")), np.sort(vol[vol > 0]))
+    # A background range: [0, 2500] against NumPy's count of the same pixels.
+    r.SetBackgroundRange(0, 2500)
+    r.Update()
+    assert r.GetOutput().GetNumberOfPoints() == np.count_nonzero(vol > 2500)
+
+
+def test_rgb_png_stack_directory_natural_order(tmp_path):
+    rng = np.random.default_rng(11)
+    vol = rng.integers(0, 256, size=(12, 8, 9, 3)).astype(np.uint8)
+    vol[rng.uniform(size=vol.shape[:3]) < 0.4] = 0
+    folder = os.path.join(str(tmp_path), "png")
+    # Names whose plain sort would put 10 and 11 before 2.
+    write_slices(vtk.vtkPNGWriter, folder, "slice%d.png", vol)
+    with open(os.path.join(folder, "notes.txt"), "w") as f:
+        f.write("not an image")
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert not msgs.errors, msgs.errors
+    assert [os.path.basename(r.GetSliceFileName(k)) for k in range(r.GetNumberOfSlices())] == \
+        ["slice%d.png" % k for k in range(12)]
+    np.testing.assert_array_equal(stack_of(r), vol)
+    nonbg = vol.sum(axis=3) > 0  # intensity = mean of R, G, B; background [0, 0]
+    assert out.GetNumberOfPoints() == np.count_nonzero(nonbg)
+    # Colours and scalars come from the pixels, in stack order (k, then j up, then i).
+    flipped = vol[:, ::-1]
+    sel = flipped.sum(axis=3) > 0
+    np.testing.assert_array_equal(array(out, "Colors"), flipped[sel])
+    np.testing.assert_allclose(array(out, "Scalars"), flipped[sel].mean(axis=1), rtol=1e-6)
+    # Background by intensity range, against NumPy.
+    r.SetBackgroundRange(0, 100)
+    r.Update()
+    assert r.GetOutput().GetNumberOfPoints() == np.count_nonzero(vol.mean(axis=3) > 100)
+
+
+def test_roi_and_stride(tmp_path):
+    vol = np.arange(1, 5 * 6 * 7 + 1, dtype=np.uint16).reshape(5, 6, 7)
+    files = write_slices(vtk.vtkTIFFWriter, str(tmp_path), "s%d.tif", vol)
+    r, out, msgs = reader_for(Files=files, RegionOfInterest=(1, 5, 0, 3, 1, 4), Stride=(2, 3, 2))
+    assert not msgs.errors
+    flipped = vol[:, ::-1]  # index j counts up from the bottom row
+    sub = flipped[1:5:2, 0:4:3, 1:6:2]
+    assert out.GetNumberOfPoints() == sub.size
+    np.testing.assert_array_equal(array(out, "Scalars"), sub.ravel())
+
+
+def test_multipage_tiff(tmp_path):
+    vol = np.random.default_rng(2).integers(0, 3, size=(4, 5, 6)).astype(np.uint8)
+    w = vtk.vtkTIFFWriter()
+    w.SetInputData(vtk_image(vol))
+    path = os.path.join(str(tmp_path), "pages.tif")
+    w.SetFileName(path)
+    w.Write()
+    r, out, msgs = reader_for(Files=[path])
+    assert not msgs.errors
+    assert r.GetNumberOfSlices() == 4
+    assert r.GetSliceFileName(1) == path + "#2"
+    assert out.GetNumberOfPoints() == np.count_nonzero(vol)
+
+
+def test_rgba_alpha_is_background(tmp_path):
+    vol = np.zeros((1, 2, 2, 4), np.uint8)
+    vol[0, 0, 0] = (10, 20, 30, 255)
+    vol[0, 0, 1] = (10, 20, 30, 0)  # transparent: background
+    vol[0, 1, 0] = (0, 0, 0, 255)   # black: background by intensity
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "a%d.png", vol)
+    r, out, msgs = reader_for(Files=files)
+    assert out.GetNumberOfPoints() == 1
+    assert array(out, "Colors").tolist() == [[10, 20, 30]]
+
+
+@pytest.mark.parametrize("ext,writer", [("bmp", vtk.vtkBMPWriter), ("jpg", vtk.vtkJPEGWriter)])
+def test_bmp_and_jpeg(tmp_path, ext, writer):
+    vol = np.zeros((3, 16, 16, 3), np.uint8)
+    vol[:, 4:12, 4:12] = 200
+    write_slices(writer, str(tmp_path), "x%d." + ext, vol)
+    r, out, msgs = reader_for(DirectoryName=str(tmp_path), BackgroundRange=(0, 50))
+    assert not msgs.errors
+    assert r.GetImageOutput().GetDimensions() == (16, 16, 3)
+    # JPEG is lossy but a flat 200 square on 0 stays far from the threshold.
+    assert out.GetNumberOfPoints() == 3 * 8 * 8
+
+
+def test_exr(tmp_path):
+    vol = np.zeros((2, 4, 5), np.float32)
+    vol[0, 1, 2] = 0.5
+    vol[1, 3, 4] = 2.0
+    tifs = write_slices(vtk.vtkTIFFWriter, str(tmp_path), "f%d.tif", vol)
+    exrs = []
+    for t in tifs:
+        e = t.replace(".tif", ".exr")
+        subprocess.run(["oiiotool", t, "-d", "half", "-o", e], check=True)
+        exrs.append(e)
+    r, out, msgs = reader_for(Files=exrs)
+    assert not msgs.errors, msgs.errors
+    assert r.GetImageOutput().GetScalarType() == vtk.VTK_FLOAT
+    np.testing.assert_array_equal(stack_of(r), vol)
+    assert sorted(array(out, "Scalars").tolist()) == [0.5, 2.0]
+
+
+def test_dicom_series_out_of_order(tmp_path, data_dir):
+    src = os.path.join(data_dir, "DICOM", "CT5N")
+    # Names that say nothing about position: natural name order is not z order.
+    names = {"2062.dcm": "img_7.dcm", "2392.dcm": "img_10.dcm", "2693.dcm": "img_1.dcm",
+             "3023.dcm": "img_30.dcm", "3353.dcm": "img_4.dcm"}
+    folder = os.path.join(str(tmp_path), "ct")
+    os.makedirs(folder)
+    for a, b in names.items():
+        shutil.copy(os.path.join(src, a), os.path.join(folder, b))
+    r, out, msgs = reader_for(DirectoryName=folder, BackgroundRange=(-10000, -500))
+    assert not msgs.errors, msgs.errors
+    assert r.GetIsDICOM()
+    # Reference from pydicom: sort by ImagePositionPatient z (axial, normal +z).
+    ds = [pydicom.dcmread(os.path.join(folder, n)) for n in names.values()]
+    ds.sort(key=lambda d: float(d.ImagePositionPatient[2]))
+    order = [os.path.basename(r.GetSliceFileName(k)) for k in range(r.GetNumberOfSlices())]
+    assert order == [os.path.basename(d.filename) for d in ds]
+    assert order == ["img_4.dcm", "img_30.dcm", "img_1.dcm", "img_10.dcm", "img_7.dcm"]
+    im = r.GetImageOutput()
+    assert im.GetDimensions() == (16, 16, 5)
+    np.testing.assert_allclose(im.GetSpacing(), [0.488281, 0.488281, 2.5], rtol=1e-6)
+    np.testing.assert_allclose(im.GetOrigin(), [float(v) for v in ds[0].ImagePositionPatient],
+                               rtol=1e-6)
+    hu = np.stack([d.pixel_array * float(d.RescaleSlope) + float(d.RescaleIntercept) for d in ds])
+    assert im.GetScalarType() == vtk.VTK_FLOAT
+    # DICOM rows stay top-down (j follows the column direction cosines).
+    got = vtk_to_numpy(im.GetPointData().GetScalars()).reshape(5, 16, 16)
+    np.testing.assert_array_equal(got, hu.astype(np.float32))
+    assert out.GetNumberOfPoints() == np.count_nonzero(hu > -500)
+    # Particle positions are patient coordinates: origin + i*dx*row + j*dy*col + k*dz*normal.
+    k, j, i = np.nonzero(hu > -500)
+    ipp = np.array([float(v) for v in ds[0].ImagePositionPatient])
+    expected = ipp + np.column_stack([i * 0.488281, j * 0.488281, k * 2.5])
+    np.testing.assert_allclose(points(out), expected, atol=1e-4)
+
+
+def test_dicom_single_ct_slice(data_dir):
+    path = os.path.join(data_dir, "DICOM", "CT_small", "CT_small.dcm")
+    r, out, msgs = reader_for(Files=[path], BackgroundRange=(-5000, 0))
+    assert not msgs.errors
+    d = pydicom.dcmread(path)
+    hu = d.pixel_array * float(d.RescaleSlope) + float(d.RescaleIntercept)
+    assert r.GetImageOutput().GetDimensions() == (128, 128, 1)
+    assert out.GetNumberOfPoints() == np.count_nonzero(hu > 0)
+
+
+# --- errors ----------------------------------------------------------------
+
+def test_error_missing_slice_in_pattern(tmp_path):
+    vol = np.ones((3, 4, 4), np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "m%d.png", vol)
+    os.remove(files[1])
+    r, out, msgs = reader_for(FilePattern=os.path.join(str(tmp_path), "m%d.png"),
+                              FileNameRange=(0, 2))
+    assert out.GetNumberOfPoints() == 0
+    assert r.GetErrorMessage().startswith("slice file '%s' is missing" % files[1])
+    assert msgs.errors and files[1] in msgs.errors[0]
+
+
+def test_error_missing_listed_file(tmp_path):
+    r, out, msgs = reader_for(Files=[os.path.join(str(tmp_path), "gone.png")])
+    assert "slice file '%s' does not exist" % os.path.join(str(tmp_path), "gone.png") \
+        == r.GetErrorMessage()
+
+
+def test_error_pattern_matches_nothing(tmp_path):
+    pattern = os.path.join(str(tmp_path), "none_%03d.tif")
+    r, out, msgs = reader_for(FilePattern=pattern, FileNameRange=(1, 9))
+    assert r.GetErrorMessage() == \
+        "the file pattern '%s' with numbers 1 to 9 matches no file" % pattern
+    assert out.GetNumberOfPoints() == 0
+
+
+def test_error_empty_directory(tmp_path):
+    folder = os.path.join(str(tmp_path), "empty")
+    os.makedirs(folder)
+    with open(os.path.join(folder, "readme.txt"), "w") as f:
+        f.write("x")
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert r.GetErrorMessage() == "the directory '%s' has no image or DICOM files" % folder
+    assert len(msgs.errors) == 1
+
+
+def test_error_unreadable_slice(tmp_path):
+    vol = np.ones((2, 4, 4), np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "u%d.png", vol)
+    with open(files[1], "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n garbage")
+    r, out, msgs = reader_for(Files=files)
+    assert r.GetErrorMessage().startswith("cannot read slice '%s'" % files[1])
+    assert out.GetNumberOfPoints() == 0
+    assert r.GetImageOutput().GetNumberOfPoints() == 0
+
+
+def test_error_different_sizes(tmp_path):
+    a = write_slices(vtk.vtkPNGWriter, str(tmp_path), "a%d.png", np.ones((1, 4, 5), np.uint8))
+    b = write_slices(vtk.vtkPNGWriter, str(tmp_path), "b%d.png", np.ones((1, 6, 7), np.uint8))
+    r, out, msgs = reader_for(Files=a + b)
+    assert r.GetErrorMessage() == (
+        "slice '%s' is 7x6 grey uint8 but slice '%s' is 5x4 grey uint8; "
+        "all slices must have one size and type" % (b[0], a[0]))
+
+
+def test_error_different_types(tmp_path):
+    a = write_slices(vtk.vtkPNGWriter, str(tmp_path), "a%d.png", np.ones((1, 4, 4), np.uint8))
+    b = write_slices(vtk.vtkPNGWriter, str(tmp_path), "b%d.png", np.ones((1, 4, 4), np.uint16))
+    c = write_slices(vtk.vtkPNGWriter, str(tmp_path), "c%d.png", np.ones((1, 4, 4, 3), np.uint8))
+    r, out, msgs = reader_for(Files=a + b)
+    assert "is 4x4 grey uint16 but slice '%s' is 4x4 grey uint8" % a[0] in r.GetErrorMessage()
+    r, out, msgs = reader_for(Files=a + c)
+    assert "is 4x4 RGB uint8 but slice '%s' is 4x4 grey uint8" % a[0] in r.GetErrorMessage()
+
+
+def test_error_nothing_given():
+    r, out, msgs = reader_for()
+    assert r.GetErrorMessage() == "no slices given: set file names, a directory or a file pattern"
+
+
+def test_progress_per_slice(tmp_path):
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "p%d.png", np.ones((5, 3, 3), np.uint8))
+    r = octoray.vtkSliceStackReader()
+    for f in files:
+        r.AddFileName(f)
+    progress = []
+    r.AddObserver("ProgressEvent", lambda o, e: progress.append(o.GetProgress()))
+    r.Update()
+    assert len(progress) >= 7  # start, one per slice, end
+    assert progress[-1] == 1.0
+
+
+def test_volume_port_in_a_pipeline(tmp_path):
+    """Output 1 announces its whole extent before reading, and a VTK image
+    filter downstream gets the whole stack (as VTK's volume mappers would)."""
+    vol = np.random.default_rng(3).integers(0, 100, size=(4, 6, 5)).astype(np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "v%d.png", vol)
+    r = octoray.vtkSliceStackReader()
+    for f in files:
+        r.AddFileName(f)
+    r.UpdateInformation()
+    info = r.GetOutputInformation(1)
+    assert info.Get(vtk.vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()) == (0, 4, 0, 5, 0, 3)
+    shift = vtk.vtkImageShiftScale()
+    shift.SetInputConnection(r.GetOutputPort(1))
+    shift.SetShift(1)
+    shift.SetOutputScalarTypeToUnsignedShort()
+    shift.Update()
+    out = shift.GetOutput()
+    assert out.GetDimensions() == (5, 6, 4)
+    got = vtk_to_numpy(out.GetPointData().GetScalars()).reshape(4, 6, 5)[:, ::-1]
+    np.testing.assert_array_equal(got, vol.astype(np.uint16) + 1)
