@@ -556,17 +556,20 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
   image.depth.resize(pixels);
   // Rows are interleaved over threads so that costly regions are shared.
   std::vector<std::size_t> secondary(Threads, 0);
-  ParallelChunks(static_cast<std::size_t>(Threads), Threads, [&](std::size_t, std::size_t, int t) {
-    std::size_t rays = 0;
-    for (int y = t; y < settings.height; y += Threads)
-    {
-      for (int x = 0; x < settings.width; ++x)
+  DispatchFeatures(frame, [&](auto features) {
+    using F = decltype(features);
+    ParallelChunks(static_cast<std::size_t>(Threads), Threads, [&](std::size_t, std::size_t, int t) {
+      std::size_t rays = 0;
+      for (int y = t; y < settings.height; y += Threads)
       {
-        const std::size_t i = static_cast<std::size_t>(y) * settings.width + x;
-        RenderPixel(frame, view, x, y, &image.rgba[4 * i], image.depth[i], rays);
+        for (int x = 0; x < settings.width; ++x)
+        {
+          const std::size_t i = static_cast<std::size_t>(y) * settings.width + x;
+          RenderPixel<F>(frame, view, x, y, &image.rgba[4 * i], image.depth[i], rays);
+        }
       }
-    }
-    secondary[t] = rays;
+      secondary[t] = rays;
+    });
   });
   RenderStats stats;
   stats.primaryRays = pixels;

@@ -338,6 +338,7 @@ __global__ void ApplyDeltasKernel(OctreeView t, PointArraysView pts, const std::
   ApplyNodeDelta(t, recordNode[starts[r]], dCount, dSum);
 }
 
+template <typename F>
 __global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, float* depth,
   unsigned long long* secondaryRays)
 {
@@ -350,7 +351,7 @@ __global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, flo
   const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
   std::size_t rays = 0;
   float pixel[4];
-  RenderPixel(f, tree, x, y, pixel, depth[i], rays);
+  RenderPixel<F>(f, tree, x, y, pixel, depth[i], rays);
   reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
   if (rays)
   {
@@ -818,12 +819,14 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   }
   ImageRgba.Reserve(Pool, 4 * pixels, "image colours");
   ImageDepth.Reserve(Pool, pixels, "image depth");
-  DeviceBuffer<unsigned long long> counter;
-  counter.Reserve(Pool, 1, "counters");
+  RayCounter.Reserve(Pool, 1, "counters");
+  DeviceBuffer<unsigned long long>& counter = RayCounter;
   CudaCheck(cudaMemset(counter.Get(), 0, sizeof(unsigned long long)), "cudaMemset");
   const dim3 block(16, 8);
   const dim3 grid((settings.width + block.x - 1) / block.x, (settings.height + block.y - 1) / block.y);
-  RenderKernel<<<grid, block>>>(frame, view, ImageRgba.Get(), ImageDepth.Get(), counter.Get());
+  DispatchFeatures(frame, [&](auto features) {
+    RenderKernel<decltype(features)><<<grid, block>>>(frame, view, ImageRgba.Get(), ImageDepth.Get(), counter.Get());
+  });
   CudaCheckLaunch("RenderKernel");
   CudaCheck(cudaDeviceSynchronize(), "RenderKernel");
   RenderStats stats;

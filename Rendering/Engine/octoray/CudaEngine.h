@@ -83,5 +83,6 @@ private:
   // Per-frame buffers, kept while the viewport keeps its size.
   DeviceBuffer<Rgba> Transfer;
   DeviceBuffer<float> DepthIn, ImageRgba, ImageDepth;
+  DeviceBuffer<unsigned long long> RayCounter;
 };
 }

@@ -39,6 +39,23 @@ struct FrameConstants
   const float* depthBuffer = nullptr;
 };
 
+// What a frame uses, fixed at compile time: each combination is its own
+// instantiation of RenderPixel, so a frame without lights, shadows or
+// secondary rays carries none of their code or registers (DispatchFeatures
+// picks the instantiation per frame).
+template <bool Volume, bool Lit, bool Shadows, bool Secondary>
+struct Features
+{
+  static constexpr bool kVolume = Volume;       // a volume blend mode, not a surface
+  static constexpr bool kLit = Lit;             // Phong shading
+  static constexpr bool kShadows = Shadows;     // shadow rays towards the lights
+  static constexpr bool kSecondary = Secondary; // mirror and refracted rays
+};
+
+// Calls fn(Features<...>()) with the frame's feature set.
+template <typename Fn>
+void DispatchFeatures(const FrameConstants& f, Fn&& fn);
+
 OCTORAY_HD void Transform(const double m[16], const double in[4], double out[4])
 {
   for (int r = 0; r < 4; ++r)
@@ -266,6 +283,7 @@ OCTORAY_HD void EntryPoint(const Ray& ray, const NodeHit& hit, float p[3])
 }
 
 // Lit colour of a surface hit (before reflection).
+template <typename F>
 OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit,
   float tFromNear, const LevelOfDetail& lod, float rgb[3], std::size_t& secondaryRays)
 {
@@ -279,7 +297,7 @@ OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, co
     rgb[0] *= k, rgb[1] *= k, rgb[2] *= k;
     return;
   }
-  if (f.shade != ShadeMode::Phong)
+  if constexpr (!F::kLit)
   {
     return;
   }
@@ -314,7 +332,7 @@ OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, co
     {
       continue;
     }
-    if (f.shadows && f.lightCount > 0)
+    if constexpr (F::kShadows)
     {
       Ray shadow;
       for (int a = 0; a < 3; ++a)
@@ -561,6 +579,7 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
 }
 
 // One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+template <typename F>
 OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
   float& depth, std::size_t& secondaryRays)
 {
@@ -577,7 +596,7 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
   lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(tBase);
   lod.footprintSlope = f.footprintSlope;
 
-  if (f.blend != BlendMode::Surface)
+  if constexpr (F::kVolume)
   {
     BlendVisitor blend;
     blend.f = &f;
@@ -611,6 +630,22 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     return;
   }
 
+  if constexpr (!F::kSecondary)
+  {
+    // Surface, first hit only.
+    FirstHitVisitor first;
+    Traverse(tree, ray, lod, first);
+    if (first.found)
+    {
+      const float tHit = first.hit.tEnter > ray.tMin ? first.hit.tEnter : ray.tMin;
+      const double p[3] = { origin[0] + tHit * direction[0], origin[1] + tHit * direction[1],
+        origin[2] + tHit * direction[2] };
+      depth = WindowDepth(f, p);
+      ShadeSurface<F>(f, tree, ray, first.hit, static_cast<float>(tBase) + tHit, lod, rgba, secondaryRays);
+      rgba[3] = 1.0f;
+    }
+    return;
+  }
   // Surface: the first voxel, then the mirror and refracted rays it spawns,
   // each carrying its weight in the pixel, until the bounce limit.
   PendingRay pending[kMaxPendingRays];
@@ -638,7 +673,7 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
       primary = false;
     }
     float rgb[3];
-    ShadeSurface(f, tree, path.ray, hit, path.tFromNear + tHit, lod, rgb, secondaryRays);
+    ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, lod, rgb, secondaryRays);
     const bool canBounce = path.bounces < f.maxBounces;
     float reflectivity = canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f;
     reflectivity = reflectivity < 0.0f ? 0.0f : (reflectivity > 1.0f ? 1.0f : reflectivity);
@@ -688,6 +723,31 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
         ++secondaryRays;
       }
     }
+  }
+}
+
+template <typename Fn>
+void DispatchFeatures(const FrameConstants& f, Fn&& fn)
+{
+  if (f.blend != BlendMode::Surface)
+  {
+    fn(Features<true, false, false, false>());
+    return;
+  }
+  const bool lit = f.shade == ShadeMode::Phong;
+  const bool shadows = lit && f.shadows;
+  const bool secondary = f.maxBounces > 0;
+  if (shadows)
+  {
+    secondary ? fn(Features<false, true, true, true>()) : fn(Features<false, true, true, false>());
+  }
+  else if (lit)
+  {
+    secondary ? fn(Features<false, true, false, true>()) : fn(Features<false, true, false, false>());
+  }
+  else
+  {
+    secondary ? fn(Features<false, false, false, true>()) : fn(Features<false, false, false, false>());
   }
 }
 }
