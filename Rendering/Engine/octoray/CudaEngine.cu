@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace octoray
 {
@@ -195,6 +196,21 @@ __global__ void InnerKernel(OctreeView t, int level, const std::uint32_t* starts
     const std::uint32_t c0 = t.levelBegin[level + 1] + starts[j];
     const std::uint32_t c1 = t.levelBegin[level + 1] + starts[j + 1];
     ReduceChildren(t, t.levelBegin[level] + j, t.key[c0] >> 3, c0, c1);
+  }
+}
+
+// The first of n xyz triples with a NaN or infinite coordinate.
+template <typename T>
+__global__ void FirstNonFiniteKernel(const T* xyz, std::size_t n, unsigned long long* first)
+{
+  const std::size_t k = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  if (k < n)
+  {
+    const double p[3] = { double(xyz[3 * k]), double(xyz[3 * k + 1]), double(xyz[3 * k + 2]) };
+    if (!IsFinitePoint(p))
+    {
+      atomicMin(first, static_cast<unsigned long long>(k));
+    }
   }
 }
 
@@ -715,18 +731,6 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
   ValidateUpdate(positions, s.count);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t moved = positions.count;
-  for (std::size_t k = 0; k < moved; ++k)
-  {
-    double p[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      p[a] = positions.xyzDouble ? positions.xyzDouble[3 * k + a] : positions.xyzFloat[3 * k + a];
-    }
-    if (!IsFinitePoint(p))
-    {
-      throw Error(NonFinitePointMessage(positions.indices ? positions.indices[k] : k, p));
-    }
-  }
   UpdateStats stats;
   stats.moved = moved;
 
@@ -737,21 +741,35 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
   }
   float* xyzFloat = s.xyzFloat.Empty() ? nullptr : s.xyzFloat.Get();
   double* xyzDouble = s.xyzDouble.Empty() ? nullptr : s.xyzDouble.Get();
-  if (positions.xyzDouble)
-  {
-    DeviceBuffer<double> xyz;
-    Upload(Pool, xyz, positions.xyzDouble, 3 * moved, "update positions");
+  // The new positions are checked on the device before any is written, so
+  // that a non-finite one is refused with nothing changed.
+  auto checkAndScatter = [&](auto* host) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(host)>>;
+    DeviceBuffer<T> xyz;
+    Upload(Pool, xyz, host, 3 * moved, "update positions");
+    DeviceBuffer<unsigned long long> firstBad;
+    firstBad.Reserve(Pool, 1, "counters");
+    CudaCheck(cudaMemset(firstBad.Get(), 0xFF, sizeof(unsigned long long)), "cudaMemset");
+    FirstNonFiniteKernel<<<Blocks(moved), kBlock>>>(xyz.Get(), moved, firstBad.Get());
+    CudaCheckLaunch("FirstNonFiniteKernel");
+    unsigned long long bad = 0;
+    CudaCheck(cudaMemcpy(&bad, firstBad.Get(), sizeof(bad), cudaMemcpyDeviceToHost), "FirstNonFiniteKernel");
+    if (bad != ~0ull)
+    {
+      const double p[3] = { double(host[3 * bad]), double(host[3 * bad + 1]), double(host[3 * bad + 2]) };
+      throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, p));
+    }
     ScatterPositionsKernel<<<Blocks(moved), kBlock>>>(xyz.Get(), indices.Get(), moved, xyzFloat, xyzDouble);
     CudaCheckLaunch("ScatterPositionsKernel");
     CudaCheck(cudaDeviceSynchronize(), "ScatterPositionsKernel");
+  };
+  if (positions.xyzDouble)
+  {
+    checkAndScatter(positions.xyzDouble);
   }
   else
   {
-    DeviceBuffer<float> xyz;
-    Upload(Pool, xyz, positions.xyzFloat, 3 * moved, "update positions");
-    ScatterPositionsKernel<<<Blocks(moved), kBlock>>>(xyz.Get(), indices.Get(), moved, xyzFloat, xyzDouble);
-    CudaCheckLaunch("ScatterPositionsKernel");
-    CudaCheck(cudaDeviceSynchronize(), "ScatterPositionsKernel");
+    checkAndScatter(positions.xyzFloat);
   }
 
   const int leafShift = 3 * (kMaxLevel - s.depth);
