@@ -228,6 +228,42 @@ TEST_P(RenderTest, BadSettingsAreErrors)
   }
 }
 
+TEST_P(RenderTest, EightBitOutputIsTheRoundedFloatPicture)
+{
+  const Cloud c = GaussianClusters(2000, 47);
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(c.View(), options);
+  const int w = 40, h = 30;
+  const double eye[3] = { 20, -25, 15 }, target[3] = { 2, 1, 1 };
+  const Matrix vp = ViewProjection(eye, target, kUp, 40, double(w) / h, 1, 100);
+  for (BlendMode blend : { BlendMode::Surface, BlendMode::Composite })
+  {
+    RenderSettings s = Settings(vp, w, h);
+    s.blend = blend;
+    s.shade = ShadeMode::Phong;
+    s.transfer.range[0] = -50;
+    s.transfer.range[1] = 50;
+    s.transfer.table = { Rgba{ 0, 0, 1, 0.05f }, Rgba{ 1, 1, 0, 0.05f } };
+    Image f, b;
+    engine->Render(s, f);
+    s.rgba8 = true;
+    engine->Render(s, b);
+    ASSERT_EQ(f.rgba.size(), 4u * w * h);
+    ASSERT_TRUE(f.rgba8.empty());
+    ASSERT_EQ(b.rgba8.size(), 4u * w * h);
+    ASSERT_TRUE(b.rgba.empty());
+    int lit = 0;
+    for (std::size_t i = 0; i < f.rgba.size(); ++i)
+    {
+      ASSERT_EQ(b.rgba8[i], ChannelToByte(f.rgba[i])) << "channel " << i;
+      lit += b.rgba8[i] > 0;
+    }
+    EXPECT_GT(lit, 100);
+    EXPECT_EQ(f.depth, b.depth);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, RenderTest, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
 
 // The CUDA picture against the CPU one (the reference), per mode.

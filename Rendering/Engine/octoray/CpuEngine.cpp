@@ -552,7 +552,8 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
   image.width = settings.width;
   image.height = settings.height;
   const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
-  image.rgba.resize(4 * pixels);
+  image.rgba.assign(settings.rgba8 ? 0 : 4 * pixels, 0.0f);
+  image.rgba8.assign(settings.rgba8 ? 4 * pixels : 0, 0);
   image.depth.resize(pixels);
   // Rows are interleaved over threads so that costly regions are shared.
   std::vector<std::size_t> secondary(Threads, 0);
@@ -565,7 +566,19 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
         for (int x = 0; x < settings.width; ++x)
         {
           const std::size_t i = static_cast<std::size_t>(y) * settings.width + x;
-          RenderPixel<F>(frame, view, x, y, &image.rgba[4 * i], image.depth[i], rays);
+          float pixel[4];
+          RenderPixel<F>(frame, view, x, y, pixel, image.depth[i], rays);
+          for (int c = 0; c < 4; ++c)
+          {
+            if (settings.rgba8)
+            {
+              image.rgba8[4 * i + c] = ChannelToByte(pixel[c]);
+            }
+            else
+            {
+              image.rgba[4 * i + c] = pixel[c];
+            }
+          }
         }
       }
       secondary[t] = rays;

@@ -354,8 +354,15 @@ __global__ void ApplyDeltasKernel(OctreeView t, PointArraysView pts, const std::
   ApplyNodeDelta(t, recordNode[starts[r]], dCount, dSum);
 }
 
+// A premultiplied channel in [0,1] as a byte, as ChannelToByte on the host.
+__device__ std::uint8_t DeviceChannelToByte(float v)
+{
+  v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+  return static_cast<std::uint8_t>(__fadd_rn(__fmul_rn(v, 255.0f), 0.5f));
+}
+
 template <typename F>
-__global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, float* depth,
+__global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, std::uint8_t* rgba8, float* depth,
   unsigned long long* secondaryRays)
 {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -368,7 +375,15 @@ __global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, flo
   std::size_t rays = 0;
   float pixel[4];
   RenderPixel<F>(f, tree, x, y, pixel, depth[i], rays);
-  reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
+  if (rgba8)
+  {
+    reinterpret_cast<uchar4*>(rgba8)[i] = make_uchar4(DeviceChannelToByte(pixel[0]), DeviceChannelToByte(pixel[1]),
+      DeviceChannelToByte(pixel[2]), DeviceChannelToByte(pixel[3]));
+  }
+  else
+  {
+    reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
+  }
   if (rays)
   {
     atomicAdd(secondaryRays, static_cast<unsigned long long>(rays));
@@ -835,7 +850,14 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
     Upload(Pool, DepthIn, settings.depthBuffer.data(), pixels, "depth buffer");
     frame.depthBuffer = DepthIn.Get();
   }
-  ImageRgba.Reserve(Pool, 4 * pixels, "image colours");
+  if (settings.rgba8)
+  {
+    ImageRgba8.Reserve(Pool, 4 * pixels, "image colours");
+  }
+  else
+  {
+    ImageRgba.Reserve(Pool, 4 * pixels, "image colours");
+  }
   ImageDepth.Reserve(Pool, pixels, "image depth");
   RayCounter.Reserve(Pool, 1, "counters");
   DeviceBuffer<unsigned long long>& counter = RayCounter;
@@ -843,7 +865,8 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   const dim3 block(16, 8);
   const dim3 grid((settings.width + block.x - 1) / block.x, (settings.height + block.y - 1) / block.y);
   DispatchFeatures(frame, [&](auto features) {
-    RenderKernel<decltype(features)><<<grid, block>>>(frame, view, ImageRgba.Get(), ImageDepth.Get(), counter.Get());
+    RenderKernel<decltype(features)><<<grid, block>>>(frame, view, settings.rgba8 ? nullptr : ImageRgba.Get(),
+      settings.rgba8 ? ImageRgba8.Get() : nullptr, ImageDepth.Get(), counter.Get());
   });
   CudaCheckLaunch("RenderKernel");
   CudaCheck(cudaDeviceSynchronize(), "RenderKernel");
@@ -858,13 +881,23 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   if (settings.copyToHost)
   {
     const auto copy = std::chrono::steady_clock::now();
-    Download(ImageRgba, image.rgba);
+    if (settings.rgba8)
+    {
+      Download(ImageRgba8, image.rgba8);
+      image.rgba.clear();
+    }
+    else
+    {
+      Download(ImageRgba, image.rgba);
+      image.rgba8.clear();
+    }
     Download(ImageDepth, image.depth);
     stats.copySeconds = SecondsSince(copy);
   }
   else
   {
     image.rgba.clear();
+    image.rgba8.clear();
     image.depth.clear();
   }
   return stats;

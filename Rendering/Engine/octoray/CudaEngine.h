@@ -60,6 +60,7 @@ public:
   // The last frame in device memory: premultiplied RGBA (4 floats a pixel)
   // and window depth, rows from the bottom.
   const float* DeviceImageRgba() const { return ImageRgba.Get(); }
+  const std::uint8_t* DeviceImageRgba8() const { return ImageRgba8.Get(); }
   const float* DeviceImageDepth() const { return ImageDepth.Get(); }
 
 private:
@@ -83,6 +84,7 @@ private:
   // Per-frame buffers, kept while the viewport keeps its size.
   DeviceBuffer<Rgba> Transfer;
   DeviceBuffer<float> DepthIn, ImageRgba, ImageDepth;
+  DeviceBuffer<std::uint8_t> ImageRgba8;
   DeviceBuffer<unsigned long long> RayCounter;
 };
 }

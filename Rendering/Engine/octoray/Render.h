@@ -64,8 +64,12 @@ struct RenderSettings
   // opaque geometry already drawn; rays stop there. Empty = none.
   std::vector<float> depthBuffer;
   // CUDA: copy the picture to the host Image. Off, it stays in device memory
-  // (CudaEngine::DeviceImage) for a caller that draws it from there.
+  // (CudaEngine::DeviceImageRgba/DeviceImageDepth) for a caller that draws it
+  // from there.
   bool copyToHost = true;
+  // Colour as float (Image::rgba) or 8-bit (Image::rgba8, a quarter of the
+  // bytes to copy and upload): the caller's choice.
+  bool rgba8 = false;
 };
 
 // Premultiplied RGBA and window depth (1 where nothing was hit), rows from
@@ -73,9 +77,17 @@ struct RenderSettings
 struct Image
 {
   int width = 0, height = 0;
-  std::vector<float> rgba;
+  std::vector<float> rgba;         // 4 floats a pixel (RenderSettings::rgba8 off)
+  std::vector<std::uint8_t> rgba8; // 4 bytes a pixel, rounded from the floats (rgba8 on)
   std::vector<float> depth;
 };
+
+// A premultiplied channel in [0,1] as a byte, rounded to nearest.
+inline std::uint8_t ChannelToByte(float v)
+{
+  v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+  return static_cast<std::uint8_t>(v * 255.0f + 0.5f);
+}
 
 struct RenderStats
 {
