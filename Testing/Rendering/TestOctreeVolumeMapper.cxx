@@ -23,6 +23,7 @@
 #include "vtkGlyph3D.h"
 #include "vtkImageData.h"
 #include "vtkLight.h"
+#include "vtkLightCollection.h"
 #include "vtkNew.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkPiecewiseFunction.h"
@@ -467,6 +468,249 @@ int Modes(const std::string& baselineDir, const std::string& tmpDir)
   }
   return 0;
 }
+// Counts warnings and errors, and keeps VTK from printing them.
+struct Messages
+{
+  int warnings = 0, errors = 0;
+  std::string last;
+  vtkNew<vtkCallbackCommand> callback;
+  explicit Messages(vtkObject* o)
+  {
+    callback->SetClientData(this);
+    callback->SetCallback([](vtkObject*, unsigned long event, void* self, void* text) {
+      auto* m = static_cast<Messages*>(self);
+      (event == vtkCommand::WarningEvent ? m->warnings : m->errors)++;
+      m->last = text ? static_cast<const char*>(text) : "";
+    });
+    o->AddObserver(vtkCommand::WarningEvent, callback);
+    o->AddObserver(vtkCommand::ErrorEvent, callback);
+  }
+};
+
+// ---- Backend choice, CUDA fallback, and work only when needed.
+int Work()
+{
+  vtkSmartPointer<vtkPolyData> cloud = Cloud(2000, 3);
+  // New() picks CUDA when a device is usable, the CPU otherwise.
+  {
+    vtkNew<vtkOctreeVolumeMapper> automatic;
+    CHECK(vtkOctreeVolumeMapper::IsCudaAvailable() ? automatic->IsA("vtkCudaOctreeVolumeMapper")
+                                                   : automatic->IsA("vtkCPUOctreeVolumeMapper"));
+  }
+  // The CUDA mapper without a usable device, or with a device whose memory
+  // is exhausted: a warning, and the CPU draws the picture.
+  {
+    vtkNew<vtkCudaOctreeVolumeMapper> cuda;
+    Messages messages(cuda);
+    cuda->SetInputData(cloud);
+    cuda->SetCudaMemoryBudget(1024); // far too little for any octree
+    vtkNew<vtkRenderer> ren;
+    ren->AddVolume(Volume(cuda));
+    SetCamera(ren->GetActiveCamera(), false);
+    vtkSmartPointer<vtkRenderWindow> window = Window(120, 120);
+    window->AddRenderer(ren);
+    window->Render();
+    std::cout << "CUDA mapper: " << cuda->GetLastUsedBackendName() << " (" << cuda->GetBackendDescription()
+              << "), warning: " << messages.last << "\n";
+    CHECK(cuda->GetLastUsedBackend() == vtkOctreeVolumeMapper::BACKEND_CPU);
+    CHECK(messages.warnings == 1);
+    CHECK(messages.errors == 0);
+    CHECK(cuda->GetNumberOfTraces() == 1);
+  }
+
+  vtkNew<vtkCPUOctreeVolumeMapper> mapper;
+  mapper->SetInputData(cloud);
+  vtkNew<vtkRenderer> ren;
+  vtkSmartPointer<vtkVolume> volume = Volume(mapper);
+  ren->AddVolume(volume);
+  SetCamera(ren->GetActiveCamera(), false);
+  vtkSmartPointer<vtkRenderWindow> window = Window(160, 120);
+  window->AddRenderer(ren);
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfTraces() == 1);
+  CHECK(std::string(mapper->GetLastUsedBackendName()) == "CPU");
+  CHECK(mapper->GetNumberOfOctreePoints() == 2000);
+  // Nothing changed: no build, no trace.
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfTraces() == 1);
+  // The camera moved: trace, no build.
+  ren->GetActiveCamera()->Azimuth(10);
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfTraces() == 2);
+  // A light changed: trace.
+  ren->GetLights()->GetItemAsObject(0);
+  vtkNew<vtkLight> light;
+  light->SetPosition(1, 2, 3);
+  ren->AddLight(light);
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfTraces() == 3);
+  light->SetIntensity(0.5);
+  window->Render();
+  CHECK(mapper->GetNumberOfTraces() == 4);
+  // The property changed: trace.
+  volume->GetProperty()->SetAmbient(0.3);
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfTraces() == 5);
+  // Only the positions changed (same array, modified in place): update.
+  double p[3];
+  cloud->GetPoints()->GetPoint(0, p);
+  p[0] += 0.01;
+  cloud->GetPoints()->SetPoint(0, p);
+  cloud->GetPoints()->Modified();
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 1 && mapper->GetNumberOfUpdates() == 1);
+  CHECK(mapper->GetNumberOfTraces() == 6);
+  // The colours changed: rebuild.
+  cloud->GetPointData()->GetScalars()->Modified();
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 2 && mapper->GetNumberOfUpdates() == 1);
+  // A mapper setting that shapes the octree: rebuild.
+  mapper->SetLeafDepth(3);
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 3);
+  // Depth 3: a leaf is an eighth of the root cube, which is about 2 wide.
+  CHECK(mapper->GetLeafSize() * 8 > 1.8 && mapper->GetLeafSize() * 8 < 2.01);
+  // A setting of the picture only: trace, no build.
+  mapper->SetBlendModeToMaximumIntensity();
+  window->Render();
+  CHECK(mapper->GetNumberOfBuilds() == 3 && mapper->GetNumberOfTraces() == 9);
+
+  // vtkImageData: voxels above the background become points.
+  {
+    vtkNew<vtkImageData> image;
+    image->SetDimensions(10, 10, 10);
+    image->AllocateScalars(VTK_FLOAT, 1);
+    auto* v = vtkFloatArray::SafeDownCast(image->GetPointData()->GetScalars());
+    for (vtkIdType i = 0; i < 1000; ++i)
+    {
+      v->SetValue(i, i % 4 == 0 ? 5.0f : 0.0f);
+    }
+    vtkNew<vtkCPUOctreeVolumeMapper> imageMapper;
+    imageMapper->SetInputData(image);
+    imageMapper->SetImageBackground(1.0);
+    vtkNew<vtkRenderer> r2;
+    r2->AddVolume(Volume(imageMapper));
+    r2->ResetCamera();
+    vtkSmartPointer<vtkRenderWindow> w2 = Window(100, 100);
+    w2->AddRenderer(r2);
+    w2->Render();
+    CHECK(imageMapper->GetNumberOfOctreePoints() == 250);
+  }
+  return 0;
+}
+
+// ---- Moving points for `frames` frames gives the pictures of building
+// from scratch at each frame. Left renderer: one mapper, updated in place;
+// right renderer: a new mapper per frame. Eight fixed corner points keep
+// the bounds, and so the root cube, the same for both.
+int Animation(int frames)
+{
+  const int w = 160, h = 160;
+  vtkSmartPointer<vtkPolyData> cloud = Cloud(600, 21);
+  vtkPoints* points = cloud->GetPoints();
+  vtkUnsignedCharArray* colors = vtkUnsignedCharArray::SafeDownCast(cloud->GetPointData()->GetScalars());
+  const unsigned char white[3] = { 255, 255, 255 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    points->InsertNextPoint(corner & 1 ? 1.2 : -1.2, corner & 2 ? 1.2 : -1.2, corner & 4 ? 1.2 : -1.2);
+    colors->InsertNextTypedTuple(white);
+  }
+  std::vector<double> base(3 * 600);
+  for (vtkIdType i = 0; i < 600; ++i)
+  {
+    points->GetPoint(i, &base[3 * i]);
+  }
+  vtkNew<vtkCPUOctreeVolumeMapper> animated;
+  animated->SetInputData(cloud);
+  animated->SetLeafDepth(5);
+  vtkNew<vtkRenderer> left;
+  left->SetViewport(0, 0, 0.5, 1);
+  left->AddVolume(Volume(animated));
+  SetCamera(left->GetActiveCamera(), false);
+  vtkNew<vtkRenderer> right;
+  right->SetViewport(0.5, 0, 1, 1);
+  SetCamera(right->GetActiveCamera(), false);
+  vtkSmartPointer<vtkRenderWindow> window = Window(2 * w, h);
+  window->AddRenderer(left);
+  window->AddRenderer(right);
+  int differing = 0, emptyFrames = 0;
+  for (int frame = 0; frame < frames; ++frame)
+  {
+    const double t = 0.05 * frame;
+    for (vtkIdType i = 0; i < 600; ++i)
+    {
+      const double* b = &base[3 * i];
+      points->SetPoint(i, b[0] * 0.9 + 0.08 * std::sin(t + i), b[1] * 0.9 + 0.08 * std::cos(1.3 * t + i),
+        b[2] * 0.9);
+    }
+    points->Modified();
+    // A fresh copy, so that the right mapper builds from scratch.
+    vtkNew<vtkPolyData> copy;
+    copy->DeepCopy(cloud);
+    vtkNew<vtkCPUOctreeVolumeMapper> fresh;
+    fresh->SetInputData(copy);
+    fresh->SetLeafDepth(5);
+    right->RemoveAllViewProps();
+    right->AddVolume(Volume(fresh));
+    const Picture p = Capture(window);
+    int covered = 0;
+    for (int y = 0; y < h; ++y)
+    {
+      for (int x = 0; x < w; ++x)
+      {
+        differing += !Same(p.At(x, y), p.At(x + w, y));
+        covered += p.Depth(x, y) < 1.0f;
+      }
+    }
+    emptyFrames += covered < 1000;
+  }
+  std::cout << "animation: " << frames << " frames, " << animated->GetNumberOfBuilds() << " build(s), "
+            << animated->GetNumberOfUpdates() << " updates, " << differing << " differing pixels\n";
+  CHECK(animated->GetNumberOfBuilds() == 1);
+  CHECK(animated->GetNumberOfUpdates() == frames - 1);
+  CHECK(differing == 0);
+  CHECK(emptyFrames == 0);
+  return 0;
+}
+
+// ---- A 4096x4096 offscreen window.
+int Large()
+{
+  const int size = 4096;
+  vtkSmartPointer<vtkPolyData> cloud = Cloud(5000, 9);
+  vtkNew<vtkCPUOctreeVolumeMapper> mapper;
+  mapper->SetInputData(cloud);
+  mapper->SetLeafDepth(6);
+  vtkNew<vtkRenderer> ren;
+  ren->AddVolume(Volume(mapper));
+  SetCamera(ren->GetActiveCamera(), false);
+  vtkSmartPointer<vtkRenderWindow> window = Window(size, size);
+  window->AddRenderer(ren);
+  const Picture p = Capture(window);
+  CHECK(p.w == size && p.h == size);
+  // The cloud fills the middle of the window, not only a corner.
+  int covered = 0, quadrants[4] = { 0, 0, 0, 0 };
+  for (int y = 0; y < size; y += 4)
+  {
+    for (int x = 0; x < size; x += 4)
+    {
+      if (p.Depth(x, y) < 1.0f)
+      {
+        ++covered;
+        ++quadrants[(x >= size / 2) + 2 * (y >= size / 2)];
+      }
+    }
+  }
+  std::cout << "4096x4096: " << covered << " of " << (size / 4) * (size / 4) << " sampled pixels covered, trace "
+            << mapper->GetLastTraceSeconds() << " s, depth read " << mapper->GetLastDepthReadSeconds()
+            << " s, upload " << mapper->GetLastUploadSeconds() << " s\n";
+  CHECK(covered > (size / 4) * (size / 4) / 8);
+  for (int q : quadrants)
+  {
+    CHECK(q > covered / 8);
+  }
+  return 0;
+}
 } // namespace
 
 int main(int argc, char* argv[])
@@ -483,6 +727,18 @@ int main(int argc, char* argv[])
   else if (what == "modes" && argc > 3)
   {
     Modes(argv[2], argv[3]);
+  }
+  else if (what == "work")
+  {
+    Work();
+  }
+  else if (what == "animation")
+  {
+    Animation(argc > 2 ? std::atoi(argv[2]) : 100);
+  }
+  else if (what == "large")
+  {
+    Large();
   }
   else
   {
