@@ -378,6 +378,7 @@ int Modes(const std::string& baselineDir, const std::string& tmpDir)
     { "additive", vtkVolumeMapper::ADDITIVE_BLEND, false, true },
   };
   std::vector<vtkSmartPointer<vtkImageData>> pictures;
+  vtkSmartPointer<vtkRenderWindow> lastWindow;
   for (const Mode& m : modes)
   {
     vtkNew<vtkCPUOctreeVolumeMapper> mapper;
@@ -444,6 +445,7 @@ int Modes(const std::string& baselineDir, const std::string& tmpDir)
     testing->AddArgument("-T");
     testing->AddArgument(tmpDir.c_str());
     testing->SetRenderWindow(window);
+    lastWindow = window;
     // Threshold 0.05: vtkImageDifference's thresholded error; an image of the
     // CPU reference differs from its baseline only by driver rounding.
     const int result = testing->RegressionTest(grab, 0.05, std::cout);
@@ -459,6 +461,7 @@ int Modes(const std::string& baselineDir, const std::string& tmpDir)
     testing->AddArgument(baseline.c_str());
     testing->AddArgument("-T");
     testing->AddArgument(tmpDir.c_str());
+    testing->SetRenderWindow(lastWindow);
     std::ostringstream quiet;
     vtkNew<vtkImageData> composite;
     composite->DeepCopy(pictures[4]);
