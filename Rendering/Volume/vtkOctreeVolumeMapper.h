@@ -1,0 +1,290 @@
+/**
+ * @class   vtkOctreeVolumeMapper
+ * @brief   ray-traces a sparse voxel octree of point data into a VTK renderer
+ *
+ * vtkOctreeVolumeMapper renders point data (a vtkPointSet: points with
+ * optional colours, scalars, reflectivity, refraction and normals) or a
+ * vtkImageData (every voxel above ImageBackground becomes a point) by
+ * building the octree engine's sparse voxel octree of the points and
+ * ray-tracing it. It holds the VTK plumbing shared by both backends:
+ *
+ * - the camera: rays come from the inverse of
+ *   vtkCamera::GetCompositeProjectionTransformMatrix (times the volume's
+ *   matrix), so perspective, parallel projection, clipping range and tiled
+ *   or off-axis viewports agree with VTK by construction;
+ * - compositing: the depth of the opaque geometry already drawn in the
+ *   viewport is read back so that rays stop there, and the picture
+ *   (premultiplied RGBA) is drawn as a full-viewport quad that writes
+ *   gl_FragDepth, so the octree hides and is hidden by other actors;
+ * - vtkVolumeProperty: shade on/off, ambient, diffuse, specular, specular
+ *   power, the colour transfer function and scalar opacity on the active
+ *   scalars; with IndependentComponents off, 3- or 4-component active
+ *   scalars are colours;
+ * - blend modes: composite, maximum, minimum, average, additive, and
+ *   SURFACE_BLEND (first hit; also used for ISOSURFACE_BLEND), the default;
+ * - renderer lights (headlight, camera and scene lights, positional or
+ *   directional, colour and intensity) become engine lights;
+ * - work only when needed: the octree is rebuilt when the input or the
+ *   arrays it uses change, updated in place when only point positions change
+ *   (animation), and the picture is re-traced only when the camera, lights,
+ *   properties, settings or the opaque depth change.
+ *
+ * New() returns a vtkCudaOctreeVolumeMapper when a CUDA device is usable and
+ * a vtkCPUOctreeVolumeMapper otherwise (unless an object factory overrides
+ * it). RequestedBackend chooses at run time; a CUDA failure (no device,
+ * out of memory) falls back to the CPU backend with a warning.
+ * GetLastUsedBackend() says which backend made the last picture.
+ *
+ * Positional lights are treated as point lights without cone or attenuation.
+ *
+ * @sa vtkCPUOctreeVolumeMapper vtkCudaOctreeVolumeMapper
+ */
+#ifndef vtkOctreeVolumeMapper_h
+#define vtkOctreeVolumeMapper_h
+
+#include "octorayRenderingVolumeModule.h" // for export macro
+#include "vtkVolumeMapper.h"
+
+#include <functional> // for std::function
+#include <vector>     // for std::vector
+
+class vtkOpenGLRenderWindow;
+class vtkPolyData;
+class vtkVolumeProperty;
+
+class OCTORAYRENDERINGVOLUME_EXPORT vtkOctreeVolumeMapper : public vtkVolumeMapper
+{
+public:
+  static vtkOctreeVolumeMapper* New();
+  vtkTypeMacro(vtkOctreeVolumeMapper, vtkVolumeMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /**
+   * First-hit rendering of the octree's voxels (the engine's surface mode),
+   * beside vtkVolumeMapper's blend modes. The default blend mode.
+   */
+  enum
+  {
+    SURFACE_BLEND = 10
+  };
+  void SetBlendModeToSurface() { this->SetBlendMode(SURFACE_BLEND); }
+
+  enum Backend
+  {
+    BACKEND_AUTO = 0,
+    BACKEND_CUDA = 1,
+    BACKEND_CPU = 2
+  };
+
+  ///@{
+  /**
+   * Which engine backend to use. AUTO: CUDA when a device is usable, else
+   * the CPU. CUDA: CUDA, falling back to the CPU with a warning. CPU: the
+   * CPU backend (the reference). Changing it rebuilds the octree at the next
+   * render.
+   */
+  vtkSetClampMacro(RequestedBackend, int, BACKEND_AUTO, BACKEND_CPU);
+  vtkGetMacro(RequestedBackend, int);
+  void SetRequestedBackendToAuto() { this->SetRequestedBackend(BACKEND_AUTO); }
+  void SetRequestedBackendToCuda() { this->SetRequestedBackend(BACKEND_CUDA); }
+  void SetRequestedBackendToCPU() { this->SetRequestedBackend(BACKEND_CPU); }
+  ///@}
+
+  /**
+   * The backend that made the last picture (BACKEND_CUDA or BACKEND_CPU),
+   * or -1 before the first render. GetLastUsedBackendName() gives "CUDA",
+   * "CPU" or "none"; GetBackendDescription() the engine's own words, e.g.
+   * "CPU (2 threads)".
+   */
+  int GetLastUsedBackend();
+  const char* GetLastUsedBackendName();
+  const char* GetBackendDescription();
+
+  /**
+   * Whether a CUDA device is usable here (CUDA compiled in and a device
+   * present).
+   */
+  static bool IsCudaAvailable();
+
+  ///@{
+  /**
+   * Octree leaf level, 1..21, or 0 (the default) to choose it from the data.
+   */
+  vtkSetClampMacro(LeafDepth, int, 0, 21);
+  vtkGetMacro(LeafDepth, int);
+  ///@}
+
+  ///@{
+  /**
+   * Level of detail: rays stop descending at voxels smaller than this many
+   * pixels. 0 (the default) always descends to the leaves.
+   */
+  vtkSetClampMacro(LODPixelThreshold, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(LODPixelThreshold, double);
+  ///@}
+
+  ///@{
+  /**
+   * Shadow rays towards the lights (shaded surface mode only). Off by default.
+   */
+  vtkSetMacro(Shadows, bool);
+  vtkGetMacro(Shadows, bool);
+  vtkBooleanMacro(Shadows, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Reflections and refractions a ray may follow (surface mode). Default 2.
+   */
+  vtkSetClampMacro(MaximumBounces, int, 0, 8);
+  vtkGetMacro(MaximumBounces, int);
+  ///@}
+
+  ///@{
+  /**
+   * Depth cue for unshaded surface rendering: the fraction of brightness
+   * lost at the far side of the octree. 0 (the default) turns it off.
+   */
+  vtkSetClampMacro(DepthCue, double, 0.0, 1.0);
+  vtkGetMacro(DepthCue, double);
+  ///@}
+
+  ///@{
+  /**
+   * Trace one ray per ImageSampleDistance x ImageSampleDistance pixels and
+   * stretch the picture over the viewport. 1 (the default) traces every
+   * pixel.
+   */
+  vtkSetClampMacro(ImageSampleDistance, double, 1.0, 32.0);
+  vtkGetMacro(ImageSampleDistance, double);
+  ///@}
+
+  ///@{
+  /**
+   * vtkImageData input: voxels whose value (the largest component) is at or
+   * below this become no point. Default 0.
+   */
+  vtkSetMacro(ImageBackground, double);
+  vtkGetMacro(ImageBackground, double);
+  ///@}
+
+  ///@{
+  /**
+   * Names of the optional per-point arrays read for reflectivity (0..1, the
+   * weight of the mirror ray) and index of refraction (0 = opaque).
+   * Defaults: "Reflectivity" and "Refraction", as vtkParticleTextReader
+   * names them.
+   */
+  vtkSetStringMacro(ReflectivityArrayName);
+  vtkGetStringMacro(ReflectivityArrayName);
+  vtkSetStringMacro(RefractionArrayName);
+  vtkGetStringMacro(RefractionArrayName);
+  ///@}
+
+  ///@{
+  /**
+   * CUDA only: device bytes the engine may hold; past it, an allocation
+   * fails as on a full GPU (and the mapper falls back to the CPU). 0 (the
+   * default): no limit but the device's.
+   */
+  vtkSetMacro(CudaMemoryBudget, vtkIdType);
+  vtkGetMacro(CudaMemoryBudget, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
+   * What the mapper did: full octree builds, in-place updates (only point
+   * positions changed) and traced pictures. A render that changes nothing
+   * redraws the last picture without tracing.
+   */
+  vtkGetMacro(NumberOfBuilds, vtkIdType);
+  vtkGetMacro(NumberOfUpdates, vtkIdType);
+  vtkGetMacro(NumberOfTraces, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
+   * Seconds spent in the last build or update, the engine's last trace, and
+   * the VTK layer's share of the last render: depth read-back, texture
+   * upload and the composite draw.
+   */
+  vtkGetMacro(LastBuildSeconds, double);
+  vtkGetMacro(LastTraceSeconds, double);
+  vtkGetMacro(LastDepthReadSeconds, double);
+  vtkGetMacro(LastUploadSeconds, double);
+  vtkGetMacro(LastDrawSeconds, double);
+  ///@}
+
+  /**
+   * The leaves of the octree built by the last render: one vertex per leaf
+   * at its centre with its averaged colour as 8-bit RGBA ("Colors", the
+   * active scalars) and, when the points carry scalars, their mean
+   * ("Scalars"). Empty before the first render.
+   */
+  void GetLeafVoxels(vtkPolyData* output);
+
+  /**
+   * Side length of a leaf voxel in world coordinates (0 before the first
+   * render).
+   */
+  double GetLeafSize();
+
+  /**
+   * Number of points the current octree holds.
+   */
+  vtkIdType GetNumberOfOctreePoints();
+
+  ///@{
+  /**
+   * The input: a vtkPointSet (e.g. vtkPolyData) or a vtkImageData.
+   * (vtkVolumeMapper's own SetInputData accepts images only.)
+   */
+  using Superclass::SetInputData;
+  void SetInputData(vtkDataSet* input) override;
+  ///@}
+
+  void Render(vtkRenderer* ren, vtkVolume* vol) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+protected:
+  vtkOctreeVolumeMapper();
+  ~vtkOctreeVolumeMapper() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+
+  int RequestedBackend = BACKEND_AUTO;
+  int LeafDepth = 0;
+  double LODPixelThreshold = 0.0;
+  bool Shadows = false;
+  int MaximumBounces = 2;
+  double DepthCue = 0.0;
+  double ImageSampleDistance = 1.0;
+  double ImageBackground = 0.0;
+  char* ReflectivityArrayName = nullptr;
+  char* RefractionArrayName = nullptr;
+  vtkIdType CudaMemoryBudget = 0;
+
+  vtkIdType NumberOfBuilds = 0;
+  vtkIdType NumberOfUpdates = 0;
+  vtkIdType NumberOfTraces = 0;
+  double LastBuildSeconds = 0.0;
+  double LastTraceSeconds = 0.0;
+  double LastDepthReadSeconds = 0.0;
+  double LastUploadSeconds = 0.0;
+  double LastDrawSeconds = 0.0;
+
+private:
+  vtkOctreeVolumeMapper(const vtkOctreeVolumeMapper&) = delete;
+  void operator=(const vtkOctreeVolumeMapper&) = delete;
+
+  int PrepareOctree(vtkDataSet* input, vtkVolumeProperty* property);
+  bool Guarded(const char* what, const std::function<void()>& call);
+  void ReadDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
+    std::vector<float>& depth);
+  void Draw(vtkRenderer* ren, vtkOpenGLRenderWindow* window);
+
+  class vtkInternals;
+  vtkInternals* Internals;
+};
+
+#endif

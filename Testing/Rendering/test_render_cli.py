@@ -1,0 +1,82 @@
+"""python3 -m octoray.render and the mappers from Python (label python, vtk).
+
+Run under xvfb-run by ctest (the renderer opens an offscreen OpenGL window).
+"""
+import os
+import subprocess
+import sys
+
+import vtk
+import octoray
+from vtk.util.numpy_support import vtk_to_numpy
+
+DATA = os.environ.get("OCTORAY_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "Data"))
+PARTICLES = os.path.join(DATA, "Particles", "lidar_simple.particles")
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "octoray.render", *args],
+                          capture_output=True, text=True, timeout=300)
+
+
+def read_png(path):
+    r = vtk.vtkPNGReader()
+    r.SetFileName(path)
+    r.Update()
+    img = r.GetOutput()
+    w, h, _ = img.GetDimensions()
+    return w, h, vtk_to_numpy(img.GetPointData().GetScalars())
+
+
+def test_mappers_are_in_the_package():
+    m = octoray.vtkOctreeVolumeMapper()
+    assert isinstance(m, octoray.vtkOctreeVolumeMapper)
+    expected = octoray.vtkCudaOctreeVolumeMapper if m.IsCudaAvailable() else octoray.vtkCPUOctreeVolumeMapper
+    assert isinstance(m, expected)
+    cpu = octoray.vtkCPUOctreeVolumeMapper()
+    assert cpu.GetRequestedBackend() == cpu.BACKEND_CPU
+    cpu.SetLeafDepth(7)
+    cpu.SetBlendModeToSurface()
+    assert cpu.GetBlendMode() == octoray.vtkOctreeVolumeMapper.SURFACE_BLEND
+    assert "LeafDepth: 7" in str(cpu)
+
+
+def test_render_particles(tmp_path):
+    out = tmp_path / "out.png"
+    r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "160x120", "--mode", "phong",
+            "--azimuth", "30", "--elevation", "20")
+    assert r.returncode == 0, r.stderr
+    for word in ("backend: CPU", "load:", "build:", "render:"):
+        assert word in r.stdout
+    assert "reading" in r.stderr and "100%" in r.stderr  # the progress bar
+    w, h, rgb = read_png(str(out))
+    assert (w, h) == (160, 120)
+    # The cloud covers a real part of the picture (the background is black).
+    covered = (rgb[:, :3].max(axis=1) > 0).sum()
+    assert covered > 0.05 * w * h
+
+
+def test_render_modes_differ(tmp_path):
+    pictures = []
+    for mode in ("surface", "mip"):
+        out = tmp_path / (mode + ".png")
+        r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", mode)
+        assert r.returncode == 0, r.stderr
+        pictures.append(read_png(str(out))[2])
+    assert (pictures[0] != pictures[1]).any()
+
+
+def test_render_dicom_folder(tmp_path):
+    out = tmp_path / "ct.png"
+    r = run(os.path.join(DATA, "DICOM", "CT_small"), "-o", str(out), "--backend", "cpu", "--size", "96x96",
+            "--mode", "mip", "--background", "-5000", "-500")
+    assert r.returncode == 0, r.stderr
+    assert "backend: CPU" in r.stdout
+    assert read_png(str(out))[2][:, :3].max() > 0
+
+
+def test_missing_input_is_an_error(tmp_path):
+    r = run(str(tmp_path / "nothing.particles"), "-o", str(tmp_path / "x.png"))
+    assert r.returncode != 0
+    assert "no such file" in r.stderr
+    assert not (tmp_path / "x.png").exists()
