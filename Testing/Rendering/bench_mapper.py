@@ -11,7 +11,6 @@ bench-results.json.
         Testing/Rendering/bench_mapper.py --json build/bench-results.json
 """
 import argparse
-import json
 import os
 import statistics
 import sys
@@ -24,6 +23,9 @@ from vtk.util import numpy_support
 import octoray
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# The JSON merge shared by the Python benchmarks.
+sys.path.insert(0, os.path.join(HERE, "..", "Python"))
+from bench_readers import merge  # noqa: E402
 DATA = os.environ.get("OCTORAY_DATA", os.path.join(HERE, "..", "..", "Data"))
 
 
@@ -112,21 +114,6 @@ def run(name, data, frames, size, backend):
         dict(name="mapper frame %dx%d/%s" % (size[0], size[1], name), backend=backend_name, n=n, depth=0,
              seconds=med["frame"], peer="", peer_seconds=0.0),
     ]
-
-
-def merge(path, records):
-    existing = []
-    if path and os.path.exists(path):
-        try:
-            with open(path) as f:
-                existing = json.load(f)
-        except ValueError:
-            existing = []
-    key = lambda r: (r.get("name"), r.get("backend"), r.get("n"))  # noqa: E731
-    new = {key(r) for r in records}
-    merged = [r for r in existing if key(r) not in new] + records
-    with open(path, "w") as f:
-        f.write("[\n" + ",\n".join("  " + json.dumps(r) for r in merged) + "\n]\n")
 
 
 def main():
