@@ -22,6 +22,8 @@
 // GDCM before OpenImageIO: OIIO's headers leave <byteswap.h> half-seen for
 // GDCM's byte swapper.
 #include <gdcmImage.h>
+#include <gdcmImageHelper.h>
+#include <gdcmReader.h>
 #include <gdcmImageReader.h>
 
 #include <OpenImageIO/imageio.h>
@@ -814,20 +816,34 @@ int vtkSliceStackReader::RequestInformation(
       this->Fail("DICOM slice '" + files.front() + "' does not exist");
       return 0;
     }
-    gdcm::ImageReader reader;
+    // The header only: reading stops before the pixel data (a damaged
+    // length there must not make the metadata path read gigabytes).
+    gdcm::Reader reader;
     reader.SetFileName(files.front().c_str());
-    if (!reader.Read())
+    bool read = false;
+    try
+    {
+      read = reader.ReadUpToTag(gdcm::Tag(0x7fe0, 0x0010));
+    }
+    catch (const std::exception&)
+    {
+      read = false;
+    }
+    std::vector<unsigned int> d;
+    if (read)
+    {
+      d = gdcm::ImageHelper::GetDimensionsValue(reader.GetFile());
+    }
+    if (!read || d.size() < 2 || d[0] == 0 || d[1] == 0)
     {
       this->Fail(
         "cannot read DICOM slice '" + files.front() + "': not a DICOM image GDCM can decode");
       return 0;
     }
-    const unsigned int* d = reader.GetImage().GetDimensions();
     dims[0] = static_cast<int>(d[0]);
     dims[1] = static_cast<int>(d[1]);
-    dims[2] = files.size() > 1 || reader.GetImage().GetNumberOfDimensions() < 3
-      ? static_cast<int>(files.size())
-      : static_cast<int>(d[2]);
+    dims[2] = files.size() > 1 || d.size() < 3 || d[2] < 1 ? static_cast<int>(files.size())
+                                                           : static_cast<int>(d[2]);
   }
   else
   {
