@@ -7,7 +7,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test demo bench clean
+.PHONY: all deps configure build test test-asan demo bench clean
 
 all: build
 
@@ -22,6 +22,36 @@ build: configure
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE bench
+	$(MAKE) test-asan
+
+# Issue 8: a second build folder with clang, AddressSanitizer and
+# UndefinedBehaviorSanitizer (any report fails: -fno-sanitize-recover=all,
+# LeakSanitizer on at exit) for the project's own code (CPU engine without
+# CUDA, readers, and the mappers where they exist); ParaView's libraries are
+# not instrumented. It runs the C++ tests of the engine, the readers and the
+# reliability tests, and each libFuzzer target for FUZZ_SECONDS. The Python
+# tests are not run here: the interpreter and ParaView's Python modules are
+# not instrumented (ASan would have to be preloaded into python3).
+ASAN_BUILD ?= build-asan
+FUZZ_SECONDS ?= 30
+ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+# Coverage for libFuzzer in the project's code (the readers the fuzz targets
+# call), not only in the targets themselves.
+ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
+ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader \
+  TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader octoray_fuzz_ParticleText \
+  octoray_fuzz_SliceStackMetadata
+test-asan: deps
+	CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DOCTORAY_ENABLE_CUDA=OFF -DOCTORAY_FUZZ_SECONDS=$(FUZZ_SECONDS) \
+	  -DCMAKE_C_FLAGS="$(ASAN_FLAGS)" -DCMAKE_CXX_FLAGS="$(ASAN_CXX_FLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="$(ASAN_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(ASAN_FLAGS)" $(CMAKE_FLAGS)
+	cmake --build $(ASAN_BUILD) -j $(JOBS) --target $(ASAN_TARGETS)
+	cd $(ASAN_BUILD) && \
+	  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
+	  ctest --output-on-failure -j $(JOBS) -L 'engine|vtk|reliability|fuzz'
 
 # The LiDAR tile's reflectivity column is the scanner's intensity (0.3-0.6):
 # taken as mirror weight it would blend every voxel with the empty sky, so

@@ -28,6 +28,9 @@ packages=(
   libgdcm-dev
   # Python tests, rendering without a display
   python3-pytest python3-numpy xvfb
+  # reliability (issue 8): the ASan+UBSan build and the libFuzzer targets
+  # (clang with its sanitizer and fuzzer runtimes; OpenMP for clang)
+  clang-14 libclang-rt-14-dev libomp-14-dev
   # reader benchmarks compare against pandas (pyarrow engine when present)
   python3-pandas
   # independent reference values for the DICOM tests

@@ -43,7 +43,8 @@ public:
     struct stat st;
     if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
     {
-      error = name + ": not a regular file";
+      error = name + (S_ISDIR(st.st_mode) ? ": is a directory, not a file"
+                                          : ": not a regular file");
       ::close(fd);
       return false;
     }
@@ -62,7 +63,8 @@ public:
       // The parse reads front to back; tell the kernel so it reads ahead.
       ::madvise(m, this->MapSize, MADV_SEQUENTIAL);
     }
-    ::close(fd);
+    this->Fd = fd;
+    this->Opened = st;
     if (this->MapSize >= 2 && static_cast<unsigned char>(this->Map[0]) == 0x1f &&
       static_cast<unsigned char>(this->Map[1]) == 0x8b)
     {
@@ -81,8 +83,27 @@ public:
     return true;
   }
 
+  // True when the open file's size or modification time differ from what
+  // they were when it was opened: it was written to while being read.
+  bool ChangedSinceOpen() const
+  {
+    struct stat now;
+    if (this->Fd < 0 || ::fstat(this->Fd, &now) != 0)
+    {
+      return false;
+    }
+    return now.st_size != this->Opened.st_size ||
+      now.st_mtim.tv_sec != this->Opened.st_mtim.tv_sec ||
+      now.st_mtim.tv_nsec != this->Opened.st_mtim.tv_nsec;
+  }
+
   void Close()
   {
+    if (this->Fd >= 0)
+    {
+      ::close(this->Fd);
+    }
+    this->Fd = -1;
     if (this->Map)
     {
       ::munmap(const_cast<char*>(this->Map), this->MapSize);
@@ -161,6 +182,8 @@ private:
   size_t MapSize = 0;
   std::vector<char> Inflated;
   bool Compressed = false;
+  int Fd = -1;
+  struct stat Opened = {};
 };
 } // namespace octoray
 

@@ -1,5 +1,6 @@
 #include "vtkParticleTextReader.h"
 
+#include "octorayParticleTextFormat.h"
 #include "octorayTextSource.h"
 
 #include "vtkCellArray.h"
@@ -27,253 +28,18 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <new>
 #include <sstream>
 #include <thread>
 #include <vector>
+
+#include <sys/stat.h>
 
 vtkStandardNewMacro(vtkParticleTextReader);
 
 namespace
 {
-// Where a column's value goes.
-enum class Sink
-{
-  X,
-  Y,
-  Z,
-  R,
-  G,
-  B,
-  Reflectivity,
-  Refraction,
-  Scalar,
-  Extra
-};
-
-struct Column
-{
-  std::string Name;
-  Sink Target;
-  int Extra; // index into the extra arrays for Sink::Extra
-};
-
-inline bool IsBlank(char c)
-{
-  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
-inline bool EndsToken(char c)
-{
-  return IsBlank(c) || c == ',' || c == '#';
-}
-
-// Powers of ten that are exact in float (up to 1e10) and double (up to 1e22).
-template <typename Real>
-constexpr Real Pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
-  1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22 };
-
-// Numbers as exporters write them (plain decimals such as -123.4567 or 255):
-// when the digits form an integer m that the type holds exactly and 10^k is
-// exact too, m / 10^k is one correctly rounded division (Clinger's fast
-// path), so the result equals from_chars' at a fraction of the cost. Anything
-// else (exponents, long mantissas, inf, nan) goes to std::from_chars, which
-// rejects a leading '+' that printf("%+f") writes.
-template <typename Real>
-inline const char* ParseNumber(const char* p, const char* e, Real& v)
-{
-  {
-    constexpr bool isFloat = std::is_same<Real, float>::value;
-    constexpr uint64_t maxMantissa = isFloat ? (uint64_t(1) << 24) : (uint64_t(1) << 53);
-    constexpr int maxFraction = isFloat ? 10 : 22;
-    const char* q = p;
-    bool negative = false;
-    if (q < e && (*q == '-' || *q == '+'))
-    {
-      negative = *q == '-';
-      ++q;
-    }
-    uint64_t m = 0;
-    int digits = 0, fraction = 0;
-    while (q < e && static_cast<unsigned>(*q - '0') < 10 && digits < 19)
-    {
-      m = m * 10 + static_cast<unsigned>(*q - '0');
-      ++q;
-      ++digits;
-    }
-    if (q < e && *q == '.')
-    {
-      ++q;
-      while (q < e && static_cast<unsigned>(*q - '0') < 10 && digits < 19)
-      {
-        m = m * 10 + static_cast<unsigned>(*q - '0');
-        ++q;
-        ++digits;
-        ++fraction;
-      }
-    }
-    if (digits > 0 && (q == e || EndsToken(*q)) && m <= maxMantissa && fraction <= maxFraction)
-    {
-      const Real r = static_cast<Real>(m) / Pow10<Real>[fraction];
-      v = negative ? -r : r;
-      return q;
-    }
-  }
-  if (p < e && *p == '+')
-  {
-    ++p;
-    if (p < e && (*p == '-' || *p == '+'))
-    {
-      return nullptr;
-    }
-  }
-  auto r = std::from_chars(p, e, v, std::chars_format::general);
-  if (r.ec != std::errc() || (r.ptr < e && !EndsToken(*r.ptr)))
-  {
-    return nullptr;
-  }
-  return r.ptr;
-}
-
-std::string TokenAt(const char* p, const char* e)
-{
-  const char* q = p;
-  while (q < e && !EndsToken(*q))
-  {
-    ++q;
-  }
-  std::string t(p, q);
-  if (t.size() > 40)
-  {
-    t = t.substr(0, 37) + "...";
-  }
-  return t;
-}
-
-// Splits a line into tokens (no number parsing); used for the header and
-// the first data line only.
-std::vector<std::pair<std::string, int>> SplitTokens(const char* b, const char* e)
-{
-  std::vector<std::pair<std::string, int>> tokens;
-  const char* p = b;
-  while (p < e)
-  {
-    while (p < e && (IsBlank(*p) || *p == ','))
-    {
-      ++p;
-    }
-    if (p >= e || *p == '#')
-    {
-      break;
-    }
-    const char* q = p;
-    while (q < e && !EndsToken(*q))
-    {
-      ++q;
-    }
-    tokens.emplace_back(std::string(p, q), static_cast<int>(p - b) + 1);
-    p = q;
-  }
-  return tokens;
-}
-
-std::string Lower(std::string s)
-{
-  for (char& c : s)
-  {
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  return s;
-}
-
-bool IsNumber(const std::string& s)
-{
-  double v;
-  return ParseNumber(s.data(), s.data() + s.size(), v) != nullptr;
-}
-
-// Maps header names to sinks; false when x, y or z is missing or a name repeats.
-bool LayoutFromNames(const std::vector<std::string>& names, std::vector<Column>& columns,
-  std::vector<std::string>& extras, std::string& why)
-{
-  columns.clear();
-  extras.clear();
-  bool seen[static_cast<int>(Sink::Extra)] = {};
-  for (const auto& original : names)
-  {
-    std::string n = Lower(original);
-    Sink s = Sink::Extra;
-    if (n == "x")
-      s = Sink::X;
-    else if (n == "y")
-      s = Sink::Y;
-    else if (n == "z")
-      s = Sink::Z;
-    else if (n == "r" || n == "red")
-      s = Sink::R;
-    else if (n == "g" || n == "green")
-      s = Sink::G;
-    else if (n == "b" || n == "blue")
-      s = Sink::B;
-    else if (n == "reflectivity")
-      s = Sink::Reflectivity;
-    else if (n == "refraction")
-      s = Sink::Refraction;
-    else if (n == "scalar" || n == "scalars")
-      s = Sink::Scalar;
-    if (s != Sink::Extra)
-    {
-      if (seen[static_cast<int>(s)])
-      {
-        why = "column '" + original + "' is named twice";
-        return false;
-      }
-      seen[static_cast<int>(s)] = true;
-      columns.push_back({ original, s, -1 });
-    }
-    else
-    {
-      if (std::find(extras.begin(), extras.end(), original) != extras.end())
-      {
-        why = "column '" + original + "' is named twice";
-        return false;
-      }
-      columns.push_back({ original, s, static_cast<int>(extras.size()) });
-      extras.push_back(original);
-    }
-  }
-  if (!seen[0] || !seen[1] || !seen[2])
-  {
-    why = "the header must name the columns x, y and z";
-    return false;
-  }
-  const int rgb = seen[3] + seen[4] + seen[5];
-  if (rgb != 0 && rgb != 3)
-  {
-    why = "the header names some but not all of the colour columns r, g, b";
-    return false;
-  }
-  return true;
-}
-
-bool LayoutFromCount(size_t n, std::vector<Column>& columns)
-{
-  static const char* names8[] = { "x", "y", "z", "r", "g", "b", "reflectivity", "refraction" };
-  std::vector<std::string> names;
-  if (n == 3 || n == 6 || n == 8)
-  {
-    names.assign(names8, names8 + n);
-  }
-  else if (n == 4)
-  {
-    names = { "x", "y", "z", "scalar" };
-  }
-  else
-  {
-    return false;
-  }
-  std::vector<std::string> extras;
-  std::string why;
-  return LayoutFromNames(names, columns, extras, why);
-}
+using namespace octoray::ptext;
 
 template <typename Real>
 struct Sinks
@@ -386,24 +152,77 @@ int vtkParticleTextReader::RequestData(
     this->Fail("no file name was set");
     return 0;
   }
+  // A failed update leaves the output of the last successful one (or an
+  // empty one) in place, never a half-read file: the pipeline has already
+  // emptied the output, so the kept copy is put back.
+  auto restore = [&]() {
+    if (this->LastOutput)
+    {
+      output->ShallowCopy(this->LastOutput);
+    }
+    else
+    {
+      output->Initialize();
+    }
+  };
   octoray::TextSource source;
   std::string error;
   if (!source.Open(this->FileName, error))
   {
     this->Fail(error);
+    restore();
     return 0;
   }
   this->UpdateProgress(0.0);
-  const bool ok = this->OutputPointsPrecision == DOUBLE_PRECISION
-    ? this->Parse<double>(source.Data(), source.Size(), output)
-    : this->Parse<float>(source.Data(), source.Size(), output);
+  auto fresh = vtkSmartPointer<vtkPolyData>::New();
+  bool ok = false;
+  try
+  {
+    ok = this->OutputPointsPrecision == DOUBLE_PRECISION
+      ? this->Parse<double>(source.Data(), source.Size(), fresh)
+      : this->Parse<float>(source.Data(), source.Size(), fresh);
+  }
+  catch (const std::bad_alloc&)
+  {
+    this->Fail(std::string(this->FileName) + ": out of memory while reading " +
+      std::to_string(source.Size()) + " bytes");
+    ok = false;
+  }
+  if (ok && source.ChangedSinceOpen())
+  {
+    this->Fail(std::string(this->FileName) +
+      ": the file changed while it was being read; nothing was read (read it again)");
+    ok = false;
+  }
   if (!ok)
   {
-    output->Initialize();
+    restore();
     return 0;
   }
+  output->ShallowCopy(fresh);
+  this->LastOutput = fresh;
   this->UpdateProgress(1.0);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+vtkMTimeType vtkParticleTextReader::GetMTime()
+{
+  const vtkMTimeType own = this->Superclass::GetMTime();
+  std::string signature;
+  struct stat st;
+  if (this->FileName && ::stat(this->FileName, &st) == 0)
+  {
+    signature = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino) + ":" +
+      std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
+      std::to_string(st.st_mtim.tv_nsec);
+  }
+  if (signature != this->FileSignature)
+  {
+    this->FileSignature = signature;
+    this->FileChangeTime.Modified();
+  }
+  return std::max(own, this->FileChangeTime.GetMTime());
 }
 
 //------------------------------------------------------------------------------
@@ -421,83 +240,19 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
 
   // Serial prologue: comments, the optional header, and the first data line,
   // whose column count gives the layout when there is no header.
-  std::vector<Column> columns;
-  std::vector<std::string> extras;
-  bool haveHeader = false;
-  vtkIdType lineNo = 0;
-  const char* p = data;
-  const char* firstData = nullptr;
-  vtkIdType firstDataLine = 0;
-  while (p < end)
+  Prologue pro = ParsePrologue(data, size, file);
+  this->ColumnNames = pro.Layout;
+  if (!pro.Ok)
   {
-    const char* nl = static_cast<const char*>(std::memchr(p, '\n', end - p));
-    const char* e = nl ? nl : end;
-    ++lineNo;
-    const char* q = p;
-    while (q < e && IsBlank(*q))
-    {
-      ++q;
-    }
-    if (q < e)
-    {
-      const bool comment = *q == '#';
-      auto tokens = comment ? SplitTokens(q + 1, e) : SplitTokens(q, e);
-      bool allNames = !tokens.empty() &&
-        std::none_of(tokens.begin(), tokens.end(), [](auto& t) { return IsNumber(t.first); });
-      std::vector<std::string> names;
-      for (auto& t : tokens)
-      {
-        names.push_back(t.first);
-      }
-      auto named = [&](const char* want) {
-        return std::any_of(
-          names.begin(), names.end(), [&](const std::string& n) { return Lower(n) == want; });
-      };
-      const bool namesXYZ = allNames && named("x") && named("y") && named("z");
-      if (!haveHeader && namesXYZ)
-      {
-        std::string why;
-        if (!LayoutFromNames(names, columns, extras, why))
-        {
-          this->Fail(file + ":" + std::to_string(lineNo) + ":1: bad header line: " + why);
-          return false;
-        }
-        haveHeader = true;
-      }
-      else if (!comment)
-      {
-        firstData = p;
-        firstDataLine = lineNo;
-        if (!haveHeader)
-        {
-          if (!LayoutFromCount(tokens.size(), columns))
-          {
-            this->Fail(file + ":" + std::to_string(lineNo) + ":1: expected 3 (x y z), 4 (x y z "
-                "scalar), 6 (x y z r g b) or 8 (x y z r g b reflectivity refraction) columns, "
-                "found " + std::to_string(tokens.size()) +
-              "; a header line such as '# x y z intensity' names other layouts");
-            return false;
-          }
-        }
-        break;
-      }
-    }
-    p = nl ? nl + 1 : end;
-  }
-  const int ncols = static_cast<int>(columns.size());
-  std::string layout;
-  for (const auto& c : columns)
-  {
-    layout += (layout.empty() ? "" : " ") + c.Name;
-  }
-  this->ColumnNames = layout;
-  if (!firstData)
-  {
-    this->Fail(file + ":" + std::to_string(lineNo) + ":1: no particle lines in the file (only " +
-      (haveHeader ? "a header, " : "") + "comments or blank lines); expected lines of " +
-      (haveHeader ? layout : std::string("x y z ...")));
+    this->Fail(pro.Error);
     return false;
   }
+  const std::vector<Column>& columns = pro.Columns;
+  const std::vector<std::string>& extras = pro.Extras;
+  const std::string& layout = pro.Layout;
+  const int ncols = static_cast<int>(columns.size());
+  const char* const firstData = data + pro.FirstData;
+  const vtkIdType firstDataLine = static_cast<vtkIdType>(pro.FirstDataLine);
 
   // Chunks start at line starts; each is about 1 MB, at least 8 per thread
   // so that threads that finish early pick up more.
@@ -506,20 +261,35 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   threads = std::max(1, threads);
   const size_t dataBytes = static_cast<size_t>(end - firstData);
   size_t chunkBytes = std::max<size_t>(1 << 20, dataBytes / (static_cast<size_t>(threads) * 8) + 1);
+  // Chunk boundaries: the first newline at or after each chunk's nominal
+  // end, looked for one chunk length at a time so that a file with few or no
+  // newlines (binary data, a huge sparse file) is still walked with progress
+  // and can be aborted.
   std::vector<const char*> starts{ firstData };
-  while (true)
+  std::atomic<bool> aborted{ false };
+  for (const char* s = firstData + chunkBytes; s < end;)
   {
-    const char* s = starts.back() + chunkBytes;
-    if (s >= end)
+    const char* lim = s + std::min<size_t>(chunkBytes, static_cast<size_t>(end - s));
+    const char* nl = static_cast<const char*>(std::memchr(s, '\n', lim - s));
+    if (nl)
     {
+      if (nl + 1 >= end)
+      {
+        break;
+      }
+      starts.push_back(nl + 1);
+      s = nl + 1 + chunkBytes;
+    }
+    else
+    {
+      s = lim;
+    }
+    this->UpdateProgress(0.05 * static_cast<double>(s - data) / static_cast<double>(size));
+    if (this->GetAbortExecute())
+    {
+      aborted = true;
       break;
     }
-    const char* nl = static_cast<const char*>(std::memchr(s, '\n', end - s));
-    if (!nl || nl + 1 >= end)
-    {
-      break;
-    }
-    starts.push_back(nl + 1);
   }
   const int nchunks = static_cast<int>(starts.size());
   starts.push_back(end);
@@ -535,21 +305,49 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
       const char* ce = starts[c + 1];
       while (s < ce)
       {
-        const char* nl = static_cast<const char*>(std::memchr(s, '\n', ce - s));
-        const char* e = nl ? nl : ce;
-        ++r.Lines;
-        while (s < e && IsBlank(*s))
+        if (aborted)
         {
-          ++s;
+          return;
         }
-        if (s < e && *s != '#')
+        // Whether the line holds data is decided by its first non-blank
+        // byte; its end is then looked for at most 16 MB at a time, so that
+        // an abort is seen soon even in a line of gigabytes.
+        ++r.Lines;
+        const char* q = s;
+        while (q < ce && *q != '\n' && IsBlank(*q))
+        {
+          ++q;
+        }
+        if (q < ce && *q != '\n' && *q != '#')
         {
           ++r.DataLines;
+        }
+        const char* nl = nullptr;
+        while (q < ce && !aborted)
+        {
+          const size_t look = std::min<size_t>(static_cast<size_t>(ce - q), size_t(1) << 24);
+          nl = static_cast<const char*>(std::memchr(q, '\n', look));
+          if (nl)
+          {
+            break;
+          }
+          q += look;
         }
         s = nl ? nl + 1 : ce;
       }
     },
-    [&](int done) { this->UpdateProgress(0.1 * done / nchunks); });
+    [&](int done) {
+      this->UpdateProgress(0.05 + 0.05 * done / nchunks);
+      if (this->GetAbortExecute())
+      {
+        aborted = true;
+      }
+    });
+  if (aborted)
+  {
+    this->Fail(file + ": reading was aborted");
+    return false;
+  }
   vtkIdType total = 0;
   vtkIdType line = firstDataLine;
   for (auto& r : results)
@@ -612,6 +410,25 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
     extraArrays.push_back(makeArray(name.c_str(), 1));
     sinks.Extras.push_back(extraArrays.back()->GetPointer(0));
   }
+  // A file of billions of short lines can ask for more memory than there
+  // is: say so instead of writing through a null pointer.
+  bool allocated = pointsArray->GetNumberOfTuples() == total &&
+    (!colors || colors->GetNumberOfTuples() == total);
+  for (RealArray* a : { refl.Get(), refr.Get(), scalars.Get() })
+  {
+    allocated = allocated && (!a || a->GetNumberOfTuples() == total);
+  }
+  for (auto& a : extraArrays)
+  {
+    allocated = allocated && a->GetNumberOfTuples() == total;
+  }
+  if (!allocated)
+  {
+    this->Fail(file + ": cannot allocate memory for " + std::to_string(total) + " particles of " +
+      std::to_string(ncols) + " columns (" +
+      std::to_string(static_cast<double>(total) * ncols * sizeof(Real) / (1 << 20)) + " MiB)");
+    return false;
+  }
   std::vector<unsigned char> valid;
   if (this->Lenient)
   {
@@ -624,7 +441,6 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   const bool lenient = this->Lenient;
   const size_t keep = static_cast<size_t>(this->MaximumReportedLines);
   std::atomic<int> firstFailedChunk{ std::numeric_limits<int>::max() };
-  std::atomic<bool> aborted{ false };
   ParallelChunks(
     nchunks, threads,
     [&](int c) {

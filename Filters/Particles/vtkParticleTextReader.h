@@ -45,6 +45,7 @@
 
 #include "octorayFiltersParticlesModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
+#include "vtkSmartPointer.h" // for vtkSmartPointer
 
 #include <string> // for std::string
 
@@ -105,6 +106,10 @@ public:
   /// Numeric column layout found by the last update, e.g. "x y z r g b".
   const char* GetColumnNames() { return this->ColumnNames.c_str(); }
 
+  /// Includes the file's modification time, size and inode: when the file
+  /// changes on disk, the next Update() reads it again.
+  vtkMTimeType GetMTime() override;
+
 protected:
   vtkParticleTextReader();
   ~vtkParticleTextReader() override;
@@ -120,6 +125,12 @@ protected:
   vtkIdType NumberOfSkippedLines = 0;
   std::string ErrorMessage;
   std::string ColumnNames;
+  // What the file looked like when GetMTime() last looked, and when that
+  // changed; the output of the last successful update, which a failed
+  // update leaves in place.
+  std::string FileSignature;
+  vtkTimeStamp FileChangeTime;
+  vtkSmartPointer<vtkPolyData> LastOutput;
 
 private:
   vtkParticleTextReader(const vtkParticleTextReader&) = delete;

@@ -22,6 +22,8 @@
 // GDCM before OpenImageIO: OIIO's headers leave <byteswap.h> half-seen for
 // GDCM's byte swapper.
 #include <gdcmImage.h>
+#include <gdcmImageHelper.h>
+#include <gdcmReader.h>
 #include <gdcmImageReader.h>
 
 #include <OpenImageIO/imageio.h>
@@ -34,6 +36,8 @@
 #include <fstream>
 #include <numeric>
 #include <sstream>
+
+#include <sys/stat.h>
 
 vtkStandardNewMacro(vtkSliceStackReader);
 
@@ -257,6 +261,39 @@ void Extract(const T* data, int comps, const Selection& sel, const double bg[2],
     verts->SetData(offsets, conn);
     output->SetVerts(verts);
   }
+}
+
+// Names, inodes, sizes and modification times of the inputs: a change on
+// disk changes the reader's MTime, so the next Update() reads again.
+std::string FilesSignature(const char* directory, const std::vector<std::string>& names,
+  const std::vector<std::string>& slices)
+{
+  std::string signature;
+  auto add = [&](const std::string& name) {
+    struct stat st;
+    if (::stat(name.c_str(), &st) == 0)
+    {
+      signature += name + ":" + std::to_string(st.st_ino) + ":" + std::to_string(st.st_size) +
+        ":" + std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec) + ";";
+    }
+    else
+    {
+      signature += name + ":-;";
+    }
+  };
+  if (directory && *directory)
+  {
+    add(directory);
+  }
+  for (const auto& f : names)
+  {
+    add(f);
+  }
+  for (const auto& f : slices)
+  {
+    add(f.substr(0, f.rfind('#') == std::string::npos ? f.size() : f.rfind('#')));
+  }
+  return signature;
 }
 } // namespace
 
@@ -760,6 +797,15 @@ int vtkSliceStackReader::RequestInformation(
   {
     return 0;
   }
+  for (const auto& f : files)
+  {
+    std::error_code ec;
+    if (fs::is_directory(f, ec))
+    {
+      this->Fail("slice '" + f + "' is a directory, not an image file");
+      return 0;
+    }
+  }
   int dims[3] = { 0, 0, 0 };
   const bool dicom = IsDICOMFile(files.front());
   if (dicom)
@@ -770,20 +816,34 @@ int vtkSliceStackReader::RequestInformation(
       this->Fail("DICOM slice '" + files.front() + "' does not exist");
       return 0;
     }
-    gdcm::ImageReader reader;
+    // The header only: reading stops before the pixel data (a damaged
+    // length there must not make the metadata path read gigabytes).
+    gdcm::Reader reader;
     reader.SetFileName(files.front().c_str());
-    if (!reader.Read())
+    bool read = false;
+    try
+    {
+      read = reader.ReadUpToTag(gdcm::Tag(0x7fe0, 0x0010));
+    }
+    catch (const std::exception&)
+    {
+      read = false;
+    }
+    std::vector<unsigned int> d;
+    if (read)
+    {
+      d = gdcm::ImageHelper::GetDimensionsValue(reader.GetFile());
+    }
+    if (!read || d.size() < 2 || d[0] == 0 || d[1] == 0)
     {
       this->Fail(
         "cannot read DICOM slice '" + files.front() + "': not a DICOM image GDCM can decode");
       return 0;
     }
-    const unsigned int* d = reader.GetImage().GetDimensions();
     dims[0] = static_cast<int>(d[0]);
     dims[1] = static_cast<int>(d[1]);
-    dims[2] = files.size() > 1 || reader.GetImage().GetNumberOfDimensions() < 3
-      ? static_cast<int>(files.size())
-      : static_cast<int>(d[2]);
+    dims[2] = files.size() > 1 || d.size() < 3 || d[2] < 1 ? static_cast<int>(files.size())
+                                                           : static_cast<int>(d[2]);
   }
   else
   {
@@ -865,10 +925,39 @@ int vtkSliceStackReader::RequestData(
   output->Initialize();
   image->Initialize();
 
+  // A failed update puts back the outputs of the last successful one (or
+  // leaves them empty): the pipeline has already emptied them, and a failure
+  // half-way must not leave a half-read stack.
+  auto fail = [&]() {
+    if (this->LastOutput)
+    {
+      output->ShallowCopy(this->LastOutput);
+      image->ShallowCopy(this->LastImage);
+      this->SliceFiles = this->LastSliceFiles;
+      this->IsDICOM = this->LastIsDICOM;
+    }
+    else
+    {
+      output->Initialize();
+      image->Initialize();
+      this->SliceFiles.clear();
+      this->IsDICOM = false;
+    }
+    return 0;
+  };
   std::vector<std::string> files;
   if (!this->CollectFiles(files))
   {
-    return 0;
+    return fail();
+  }
+  for (const auto& f : files)
+  {
+    std::error_code ec;
+    if (fs::is_directory(f, ec))
+    {
+      this->Fail("slice '" + f + "' is a directory, not an image file");
+      return fail();
+    }
   }
   size_t dicom = 0;
   for (const auto& f : files)
@@ -878,19 +967,56 @@ int vtkSliceStackReader::RequestData(
   if (dicom && dicom != files.size())
   {
     this->Fail("the slices mix DICOM and other image files (e.g. '" + files.front() + "')");
-    return 0;
+    return fail();
   }
   this->IsDICOM = dicom > 0;
   this->UpdateProgress(0.0);
-  const bool ok = this->IsDICOM ? this->ReadDICOM(files, image) : this->ReadPictures(files, image);
+  auto freshImage = vtkSmartPointer<vtkImageData>::New();
+  auto fresh = vtkSmartPointer<vtkPolyData>::New();
+  bool ok = false;
+  try
+  {
+    ok = this->IsDICOM ? this->ReadDICOM(files, freshImage) : this->ReadPictures(files, freshImage);
+    if (ok)
+    {
+      this->MakeParticles(freshImage, fresh);
+    }
+  }
+  catch (const std::exception& e)
+  {
+    this->Fail(std::string("reading the slices failed: ") + e.what() + " (first slice '" +
+      files.front() + "')");
+    ok = false;
+  }
   if (!ok)
   {
-    image->Initialize();
-    return 0;
+    return fail();
   }
-  this->MakeParticles(image, output);
+  output->ShallowCopy(fresh);
+  image->ShallowCopy(freshImage);
+  this->LastOutput = fresh;
+  this->LastImage = freshImage;
+  this->LastSliceFiles = this->SliceFiles;
+  this->LastIsDICOM = this->IsDICOM;
+  // The slices just read are part of the signature from now on; that is not
+  // a change on disk.
+  this->FileSignature = FilesSignature(this->DirectoryName, this->FileNames, this->SliceFiles);
   this->UpdateProgress(1.0);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+vtkMTimeType vtkSliceStackReader::GetMTime()
+{
+  const vtkMTimeType own = this->Superclass::GetMTime();
+  const std::string signature =
+    FilesSignature(this->DirectoryName, this->FileNames, this->SliceFiles);
+  if (signature != this->FileSignature)
+  {
+    this->FileSignature = signature;
+    this->FileChangeTime.Modified();
+  }
+  return std::max(own, this->FileChangeTime.GetMTime());
 }
 
 //------------------------------------------------------------------------------

@@ -40,6 +40,7 @@
 
 #include "octorayFiltersParticlesModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
+#include "vtkSmartPointer.h" // for vtkSmartPointer
 
 #include <string> // for std::string
 #include <vector> // for std::vector
@@ -124,6 +125,11 @@ public:
   int GetNumberOfSlices() const { return static_cast<int>(this->SliceFiles.size()); }
   const char* GetSliceFileName(int k) const;
 
+  /// Includes the modification times and sizes of the slice files (and of
+  /// the directory): when a slice changes on disk, the next Update() reads
+  /// the stack again.
+  vtkMTimeType GetMTime() override;
+
   /// True when the last update read a DICOM series.
   vtkGetMacro(IsDICOM, bool);
 
@@ -149,6 +155,15 @@ protected:
   bool IsDICOM = false;
   std::string ErrorMessage;
   std::vector<std::string> SliceFiles;
+  // The files' signature when GetMTime() last looked and when it changed;
+  // the outputs of the last successful update, which a failed update leaves
+  // in place (never a half-read stack).
+  std::string FileSignature;
+  vtkTimeStamp FileChangeTime;
+  vtkSmartPointer<vtkPolyData> LastOutput;
+  vtkSmartPointer<vtkImageData> LastImage;
+  std::vector<std::string> LastSliceFiles;
+  bool LastIsDICOM = false;
 
 private:
   vtkSliceStackReader(const vtkSliceStackReader&) = delete;

@@ -1,0 +1,408 @@
+// The particle text format without VTK: tokens, numbers, the column layout
+// from a header line or a column count, and the prologue (comments, header,
+// first data line) of a file. vtkParticleTextReader parses with these, and
+// the fuzz targets in Testing/Fuzz call them directly (no VTK needed).
+// Private to the module; not wrapped.
+#ifndef octorayParticleTextFormat_h
+#define octorayParticleTextFormat_h
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace octoray
+{
+namespace ptext
+{
+// Where a column's value goes.
+enum class Sink
+{
+  X,
+  Y,
+  Z,
+  R,
+  G,
+  B,
+  Reflectivity,
+  Refraction,
+  Scalar,
+  Extra
+};
+
+struct Column
+{
+  std::string Name;
+  Sink Target;
+  int Extra; // index into the extra arrays for Sink::Extra
+};
+
+inline bool IsBlank(char c)
+{
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+inline bool EndsToken(char c)
+{
+  return IsBlank(c) || c == ',' || c == '#';
+}
+
+// Powers of ten that are exact in float (up to 1e10) and double (up to 1e22).
+template <typename Real>
+inline constexpr Real Pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
+  1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22 };
+
+// Numbers as exporters write them (plain decimals such as -123.4567 or 255):
+// when the digits form an integer m that the type holds exactly and 10^k is
+// exact too, m / 10^k is one correctly rounded division (Clinger's fast
+// path), so the result equals from_chars' at a fraction of the cost. Anything
+// else (exponents, long mantissas, inf, nan) goes to std::from_chars, which
+// rejects a leading '+' that printf("%+f") writes.
+template <typename Real>
+inline const char* ParseNumber(const char* p, const char* e, Real& v)
+{
+  {
+    constexpr bool isFloat = std::is_same<Real, float>::value;
+    constexpr uint64_t maxMantissa = isFloat ? (uint64_t(1) << 24) : (uint64_t(1) << 53);
+    constexpr int maxFraction = isFloat ? 10 : 22;
+    const char* q = p;
+    bool negative = false;
+    if (q < e && (*q == '-' || *q == '+'))
+    {
+      negative = *q == '-';
+      ++q;
+    }
+    uint64_t m = 0;
+    int digits = 0, fraction = 0;
+    while (q < e && static_cast<unsigned>(*q - '0') < 10 && digits < 19)
+    {
+      m = m * 10 + static_cast<unsigned>(*q - '0');
+      ++q;
+      ++digits;
+    }
+    if (q < e && *q == '.')
+    {
+      ++q;
+      while (q < e && static_cast<unsigned>(*q - '0') < 10 && digits < 19)
+      {
+        m = m * 10 + static_cast<unsigned>(*q - '0');
+        ++q;
+        ++digits;
+        ++fraction;
+      }
+    }
+    if (digits > 0 && (q == e || EndsToken(*q)) && m <= maxMantissa && fraction <= maxFraction)
+    {
+      const Real r = static_cast<Real>(m) / Pow10<Real>[fraction];
+      v = negative ? -r : r;
+      return q;
+    }
+  }
+  if (p < e && *p == '+')
+  {
+    ++p;
+    if (p < e && (*p == '-' || *p == '+'))
+    {
+      return nullptr;
+    }
+  }
+  auto r = std::from_chars(p, e, v, std::chars_format::general);
+  if (r.ec != std::errc() || (r.ptr < e && !EndsToken(*r.ptr)))
+  {
+    return nullptr;
+  }
+  return r.ptr;
+}
+
+// The token at p for an error message: at most 40 characters (longer ones
+// end in "..."), and bytes that are not printable ASCII written as \xNN, so
+// that binary garbage gives a readable, bounded message. Looks at no more
+// than 41 bytes, whatever the token's length (a 10 GB line of NUL bytes).
+inline std::string TokenAt(const char* p, const char* e)
+{
+  const char* q = p;
+  while (q < e && q - p <= 40 && !EndsToken(*q))
+  {
+    ++q;
+  }
+  const bool cut = q - p > 40;
+  if (cut)
+  {
+    q = p + 37;
+  }
+  std::string t;
+  for (const char* c = p; c < q; ++c)
+  {
+    const unsigned char u = static_cast<unsigned char>(*c);
+    if (u >= 0x20 && u < 0x7f)
+    {
+      t += *c;
+    }
+    else
+    {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\x%02x", u);
+      t += buf;
+    }
+  }
+  if (cut)
+  {
+    t += "...";
+  }
+  return t;
+}
+
+// Splits a line into tokens (no number parsing); used for the header and
+// the first data line only.
+inline std::vector<std::pair<std::string, int>> SplitTokens(const char* b, const char* e)
+{
+  std::vector<std::pair<std::string, int>> tokens;
+  const char* p = b;
+  while (p < e)
+  {
+    while (p < e && (IsBlank(*p) || *p == ','))
+    {
+      ++p;
+    }
+    if (p >= e || *p == '#')
+    {
+      break;
+    }
+    const char* q = p;
+    while (q < e && !EndsToken(*q))
+    {
+      ++q;
+    }
+    tokens.emplace_back(std::string(p, q), static_cast<int>(p - b) + 1);
+    p = q;
+  }
+  return tokens;
+}
+
+inline std::string Lower(std::string s)
+{
+  for (char& c : s)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return s;
+}
+
+inline bool IsNumber(const std::string& s)
+{
+  double v;
+  return ParseNumber(s.data(), s.data() + s.size(), v) != nullptr;
+}
+
+// Maps header names to sinks; false when x, y or z is missing or a name repeats.
+inline bool LayoutFromNames(const std::vector<std::string>& names, std::vector<Column>& columns,
+  std::vector<std::string>& extras, std::string& why)
+{
+  columns.clear();
+  extras.clear();
+  bool seen[static_cast<int>(Sink::Extra)] = {};
+  for (const auto& original : names)
+  {
+    std::string n = Lower(original);
+    Sink s = Sink::Extra;
+    if (n == "x")
+      s = Sink::X;
+    else if (n == "y")
+      s = Sink::Y;
+    else if (n == "z")
+      s = Sink::Z;
+    else if (n == "r" || n == "red")
+      s = Sink::R;
+    else if (n == "g" || n == "green")
+      s = Sink::G;
+    else if (n == "b" || n == "blue")
+      s = Sink::B;
+    else if (n == "reflectivity")
+      s = Sink::Reflectivity;
+    else if (n == "refraction")
+      s = Sink::Refraction;
+    else if (n == "scalar" || n == "scalars")
+      s = Sink::Scalar;
+    if (s != Sink::Extra)
+    {
+      if (seen[static_cast<int>(s)])
+      {
+        why = "column '" + original + "' is named twice";
+        return false;
+      }
+      seen[static_cast<int>(s)] = true;
+      columns.push_back({ original, s, -1 });
+    }
+    else
+    {
+      if (std::find(extras.begin(), extras.end(), original) != extras.end())
+      {
+        why = "column '" + original + "' is named twice";
+        return false;
+      }
+      columns.push_back({ original, s, static_cast<int>(extras.size()) });
+      extras.push_back(original);
+    }
+  }
+  if (!seen[0] || !seen[1] || !seen[2])
+  {
+    why = "the header must name the columns x, y and z";
+    return false;
+  }
+  const int rgb = seen[3] + seen[4] + seen[5];
+  if (rgb != 0 && rgb != 3)
+  {
+    why = "the header names some but not all of the colour columns r, g, b";
+    return false;
+  }
+  return true;
+}
+
+inline bool LayoutFromCount(size_t n, std::vector<Column>& columns)
+{
+  static const char* names8[] = { "x", "y", "z", "r", "g", "b", "reflectivity", "refraction" };
+  std::vector<std::string> names;
+  if (n == 3 || n == 6 || n == 8)
+  {
+    names.assign(names8, names8 + n);
+  }
+  else if (n == 4)
+  {
+    names = { "x", "y", "z", "scalar" };
+  }
+  else
+  {
+    return false;
+  }
+  std::vector<std::string> extras;
+  std::string why;
+  return LayoutFromNames(names, columns, extras, why);
+}
+
+// The prologue of a particle text file: comment lines, the optional header
+// line, and the first data line (whose column count gives the layout when
+// there is no header). Errors name file, line and column like the reader's.
+struct Prologue
+{
+  bool Ok = false;
+  std::string Error;
+  std::vector<Column> Columns;
+  std::vector<std::string> Extras;
+  std::string Layout; // the column names, space separated
+  bool HaveHeader = false;
+  size_t FirstData = 0;        // byte offset of the first data line
+  long long FirstDataLine = 0; // its 1-based line number
+};
+
+// Longest header or first data line accepted: far more than any real layout
+// needs, and it keeps the serial prologue from walking a huge binary file.
+constexpr size_t MaxPrologueLine = size_t(1) << 20;
+
+inline Prologue ParsePrologue(const char* data, size_t size, const std::string& file)
+{
+  Prologue r;
+  const char* const end = data + size;
+  long long lineNo = 0;
+  const char* p = data;
+  bool found = false;
+  auto where = [&](long long line, long long col) {
+    return file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": ";
+  };
+  while (p < end)
+  {
+    const size_t look = std::min<size_t>(static_cast<size_t>(end - p), MaxPrologueLine + 1);
+    const char* nl = static_cast<const char*>(std::memchr(p, '\n', look));
+    ++lineNo;
+    if (!nl && look > MaxPrologueLine)
+    {
+      r.Error = where(lineNo, 1) + "line " + std::to_string(lineNo) +
+        " is longer than " + std::to_string(MaxPrologueLine) +
+        " bytes before any particle was read; not a particle text file";
+      return r;
+    }
+    const char* e = nl ? nl : end;
+    // A particle text file holds no NUL bytes: say so rather than report a
+    // bad number in what is a binary file.
+    if (const void* z = std::memchr(p, '\0', static_cast<size_t>(e - p)))
+    {
+      r.Error = where(lineNo, static_cast<const char*>(z) - p + 1) +
+        "a NUL byte (at byte offset " + std::to_string(static_cast<const char*>(z) - data) +
+        "): this is a binary file, not particle text";
+      return r;
+    }
+    const char* q = p;
+    while (q < e && IsBlank(*q))
+    {
+      ++q;
+    }
+    if (q < e)
+    {
+      const bool comment = *q == '#';
+      auto tokens = comment ? SplitTokens(q + 1, e) : SplitTokens(q, e);
+      const bool allNames = !tokens.empty() &&
+        std::none_of(tokens.begin(), tokens.end(), [](auto& t) { return IsNumber(t.first); });
+      std::vector<std::string> names;
+      for (auto& t : tokens)
+      {
+        names.push_back(t.first);
+      }
+      auto named = [&](const char* want) {
+        return std::any_of(
+          names.begin(), names.end(), [&](const std::string& n) { return Lower(n) == want; });
+      };
+      const bool namesXYZ = allNames && named("x") && named("y") && named("z");
+      if (!r.HaveHeader && namesXYZ)
+      {
+        std::string why;
+        if (!LayoutFromNames(names, r.Columns, r.Extras, why))
+        {
+          r.Error = where(lineNo, 1) + "bad header line: " + why;
+          return r;
+        }
+        r.HaveHeader = true;
+      }
+      else if (!comment)
+      {
+        r.FirstData = static_cast<size_t>(p - data);
+        r.FirstDataLine = lineNo;
+        found = true;
+        if (!r.HaveHeader)
+        {
+          if (!LayoutFromCount(tokens.size(), r.Columns))
+          {
+            r.Error = where(lineNo, 1) + "expected 3 (x y z), 4 (x y z "
+                "scalar), 6 (x y z r g b) or 8 (x y z r g b reflectivity refraction) columns, "
+                "found " + std::to_string(tokens.size()) +
+              "; a header line such as '# x y z intensity' names other layouts";
+            return r;
+          }
+        }
+        break;
+      }
+    }
+    p = nl ? nl + 1 : end;
+  }
+  for (const auto& c : r.Columns)
+  {
+    r.Layout += (r.Layout.empty() ? "" : " ") + c.Name;
+  }
+  if (!found)
+  {
+    r.Error = where(lineNo, 1) + "no particle lines in the file (only " +
+      (r.HaveHeader ? "a header, " : "") + "comments or blank lines); expected lines of " +
+      (r.HaveHeader ? r.Layout : std::string("x y z ..."));
+    return r;
+  }
+  r.Ok = true;
+  return r;
+}
+
+} // namespace ptext
+} // namespace octoray
+
+#endif
