@@ -24,6 +24,7 @@ step configure cmake -S Rendering/Engine -B build-gpu -G Ninja -DCMAKE_BUILD_TYP
   -DOCTORAY_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DOCTORAY_GTEST_SOURCE_DIR="$PWD/.deps/googletest"
 step build cmake --build build-gpu -j 16
 step tests build-gpu/bin/octoray_engine_tests
+step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
 step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*'
 step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
 step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*'
@@ -32,6 +33,6 @@ step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json
 echo
 echo "== octoray CUDA check =="
 grep -E "tests? (ran|from)|PASSED|FAILED" "$out/tests.log" | tail -3
-grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/racecheck.log "$out"/initcheck.log
+grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/racecheck.log "$out"/initcheck.log "$out"/synccheck.log
 grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
 printf '%s\n' "${status[@]}"

@@ -1,6 +1,8 @@
 // The octree against the brute-force reference, on every backend.
 #include "TestSupport.h"
 
+#include <octoray/Frame.h>
+
 using namespace octoray;
 using namespace octoray::test;
 
@@ -310,4 +312,81 @@ TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
   EXPECT_NO_THROW(engine->Build(big.View(), options));
   engine->CopyToHost(after);
   ExpectMatchesReference(after, big);
+}
+
+// Out-of-memory at every allocation site: budgets swept from nothing up to
+// what a build, an update and a render need. At each step the call either
+// succeeds or fails with the documented error, gives back what it took (the
+// engine holds no more than before) and leaves the previous octree intact.
+TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
+{
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    GTEST_SKIP() << "CUDA backend not usable here: " << why;
+  }
+  const Cloud first = UniformCloud(2000, 53);
+  const Cloud second = GaussianClusters(30000, 54);
+  BuildOptions options;
+  options.depth = 7;
+  int failures = 0, successes = 0;
+  for (std::size_t budget = 0;; budget += 48 * 1024)
+  {
+    auto engine = CreateEngine(Backend::CUDA);
+    engine->Build(first.View(), options);
+    HostOctree before;
+    engine->CopyToHost(before);
+    const std::size_t held = engine->Memory().Total();
+    engine->SetMemoryBudget(held + budget);
+    bool ok = true;
+    try
+    {
+      engine->Build(second.View(), options);
+      // An update that changes the topology (re-sort path) and a render.
+      std::vector<std::uint32_t> idx(300);
+      std::vector<double> to(900);
+      for (std::uint32_t k = 0; k < 300; ++k)
+      {
+        idx[k] = k * 97;
+        to[3 * k] = second.xyz[3 * idx[k]] * 0.5, to[3 * k + 1] = second.xyz[3 * idx[k] + 1] * 0.5,
+                 to[3 * k + 2] = second.xyz[3 * idx[k] + 2] * 0.5;
+      }
+      PositionsView moved;
+      moved.count = idx.size();
+      moved.indices = idx.data();
+      moved.xyzDouble = to.data();
+      engine->Update(moved);
+      RenderSettings s;
+      s.width = 64;
+      s.height = 48;
+      const double vp[16] = { 0.1, 0, 0, 0, 0, 0.1, 0, 0, 0, 0, -0.1, 0, 0, 0, 0, 1 };
+      Invert4x4(vp, s.inverseViewProjection);
+      Image image;
+      engine->Render(s, image);
+    }
+    catch (const Error& e)
+    {
+      ok = false;
+      ++failures;
+      const std::string message = e.what();
+      ASSERT_NE(message.find("octoray: out of memory for "), std::string::npos) << message;
+      if (engine->PointCount() == first.Size())
+      {
+        // The build failed: the first octree is untouched and nothing leaked.
+        HostOctree after;
+        engine->CopyToHost(after);
+        EXPECT_EQ(after.key, before.key) << "budget " << budget;
+        EXPECT_EQ(after.pointCount, before.pointCount) << "budget " << budget;
+        EXPECT_LE(engine->Memory().Total(), held + budget) << "budget " << budget;
+      }
+    }
+    if (ok)
+    {
+      ++successes;
+      break;
+    }
+    ASSERT_LT(budget, 256u << 20) << "no budget was enough";
+  }
+  EXPECT_GT(failures, 5); // several allocation sites were hit on the way
+  EXPECT_EQ(successes, 1);
 }

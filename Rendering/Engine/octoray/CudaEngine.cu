@@ -366,23 +366,27 @@ __global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, std
   unsigned long long* secondaryRays)
 {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
-  const int y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x >= f.width || y >= f.height)
+  if (x >= f.width)
   {
     return;
   }
-  const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
+  // Rows stride over the grid: a viewport taller than the grid's y limit
+  // (65535 blocks) is still covered.
   std::size_t rays = 0;
-  float pixel[4];
-  RenderPixel<F>(f, tree, x, y, pixel, depth[i], rays);
-  if (rgba8)
+  for (int y = blockIdx.y * blockDim.y + threadIdx.y; y < f.height; y += gridDim.y * blockDim.y)
   {
-    reinterpret_cast<uchar4*>(rgba8)[i] = make_uchar4(DeviceChannelToByte(pixel[0]), DeviceChannelToByte(pixel[1]),
-      DeviceChannelToByte(pixel[2]), DeviceChannelToByte(pixel[3]));
-  }
-  else
-  {
-    reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
+    const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
+    float pixel[4];
+    RenderPixel<F>(f, tree, x, y, pixel, depth[i], rays);
+    if (rgba8)
+    {
+      reinterpret_cast<uchar4*>(rgba8)[i] = make_uchar4(DeviceChannelToByte(pixel[0]),
+        DeviceChannelToByte(pixel[1]), DeviceChannelToByte(pixel[2]), DeviceChannelToByte(pixel[3]));
+    }
+    else
+    {
+      reinterpret_cast<float4*>(rgba)[i] = make_float4(pixel[0], pixel[1], pixel[2], pixel[3]);
+    }
   }
   if (rays)
   {
@@ -863,7 +867,8 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   DeviceBuffer<unsigned long long>& counter = RayCounter;
   CudaCheck(cudaMemset(counter.Get(), 0, sizeof(unsigned long long)), "cudaMemset");
   const dim3 block(16, 8);
-  const dim3 grid((settings.width + block.x - 1) / block.x, (settings.height + block.y - 1) / block.y);
+  const unsigned rows = (settings.height + block.y - 1) / block.y;
+  const dim3 grid((settings.width + block.x - 1) / block.x, rows < 65535u ? rows : 65535u);
   DispatchFeatures(frame, [&](auto features) {
     RenderKernel<decltype(features)><<<grid, block>>>(frame, view, settings.rgba8 ? nullptr : ImageRgba.Get(),
       settings.rgba8 ? ImageRgba8.Get() : nullptr, ImageDepth.Get(), counter.Get());
