@@ -318,3 +318,38 @@ TEST(RenderCUDA, ImagesEqualTheCpuBackend)
     }
   }
 }
+
+// A viewport taller than the CUDA grid's y limit (65535 blocks of 8 rows):
+// every row is still traced, and equals the CPU's.
+TEST(RenderCUDA, ViewportTallerThanTheGridEqualsTheCpu)
+{
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    GTEST_SKIP() << "CUDA backend not usable here: " << why;
+  }
+  const Cloud c = GaussianClusters(5000, 48);
+  BuildOptions options;
+  options.depth = 6;
+  auto cpu = CreateEngine(Backend::CPU);
+  auto gpu = CreateEngine(Backend::CUDA);
+  cpu->Build(c.View(), options);
+  gpu->Build(c.View(), options);
+  const int w = 2, h = 600000;
+  const double eye[3] = { 20, -25, 15 }, target[3] = { 2, 1, 1 };
+  const Matrix vp = ViewProjection(eye, target, kUp, 40, double(w) / h * 4000, 1, 100);
+  RenderSettings s = Settings(vp, w, h);
+  s.maxBounces = 0;
+  Image a, b;
+  cpu->Render(s, a);
+  gpu->Render(s, b);
+  ASSERT_EQ(b.rgba.size(), a.rgba.size());
+  std::size_t hits = 0;
+  for (std::size_t i = 0; i < b.depth.size(); ++i)
+  {
+    hits += a.depth[i] < 1.0f;
+  }
+  EXPECT_GT(hits, 1000u);
+  EXPECT_EQ(a.depth, b.depth);
+  EXPECT_EQ(a.rgba, b.rgba);
+}
