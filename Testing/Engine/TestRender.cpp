@@ -350,6 +350,19 @@ TEST(RenderCUDA, ViewportTallerThanTheGridEqualsTheCpu)
     hits += a.depth[i] < 1.0f;
   }
   EXPECT_GT(hits, 1000u);
-  EXPECT_EQ(a.depth, b.depth);
-  EXPECT_EQ(a.rgba, b.rgba);
+  // Every row written (NaN-free, the background where nothing is hit), and
+  // the issue 4 rule: 99.9% of pixels identical, none off by > 2/255.
+  std::size_t identical = 0;
+  for (std::size_t i = 0; i < b.depth.size(); ++i)
+  {
+    float diff = std::fabs(a.depth[i] - b.depth[i]);
+    for (int k = 0; k < 4; ++k)
+    {
+      ASSERT_FALSE(std::isnan(b.rgba[4 * i + k])) << "pixel row " << i / w;
+      diff = std::max(diff, std::fabs(a.rgba[4 * i + k] - b.rgba[4 * i + k]));
+    }
+    identical += diff == 0.0f;
+    ASSERT_LE(diff, 2.0f / 255) << "pixel row " << i / w;
+  }
+  EXPECT_GE(identical * 1000, b.depth.size() * 999);
 }
