@@ -2,6 +2,7 @@
 
 #include "vtkAlgorithmOutput.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkCommunicator.h"
 #include "vtkDataSet.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -19,6 +20,8 @@
 #include "vtkPointSet.h"
 #include "vtkRenderer.h"
 #include "vtkVolumeProperty.h"
+
+#include <algorithm> // for std::copy
 
 vtkStandardNewMacro(vtkOctreeVolumeRepresentation);
 
@@ -70,6 +73,39 @@ int vtkOctreeVolumeRepresentation::RequestData(
       this->DataSize = this->Cache->GetActualMemorySize();
     }
   }
+  // Data split over ranks: every rank builds its octree in the cube around
+  // the global bounds (and, with LeafDepth set, at the same depth), so the
+  // ranks' voxels align and depth compositing reproduces the one-rank
+  // picture. RequestData runs on every rank of the pipeline update, so the
+  // reduction is collective.
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  double globalBounds[6];
+  std::copy(this->DataBounds, this->DataBounds + 6, globalBounds);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double local[6];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool valid = vtkMath::AreBoundsInitialized(this->DataBounds);
+      // Minima and negated maxima: one MIN reduction gives both.
+      local[2 * a] = valid ? this->DataBounds[2 * a] : VTK_DOUBLE_MAX;
+      local[2 * a + 1] = valid ? -this->DataBounds[2 * a + 1] : VTK_DOUBLE_MAX;
+    }
+    double reduced[6];
+    controller->AllReduce(local, reduced, 6, vtkCommunicator::MIN_OP);
+    for (int a = 0; a < 3; ++a)
+    {
+      globalBounds[2 * a] = reduced[2 * a];
+      globalBounds[2 * a + 1] = -reduced[2 * a + 1];
+    }
+    this->Mapper->SetRootBounds(globalBounds);
+  }
+  else
+  {
+    vtkMath::UninitializeBounds(globalBounds);
+    this->Mapper->SetRootBounds(globalBounds);
+  }
+
   if (vtkMath::AreBoundsInitialized(this->DataBounds))
   {
     this->OutlineSource->SetBounds(this->DataBounds);
