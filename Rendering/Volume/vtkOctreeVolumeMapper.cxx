@@ -12,6 +12,7 @@
 #include "vtkInformation.h"
 #include "vtkLight.h"
 #include "vtkLightCollection.h"
+#include "vtkMath.h"
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -36,6 +37,7 @@
 #include <octoray/Engine.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -112,6 +114,7 @@ public:
   std::vector<ArrayStamp> Arrays; // colours/scalars, reflectivity, refraction, normals
   std::string Layout;             // which arrays play which role
   int Depth = 0;
+  std::array<double, 6> RootBounds{};
   int BuiltBackend = -1;
   vtkIdType BuildCounter = 0; // bumped by every build and update (the trace key)
 
@@ -698,10 +701,12 @@ int vtkOctreeVolumeMapper::PrepareOctree(vtkDataSet* input, vtkVolumeProperty* p
   const ArrayStamp points = pointSet ? Stamp(pointSet->GetPoints() ? pointSet->GetPoints()->GetData() : nullptr)
                                      : ArrayStamp{ input, input->GetMTime() };
   const vtkIdType count = input->GetNumberOfPoints();
+  std::array<double, 6> rootBounds;
+  std::copy(this->RootBounds, this->RootBounds + 6, rootBounds.begin());
 
   const bool sameArrays = in.Built && in.Input == input && in.Count == count &&
     in.Layout == layout && in.Arrays == arrays && in.Depth == this->LeafDepth &&
-    in.BuiltBackend == in.EngineBackend;
+    in.RootBounds == rootBounds && in.BuiltBackend == in.EngineBackend;
   if (sameArrays && in.Points == points)
   {
     return 0;
@@ -924,6 +929,15 @@ int vtkOctreeVolumeMapper::PrepareOctree(vtkDataSet* input, vtkVolumeProperty* p
 
   octoray::BuildOptions options;
   options.depth = this->LeafDepth;
+  if (vtkMath::AreBoundsInitialized(this->RootBounds))
+  {
+    // The caller's cube (e.g. global bounds over parallel ranks): the same
+    // voxel grid on every rank.
+    const double lo[3] = { this->RootBounds[0], this->RootBounds[2], this->RootBounds[4] };
+    const double hi[3] = { this->RootBounds[1], this->RootBounds[3], this->RootBounds[5] };
+    options.fixedCube = true;
+    options.cube = octoray::RootCube::FromBounds(lo, hi);
+  }
   in.Built = false;
   if (!this->Guarded("build", [&] { in.Engine->Build(view, options); }))
   {
@@ -937,6 +951,7 @@ int vtkOctreeVolumeMapper::PrepareOctree(vtkDataSet* input, vtkVolumeProperty* p
   in.Arrays = arrays;
   in.Layout = layout;
   in.Depth = this->LeafDepth;
+  in.RootBounds = rootBounds;
   in.BuiltBackend = in.EngineBackend;
   ++in.BuildCounter;
   ++this->NumberOfBuilds;
@@ -1237,6 +1252,9 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BackendDescription: " << this->Internals->Description << "\n";
   os << indent << "LeafDepth: " << this->LeafDepth << (this->LeafDepth == 0 ? " (auto)" : "") << "\n";
   os << indent << "LODPixelThreshold: " << this->LODPixelThreshold << "\n";
+  os << indent << "RootBounds: " << this->RootBounds[0] << " " << this->RootBounds[1] << " "
+     << this->RootBounds[2] << " " << this->RootBounds[3] << " " << this->RootBounds[4] << " "
+     << this->RootBounds[5] << "\n";
   os << indent << "Shadows: " << (this->Shadows ? "On" : "Off") << "\n";
   os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
   os << indent << "DepthCue: " << this->DepthCue << "\n";

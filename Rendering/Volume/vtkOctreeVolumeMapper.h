@@ -116,6 +116,19 @@ public:
 
   ///@{
   /**
+   * Build the octree inside the cube around these bounds (xmin, xmax, ymin,
+   * ymax, zmin, zmax) instead of one fitted to the input's points; every
+   * point must lie inside. Data split over parallel ranks then gives every
+   * rank the same voxel grid, so the composited picture matches one rank's
+   * (with a fixed LeafDepth). Uninitialized bounds (the default, min > max)
+   * fit the cube to the points.
+   */
+  vtkSetVector6Macro(RootBounds, double);
+  vtkGetVector6Macro(RootBounds, double);
+  ///@}
+
+  ///@{
+  /**
    * Level of detail: rays stop descending at voxels smaller than this many
    * pixels. 0 (the default) always descends to the leaves.
    */
@@ -255,6 +268,7 @@ protected:
   int RequestedBackend = BACKEND_AUTO;
   int LeafDepth = 0;
   double LODPixelThreshold = 0.0;
+  double RootBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   bool Shadows = false;
   int MaximumBounces = 2;
   double DepthCue = 0.0;

@@ -1,0 +1,345 @@
+#include "vtkOctreeVolumeRepresentation.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkCommunicator.h"
+#include "vtkDataSet.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkLogger.h"
+#include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkMultiProcessController.h"
+#include "vtkObjectFactory.h"
+#include "vtkOctreeVolumeMapper.h"
+#include "vtkOutlineSource.h"
+#include "vtkOutputWindow.h"
+#include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkPointSet.h"
+#include "vtkRenderer.h"
+#include "vtkVolumeProperty.h"
+
+#include <algorithm> // for std::copy
+
+vtkStandardNewMacro(vtkOctreeVolumeRepresentation);
+
+//----------------------------------------------------------------------------
+vtkOctreeVolumeRepresentation::vtkOctreeVolumeRepresentation()
+{
+  // The mapper's own level of detail (LODPixelThreshold) replaces ParaView's
+  // outline LOD: the octree is cheap to draw coarsely, so no LOD mapper.
+  this->Actor->SetMapper(this->Mapper);
+  this->Actor->SetEnableLOD(0);
+  vtkMath::UninitializeBounds(this->DataBounds);
+}
+
+//----------------------------------------------------------------------------
+vtkOctreeVolumeRepresentation::~vtkOctreeVolumeRepresentation() = default;
+
+//----------------------------------------------------------------------------
+int vtkOctreeVolumeRepresentation::FillInputPortInformation(int, vtkInformation* info)
+{
+  // What the mapper draws: points of any point set, or the voxels of an
+  // image above ImageBackground.
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+//----------------------------------------------------------------------------
+int vtkOctreeVolumeRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkMath::UninitializeBounds(this->DataBounds);
+  this->DataSize = 0;
+  this->Cache = nullptr;
+
+  if (inputVector[0]->GetNumberOfInformationObjects() == 1)
+  {
+    vtkDataSet* input = vtkDataSet::GetData(inputVector[0], 0);
+    if (input)
+    {
+      // A shallow copy: the view may move or redistribute the piece, and the
+      // upstream filter's output must stay untouched.
+      this->Cache.TakeReference(input->NewInstance());
+      this->Cache->ShallowCopy(input);
+      if (this->Cache->GetNumberOfPoints() > 0)
+      {
+        this->Cache->GetBounds(this->DataBounds);
+      }
+      this->DataSize = this->Cache->GetActualMemorySize();
+    }
+  }
+  // Data split over ranks: every rank builds its octree in the cube around
+  // the global bounds (and, with LeafDepth set, at the same depth), so the
+  // ranks' voxels align and depth compositing reproduces the one-rank
+  // picture. RequestData runs on every rank of the pipeline update, so the
+  // reduction is collective.
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  double globalBounds[6];
+  std::copy(this->DataBounds, this->DataBounds + 6, globalBounds);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double local[6];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool valid = vtkMath::AreBoundsInitialized(this->DataBounds);
+      // Minima and negated maxima: one MIN reduction gives both.
+      local[2 * a] = valid ? this->DataBounds[2 * a] : VTK_DOUBLE_MAX;
+      local[2 * a + 1] = valid ? -this->DataBounds[2 * a + 1] : VTK_DOUBLE_MAX;
+    }
+    double reduced[6];
+    controller->AllReduce(local, reduced, 6, vtkCommunicator::MIN_OP);
+    for (int a = 0; a < 3; ++a)
+    {
+      globalBounds[2 * a] = reduced[2 * a];
+      globalBounds[2 * a + 1] = -reduced[2 * a + 1];
+    }
+    this->Mapper->SetRootBounds(globalBounds);
+  }
+  else
+  {
+    vtkMath::UninitializeBounds(globalBounds);
+    this->Mapper->SetRootBounds(globalBounds);
+  }
+
+  if (vtkMath::AreBoundsInitialized(this->DataBounds))
+  {
+    this->OutlineSource->SetBounds(this->DataBounds);
+  }
+  else
+  {
+    this->OutlineSource->SetBounds(0, 0, 0, 0, 0, 0);
+  }
+  this->OutlineSource->Update();
+
+  return this->Superclass::RequestData(request, inputVector, outputVector);
+}
+
+//----------------------------------------------------------------------------
+bool vtkOctreeVolumeRepresentation::IsTranslucentBlendMode() const
+{
+  const int mode = this->Mapper->GetBlendMode();
+  return mode != vtkOctreeVolumeMapper::SURFACE_BLEND &&
+    mode != vtkVolumeMapper::ISOSURFACE_BLEND;
+}
+
+//----------------------------------------------------------------------------
+int vtkOctreeVolumeRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* request_type, vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+
+  if (request_type == vtkPVView::REQUEST_UPDATE())
+  {
+    vtkDataObject* piece = this->Cache ? static_cast<vtkDataObject*>(this->Cache)
+                                       : this->OutlineSource->GetOutputDataObject(0);
+    vtkPVRenderView::SetPiece(inInfo, this, piece, this->DataSize);
+
+    // Every process traces its own points; the picture is composited, never
+    // the data gathered on the client.
+    vtkPVRenderView::SetRequiresDistributedRendering(inInfo, this, true);
+
+    vtkNew<vtkMatrix4x4> matrix;
+    this->Actor->GetMatrix(matrix);
+    vtkPVRenderView::SetGeometryBounds(inInfo, this, this->DataBounds, matrix);
+
+    const int ranks = vtkMultiProcessController::GetGlobalController()
+      ? vtkMultiProcessController::GetGlobalController()->GetNumberOfProcesses()
+      : 1;
+    if (this->IsTranslucentBlendMode() && this->Cache && this->Cache->IsA("vtkPointSet"))
+    {
+      // Blended modes: the view cuts the points into spatially disjoint
+      // pieces (k-d tree over the ranks) that IceT blends in order.
+      outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 1);
+      vtkPVRenderView::SetOrderedCompositingConfiguration(inInfo, this,
+        vtkPVRenderView::DATA_IS_REDISTRIBUTABLE | vtkPVRenderView::USE_DATA_FOR_LOAD_BALANCING);
+      vtkPVRenderView::SetRedistributionModeToUniquelyAssignBoundaryCells(inInfo, this);
+      if (ranks > 1 && !this->OrderWarningIssued)
+      {
+        this->OrderWarningIssued = true;
+        vtkWarningMacro("Octree Volume: with a translucent blend mode over "
+          << ranks
+          << " ranks the points are redistributed into disjoint pieces and blended in order; "
+             "each piece has its own octree, so voxels along the cuts may differ from a "
+             "one-rank picture. The surface modes composite exactly.");
+      }
+    }
+    else if (this->IsTranslucentBlendMode() && ranks > 1 && !this->OrderWarningIssued)
+    {
+      // Image data is not redistributed by the view: the pieces the reader
+      // made are blended as they are.
+      this->OrderWarningIssued = true;
+      vtkWarningMacro("Octree Volume: translucent blend modes on image data over "
+        << ranks << " ranks blend each rank's picture without ordering; use the surface modes "
+        << "or one rank for an exact picture.");
+    }
+  }
+  else if (request_type == vtkPVView::REQUEST_RENDER())
+  {
+    vtkAlgorithmOutput* producerPort = vtkPVRenderView::GetPieceProducer(inInfo, this);
+    vtkDataSet* piece =
+      producerPort ? vtkDataSet::SafeDownCast(producerPort->GetProducer()->GetOutputDataObject(0)) : nullptr;
+    if (!this->BackendReported)
+    {
+      // Once per representation and process: say which backend draws, so a
+      // server without a GPU tells the user it uses the CPU.
+      this->BackendReported = true;
+      if (!vtkOctreeVolumeMapper::IsCudaAvailable())
+      {
+        vtkOutputWindowDisplayText("Octree Volume: no usable CUDA device on this server; "
+                                   "vtkOctreeVolumeMapper uses its CPU backend.\n");
+      }
+    }
+    if (piece && (piece->IsA("vtkPointSet") || piece->IsA("vtkImageData")) &&
+      piece->GetNumberOfPoints() > 0 && this->Cache)
+    {
+      this->Mapper->SetInputConnection(producerPort);
+      this->UpdateMapperParameters();
+      this->Actor->SetMapper(this->Mapper);
+    }
+    else
+    {
+      // Nothing to draw on this rank (e.g. fewer pieces than ranks): no
+      // mapper, so the volume adds nothing to the composite.
+      this->Actor->SetMapper(nullptr);
+    }
+  }
+  return 1;
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::UpdateMapperParameters()
+{
+  const char* colorArrayName = nullptr;
+  int fieldAssociation = vtkDataObject::FIELD_ASSOCIATION_POINTS;
+  vtkInformation* info = this->GetInputArrayInformation(0);
+  if (info && info->Has(vtkDataObject::FIELD_ASSOCIATION()) &&
+    info->Has(vtkDataObject::FIELD_NAME()))
+  {
+    colorArrayName = info->Get(vtkDataObject::FIELD_NAME());
+    fieldAssociation = info->Get(vtkDataObject::FIELD_ASSOCIATION());
+  }
+  this->Mapper->SelectScalarArray(colorArrayName);
+  // The octree holds point attributes only (the mapper warns about cell
+  // scalars); no array means the voxels' own colours or white.
+  this->Mapper->SetScalarMode(fieldAssociation == vtkDataObject::FIELD_ASSOCIATION_CELLS
+      ? VTK_SCALAR_MODE_USE_CELL_FIELD_DATA
+      : VTK_SCALAR_MODE_USE_POINT_FIELD_DATA);
+
+  // As ParaView's Volume representation: "Map Scalars" off (or
+  // multi-component mapping) makes 3/4-component arrays direct colours.
+  this->Property->SetIndependentComponents(this->MapScalars && !this->MultiComponentsMapping);
+}
+
+//----------------------------------------------------------------------------
+bool vtkOctreeVolumeRepresentation::AddToView(vtkView* view)
+{
+  vtkPVRenderView* rview = vtkPVRenderView::SafeDownCast(view);
+  if (rview)
+  {
+    rview->GetRenderer()->AddActor(this->Actor);
+    return this->Superclass::AddToView(view);
+  }
+  return false;
+}
+
+//----------------------------------------------------------------------------
+bool vtkOctreeVolumeRepresentation::RemoveFromView(vtkView* view)
+{
+  vtkPVRenderView* rview = vtkPVRenderView::SafeDownCast(view);
+  if (rview)
+  {
+    rview->GetRenderer()->RemoveActor(this->Actor);
+    return this->Superclass::RemoveFromView(view);
+  }
+  return false;
+}
+
+//----------------------------------------------------------------------------
+const char* vtkOctreeVolumeRepresentation::GetLastUsedBackendName()
+{
+  return this->Mapper->GetLastUsedBackendName();
+}
+
+//----------------------------------------------------------------------------
+// Forwarded to vtkVolumeProperty.
+void vtkOctreeVolumeRepresentation::SetAmbient(double val)
+{
+  this->Property->SetAmbient(val);
+}
+void vtkOctreeVolumeRepresentation::SetDiffuse(double val)
+{
+  this->Property->SetDiffuse(val);
+}
+void vtkOctreeVolumeRepresentation::SetSpecular(double val)
+{
+  this->Property->SetSpecular(val);
+}
+void vtkOctreeVolumeRepresentation::SetSpecularPower(double val)
+{
+  this->Property->SetSpecularPower(val);
+}
+void vtkOctreeVolumeRepresentation::SetShade(bool val)
+{
+  this->Property->SetShade(val);
+}
+
+//----------------------------------------------------------------------------
+// Forwarded to the mapper. The blend mode also decides whether the view must
+// composite in order, so it marks the representation modified (a new
+// REQUEST_UPDATE pass).
+void vtkOctreeVolumeRepresentation::SetBlendMode(int val)
+{
+  if (this->Mapper->GetBlendMode() != val)
+  {
+    this->Mapper->SetBlendMode(val);
+    this->MarkModified();
+  }
+}
+void vtkOctreeVolumeRepresentation::SetRequestedBackend(int val)
+{
+  this->Mapper->SetRequestedBackend(val);
+}
+void vtkOctreeVolumeRepresentation::SetLeafDepth(int val)
+{
+  this->Mapper->SetLeafDepth(val);
+}
+void vtkOctreeVolumeRepresentation::SetLODPixelThreshold(double val)
+{
+  this->Mapper->SetLODPixelThreshold(val);
+}
+void vtkOctreeVolumeRepresentation::SetShadows(bool val)
+{
+  this->Mapper->SetShadows(val);
+}
+void vtkOctreeVolumeRepresentation::SetMaximumBounces(int val)
+{
+  this->Mapper->SetMaximumBounces(val);
+}
+void vtkOctreeVolumeRepresentation::SetDepthCue(double val)
+{
+  this->Mapper->SetDepthCue(val);
+}
+void vtkOctreeVolumeRepresentation::SetImageSampleDistance(double val)
+{
+  this->Mapper->SetImageSampleDistance(val);
+}
+void vtkOctreeVolumeRepresentation::SetImageBackground(double val)
+{
+  this->Mapper->SetImageBackground(val);
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Mapper: " << this->Mapper->GetClassName() << "\n";
+  os << indent << "Cache: " << (this->Cache ? this->Cache->GetClassName() : "(none)") << "\n";
+}

@@ -1,0 +1,128 @@
+/**
+ * @class   vtkOctreeVolumeRepresentation
+ * @brief   ParaView's "Octree Volume" representation: point data or image
+ *          data drawn by vtkOctreeVolumeMapper in the render view
+ *
+ * vtkOctreeVolumeRepresentation follows ParaView's own volume
+ * representations (vtkImageVolumeRepresentation,
+ * vtkUnstructuredGridVolumeRepresentation): RequestData keeps a shallow copy
+ * of the input, REQUEST_UPDATE hands it to the render view as this
+ * representation's piece, and REQUEST_RENDER connects the view's copy of the
+ * piece to the mapper and pushes the colour array, the transfer functions
+ * and the mapper's settings. The vtkVolume (a vtkPVLODVolume, from
+ * vtkVolumeRepresentation) is added to the view's renderer.
+ *
+ * Data stays where it was produced: the piece is never gathered on the
+ * client (SetRequiresDistributedRendering), so with N ranks every rank
+ * builds and traces the octree of its own points and the view's compositor
+ * (IceT) merges the pictures.
+ *
+ * - Surface blend mode (first hit, shaded or not: the "Phong" picture) is
+ *   opaque: the mapper writes window depth, and IceT's depth compositing
+ *   gives the same picture as one rank.
+ * - The translucent blend modes (composite, maximum, minimum, average,
+ *   additive) need the pieces blended back to front. The representation
+ *   then asks the view for ordered compositing: the view redistributes the
+ *   points into spatially disjoint pieces (a k-d tree over the ranks) and
+ *   IceT blends them in visibility order. Each rank's octree covers only its
+ *   own piece, so voxels along the cuts may differ from the one-rank
+ *   picture; a warning says so once.
+ *
+ * The mapper is created with vtkOctreeVolumeMapper::New(): CUDA when the
+ * server has a usable device, else the CPU backend; the first render logs
+ * which backend drew (and the mapper itself warns when CUDA fails and it
+ * falls back).
+ *
+ * @sa vtkOctreeVolumeMapper vtkVolumeRepresentation
+ */
+#ifndef vtkOctreeVolumeRepresentation_h
+#define vtkOctreeVolumeRepresentation_h
+
+#include "octorayViewsParaViewModule.h" // for export macro
+#include "vtkVolumeRepresentation.h"
+
+#include "vtkNew.h" // for vtkNew
+
+class vtkDataSet;
+class vtkOctreeVolumeMapper;
+
+class OCTORAYVIEWSPARAVIEW_EXPORT vtkOctreeVolumeRepresentation : public vtkVolumeRepresentation
+{
+public:
+  static vtkOctreeVolumeRepresentation* New();
+  vtkTypeMacro(vtkOctreeVolumeRepresentation, vtkVolumeRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  int ProcessViewRequest(vtkInformationRequestKey* request_type, vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+
+  ///@{
+  /**
+   * Forwarded to vtkVolumeProperty (as vtkImageVolumeRepresentation does).
+   */
+  void SetAmbient(double);
+  void SetDiffuse(double);
+  void SetSpecular(double);
+  void SetSpecularPower(double);
+  void SetShade(bool);
+  ///@}
+
+  ///@{
+  /**
+   * Forwarded to vtkOctreeVolumeMapper; see its documentation. BlendMode
+   * takes vtkVolumeMapper's values or vtkOctreeVolumeMapper::SURFACE_BLEND.
+   */
+  void SetBlendMode(int);
+  void SetRequestedBackend(int);
+  void SetLeafDepth(int);
+  void SetLODPixelThreshold(double);
+  void SetShadows(bool);
+  void SetMaximumBounces(int);
+  void SetDepthCue(double);
+  void SetImageSampleDistance(double);
+  void SetImageBackground(double);
+  ///@}
+
+  /**
+   * The backend that drew the last picture on this process ("CUDA", "CPU"
+   * or "none"), for scripts and tests.
+   */
+  const char* GetLastUsedBackendName();
+
+  /**
+   * The mapper (one per process).
+   */
+  vtkOctreeVolumeMapper* GetMapper() { return this->Mapper; }
+
+protected:
+  vtkOctreeVolumeRepresentation();
+  ~vtkOctreeVolumeRepresentation() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool AddToView(vtkView* view) override;
+  bool RemoveFromView(vtkView* view) override;
+
+  /**
+   * Colour array, scalar mode and component handling, as
+   * vtkUnstructuredGridVolumeRepresentation::UpdateMapperParameters.
+   */
+  void UpdateMapperParameters();
+
+  /**
+   * True for the blend modes whose picture depends on the order in which
+   * pieces are blended (everything but the opaque surface mode).
+   */
+  bool IsTranslucentBlendMode() const;
+
+  vtkNew<vtkOctreeVolumeMapper> Mapper;
+  vtkSmartPointer<vtkDataSet> Cache;
+  bool BackendReported = false;
+  bool OrderWarningIssued = false;
+
+private:
+  vtkOctreeVolumeRepresentation(const vtkOctreeVolumeRepresentation&) = delete;
+  void operator=(const vtkOctreeVolumeRepresentation&) = delete;
+};
+
+#endif

@@ -1,0 +1,65 @@
+"""LoadPlugin + the plugin's readers (run by pvpython and by pvbatch).
+
+usage: plugin_readers.py PLUGIN DATA_DIR
+"""
+import os
+import sys
+
+from paraview.simple import *  # noqa: F401,F403
+from paraview import servermanager
+
+plugin, data = sys.argv[1], sys.argv[2]
+LoadPlugin(plugin, remote=False, ns=globals())
+
+failures = []
+
+
+def check(what, got, expected):
+    print(f"{what}: {got} (expected {expected})")
+    if got != expected:
+        failures.append(what)
+
+
+# The particle reader by name and through File > Open's reader factory.
+particles = os.path.join(data, "Particles", "lidar_simple.particles")
+r = OctorayParticleReader(FileName=particles)
+r.UpdatePipeline()
+check("particles: points", r.GetDataInformation().GetNumberOfPoints(), 1065)
+check("particles: Colors array", "Colors" in r.PointData.keys(), True)
+factory = servermanager.vtkSMProxyManager.GetProxyManager().GetReaderFactory()
+session = servermanager.ActiveConnection.Session
+
+
+def readers_for(path):
+    """The reader proxies File > Open offers for path."""
+    found = factory.GetReaders(path, session)
+    return [found.GetString(i) for i in range(1, found.GetLength(), 3)]
+
+
+check("particles: File > Open offers the reader",
+      "OctorayParticleReader" in readers_for(particles), True)
+o = OpenDataFile(particles)
+check("OpenDataFile(.particles)", o.GetXMLName(), "OctorayParticleReader")
+
+# A DICOM folder: the folder reader, then the same files as a series.
+folder = os.path.join(data, "DICOM", "CT5N")
+d = OctoraySliceFolderReader(DirectoryName=folder)
+d.UpdatePipeline()
+dicom_points = d.GetDataInformation(0).GetNumberOfPoints()
+check("DICOM folder: particles > 0", dicom_points > 0, True)
+volume = d.GetDataInformation(1)
+check("DICOM folder: volume slices", volume.GetExtent()[5] - volume.GetExtent()[4] + 1, 5)
+check("DICOM folder: File > Open offers the folder reader",
+      "OctoraySliceFolderReader" in readers_for(folder), True)
+files = sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".dcm"))
+s = OctoraySliceStackReader(FileNames=files, BackgroundRange=[0, 0])
+s.UpdatePipeline()
+check("DICOM series: same points as the folder", s.GetDataInformation(0).GetNumberOfPoints(),
+      dicom_points)
+check("DICOM .dcm: File > Open offers the series reader",
+      "OctoraySliceStackReader" in readers_for(files[0]), True)
+
+if failures:
+    print("FAILED:", ", ".join(failures))
+    sys.exit(1)
+print("OK")
