@@ -676,6 +676,65 @@ int Animation(int frames)
   return 0;
 }
 
+// ---- Two render windows with their own mappers on the same input,
+// rendering in turn (issue 8): each round both show the same picture, and
+// a camera seen before gives the picture it gave then.
+int TwoWindows()
+{
+  const int w = 120, h = 120;
+  vtkSmartPointer<vtkPolyData> cloud = Cloud(3000, 33);
+  vtkNew<vtkCPUOctreeVolumeMapper> mapperA, mapperB;
+  vtkSmartPointer<vtkRenderWindow> windows[2] = { Window(w, h), Window(w, h) };
+  vtkNew<vtkRenderer> renderers[2];
+  vtkOctreeVolumeMapper* mappers[2] = { mapperA, mapperB };
+  for (int k = 0; k < 2; ++k)
+  {
+    mappers[k]->SetInputData(cloud);
+    mappers[k]->SetLeafDepth(6);
+    renderers[k]->AddVolume(Volume(mappers[k]));
+    SetCamera(renderers[k]->GetActiveCamera(), false);
+    windows[k]->AddRenderer(renderers[k]);
+  }
+  std::vector<Picture> firstLap;
+  int differing = 0, changedOnRevisit = 0, empty = 0;
+  for (int round = 0; round < 8; ++round)
+  {
+    // Four camera positions, visited twice.
+    Picture p[2];
+    for (int k = 0; k < 2; ++k)
+    {
+      renderers[k]->GetActiveCamera()->Azimuth(90);
+      p[k] = Capture(windows[k]);
+    }
+    int covered = 0;
+    for (int y = 0; y < h; ++y)
+    {
+      for (int x = 0; x < w; ++x)
+      {
+        differing += !Same(p[0].At(x, y), p[1].At(x, y)) || p[0].Depth(x, y) != p[1].Depth(x, y);
+        covered += p[0].Depth(x, y) < 1.0f;
+        if (round >= 4)
+        {
+          changedOnRevisit += !Same(p[0].At(x, y), firstLap[round - 4].At(x, y));
+        }
+      }
+    }
+    empty += covered < 500;
+    if (round < 4)
+    {
+      firstLap.push_back(p[0]);
+    }
+  }
+  std::cout << "two windows: " << differing << " pixels differ between the windows, " << changedOnRevisit
+            << " changed on revisiting a camera; builds " << mapperA->GetNumberOfBuilds() << " and "
+            << mapperB->GetNumberOfBuilds() << "\n";
+  CHECK(differing == 0);
+  CHECK(changedOnRevisit == 0);
+  CHECK(empty == 0);
+  CHECK(mapperA->GetNumberOfBuilds() == 1 && mapperB->GetNumberOfBuilds() == 1);
+  return 0;
+}
+
 // ---- A 4096x4096 offscreen window.
 int Large()
 {
@@ -742,6 +801,10 @@ int main(int argc, char* argv[])
   else if (what == "large")
   {
     Large();
+  }
+  else if (what == "twowindows")
+  {
+    TwoWindows();
   }
   else
   {
