@@ -21,8 +21,10 @@ build: configure
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Without a display, the whole test run shares one Xvfb (the OpenGL tests
-# find DISPLAY set; see Testing/with-display.sh).
-XVFB = $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1280x1024x24")
+# find DISPLAY set; see Testing/with-display.sh). -noreset: by default Xvfb
+# resets when its last client leaves, and a test connecting during that
+# reset fails with "bad X server connection".
+XVFB = $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1280x1024x24 -noreset")
 
 test: build
 	cd $(BUILD) && $(XVFB) ctest --output-on-failure -j $(JOBS) -LE bench
