@@ -16,6 +16,19 @@
 
 namespace octoray
 {
+// Global index of the child in `octant` of a node whose children start at
+// firstChild and exist where childMask has bits: children are stored in
+// octant order, so the index is firstChild plus the children before it.
+OCTORAY_HD std::uint32_t ChildIndex(unsigned childMask, std::uint32_t firstChild, unsigned octant)
+{
+  const unsigned before = childMask & ((1u << octant) - 1u);
+#if defined(__CUDA_ARCH__)
+  return firstChild + static_cast<std::uint32_t>(__popc(before));
+#else
+  return firstChild + static_cast<std::uint32_t>(__builtin_popcount(before));
+#endif
+}
+
 // Plain pointers into the node arrays (host or device memory). Attribute
 // pointers are null when the input lacked that attribute.
 struct OctreeView
@@ -40,24 +53,6 @@ struct OctreeView
   OCTORAY_HD std::uint32_t LevelSize(int level) const
   {
     return levelBegin[level + 1] - levelBegin[level];
-  }
-
-  // Global index of the child in `octant`, or kInvalidIndex when absent.
-  OCTORAY_HD std::uint32_t Child(std::uint32_t node, int octant) const
-  {
-    const unsigned mask = childMask[node];
-    if (!(mask & (1u << octant)))
-    {
-      return kInvalidIndex;
-    }
-    const unsigned before = mask & ((1u << octant) - 1u);
-    unsigned rank = 0;
-#if OCTORAY_DEVICE_CODE && defined(__CUDA_ARCH__)
-    rank = __popc(before);
-#else
-    rank = static_cast<unsigned>(__builtin_popcount(before));
-#endif
-    return firstChild[node] + rank;
   }
 
   // Binary search for a node of `level` by its level-local key.

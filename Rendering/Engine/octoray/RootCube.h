@@ -74,14 +74,5 @@ struct RootCube
     key = EncodeMorton(c[0], c[1], c[2]);
     return true;
   }
-
-  // Data coordinates -> the unit cube [0,1]^3 in which the renderer works.
-  OCTORAY_HD void ToUnit(const double p[3], double u[3]) const
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      u[a] = (p[a] - origin[a]) / size;
-    }
-  }
 };
 }

@@ -185,13 +185,7 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
       {
         continue;
       }
-      const unsigned before = mask & ((1u << octant) - 1u);
-#if defined(__CUDA_ARCH__)
-      const unsigned rank = __popc(before);
-#else
-      const unsigned rank = static_cast<unsigned>(__builtin_popcount(before));
-#endif
-      stack[top++] = TraversalEntry{ firstChild + rank, e.level + 1, t0 };
+      stack[top++] = TraversalEntry{ ChildIndex(mask, firstChild, octant), e.level + 1, t0 };
     }
   }
 }
