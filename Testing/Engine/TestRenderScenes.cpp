@@ -8,6 +8,8 @@
 // NaN and infinity (RenderChecked). Each test runs on both backends.
 #include "TestRenderSupport.h"
 
+#include <octoray/RenderModes.h>
+
 #include <set>
 
 using namespace octoray;
@@ -1076,32 +1078,11 @@ TEST_P(SceneTest, RepeatedRendersAreBitIdenticalInEveryMode)
   const int w = 64, h = 48;
   const double eye[3] = { 20, -25, 15 }, target[3] = { 2, 1, 1 };
   const Matrix vp = ViewProjection(eye, target, kZUp, 40, double(w) / h, 1, 100);
-  struct Mode
-  {
-    const char* name;
-    BlendMode blend;
-    ShadeMode shade;
-    bool shadows;
-    int bounces;
-  };
-  const Mode modes[] = { { "flat", BlendMode::Surface, ShadeMode::Flat, false, 0 },
-    { "depth cue", BlendMode::Surface, ShadeMode::DepthCue, false, 0 },
-    { "phong", BlendMode::Surface, ShadeMode::Phong, false, 0 },
-    { "phong shadows", BlendMode::Surface, ShadeMode::Phong, true, 0 },
-    { "reflections", BlendMode::Surface, ShadeMode::Phong, true, 4 },
-    { "composite", BlendMode::Composite, ShadeMode::Flat, false, 0 },
-    { "mip", BlendMode::Maximum, ShadeMode::Flat, false, 0 },
-    { "minip", BlendMode::Minimum, ShadeMode::Flat, false, 0 },
-    { "average", BlendMode::Average, ShadeMode::Flat, false, 0 },
-    { "additive", BlendMode::Additive, ShadeMode::Flat, false, 0 } };
-  for (const Mode& m : modes)
+  for (const NamedRenderMode& m : kRenderModes)
   {
     SCOPED_TRACE(m.name);
     RenderSettings s = Settings(vp, w, h);
-    s.blend = m.blend;
-    s.shade = m.shade;
-    s.shadows = m.shadows;
-    s.maxBounces = m.bounces;
+    m.ApplyTo(s);
     Light sun;
     sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
     s.lights.push_back(sun);

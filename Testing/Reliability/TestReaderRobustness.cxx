@@ -6,6 +6,7 @@
 // a reader re-executes when its file changes on disk, and the picture the
 // engine makes of the same file is the same each time.
 //   TestReaderRobustness <scratch folder> <Data folder> <seed PNG>
+#include "EnginePicture.h"
 #include "octorayTestCheck.h"
 
 #include "vtkCallbackCommand.h"
@@ -65,39 +66,6 @@ void Quiet(vtkObject* o)
   cb->SetCallback([](vtkObject*, unsigned long, void*, void*) {});
   o->AddObserver(vtkCommand::ErrorEvent, cb);
   o->AddObserver(vtkCommand::WarningEvent, cb);
-}
-
-// The engine's picture of a poly data's points (CPU backend, 64x48).
-std::vector<float> Picture(vtkPolyData* pd)
-{
-  const vtkIdType n = pd->GetNumberOfPoints();
-  std::vector<float> xyz(3 * n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double p[3];
-    pd->GetPoint(i, p);
-    for (int a = 0; a < 3; ++a)
-      xyz[3 * i + a] = static_cast<float>(p[a]);
-  }
-  octoray::PointCloudView view;
-  view.count = static_cast<size_t>(n);
-  view.xyzFloat = xyz.data();
-  auto engine = octoray::CreateEngine(octoray::Backend::CPU);
-  engine->Build(view, octoray::BuildOptions{});
-  octoray::RenderSettings s;
-  s.width = 64;
-  s.height = 48;
-  // Looking down -z at the unit cube around the data's centre: an
-  // orthographic camera written as the inverse view-projection directly.
-  double b[6];
-  pd->GetBounds(b);
-  const double c[3] = { (b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2 };
-  const double r = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4], 1e-6 });
-  const double inv[16] = { r, 0, 0, c[0], 0, r, 0, c[1], 0, 0, -r, c[2], 0, 0, 0, 1 };
-  std::copy(inv, inv + 16, s.inverseViewProjection);
-  octoray::Image image;
-  engine->Render(s, image);
-  return image.rgba;
 }
 
 struct Progress
@@ -354,7 +322,7 @@ int main(int argc, char* argv[])
     r->Update();
     const vtkIdType n = r->GetOutput()->GetNumberOfPoints();
     CHECK(n > 100);
-    const auto first = Picture(r->GetOutput());
+    const auto first = EnginePicture(r->GetOutput(), 64, 48);
     const vtkMTimeType t = r->GetOutput()->GetMTime();
     r->Update(); // nothing changed: no new execution
     CHECK(r->GetOutput()->GetMTime() == t);
@@ -371,7 +339,7 @@ int main(int argc, char* argv[])
     std::ofstream(path, std::ios::binary | std::ios::trunc) << original;
     r->Update();
     CHECK(r->GetOutput()->GetNumberOfPoints() == n);
-    CHECK(Picture(r->GetOutput()) == first);
+    CHECK(EnginePicture(r->GetOutput(), 64, 48) == first);
     bool lit = false;
     for (float v : first)
       lit = lit || v > 0;

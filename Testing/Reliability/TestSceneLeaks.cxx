@@ -3,6 +3,7 @@
 // checks at exit that nothing leaked (the test fails if anything did); in
 // every build the process's resident memory must not grow with the rounds.
 //   TestSceneLeaks <particle file> [rounds]
+#include "EnginePicture.h"
 #include "vtkNew.h"
 #include "vtkParticleTextReader.h"
 #include "vtkPoints.h"
@@ -49,31 +50,7 @@ size_t Round(const char* file)
     std::cerr << "nothing read: " << reader->GetErrorMessage() << std::endl;
     std::exit(1);
   }
-  std::vector<float> xyz(3 * n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double p[3];
-    pd->GetPoint(i, p);
-    for (int a = 0; a < 3; ++a)
-      xyz[3 * i + a] = static_cast<float>(p[a]);
-  }
-  octoray::PointCloudView view;
-  view.count = static_cast<size_t>(n);
-  view.xyzFloat = xyz.data();
-  auto engine = octoray::CreateEngine(octoray::Backend::CPU);
-  engine->Build(view, octoray::BuildOptions{});
-  octoray::RenderSettings s;
-  s.width = 48;
-  s.height = 32;
-  double b[6];
-  pd->GetBounds(b);
-  const double r = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
-  const double inv[16] = { r, 0, 0, (b[0] + b[1]) / 2, 0, r, 0, (b[2] + b[3]) / 2, 0, 0, -r,
-    (b[4] + b[5]) / 2, 0, 0, 0, 1 };
-  std::copy(inv, inv + 16, s.inverseViewProjection);
-  octoray::Image image;
-  engine->Render(s, image);
-  return image.rgba.size();
+  return EnginePicture(pd, 48, 32).size();
 }
 } // namespace
 

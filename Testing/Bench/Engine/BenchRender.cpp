@@ -16,6 +16,7 @@
 #include "PointFile.h"
 
 #include <octoray/Engine.h>
+#include <octoray/RenderModes.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -99,25 +100,8 @@ SphereField MakeSphereField(std::size_t points, int spheres = 48)
   return f;
 }
 
-struct Mode
-{
-  const char* name;
-  BlendMode blend;
-  ShadeMode shade;
-  bool shadows;
-  int bounces;
-};
-
-const Mode kModes[] = { { "surface-flat", BlendMode::Surface, ShadeMode::Flat, false, 0 },
-  { "depth-cue", BlendMode::Surface, ShadeMode::DepthCue, false, 0 },
-  { "phong", BlendMode::Surface, ShadeMode::Phong, false, 0 },
-  { "phong-shadows", BlendMode::Surface, ShadeMode::Phong, true, 0 },
-  { "reflections", BlendMode::Surface, ShadeMode::Phong, true, 2 },
-  { "composite", BlendMode::Composite, ShadeMode::Flat, false, 0 },
-  { "mip", BlendMode::Maximum, ShadeMode::Flat, false, 0 },
-  { "minip", BlendMode::Minimum, ShadeMode::Flat, false, 0 },
-  { "average", BlendMode::Average, ShadeMode::Flat, false, 0 },
-  { "additive", BlendMode::Additive, ShadeMode::Flat, false, 0 } };
+using Mode = NamedRenderMode;
+const auto& kModes = kRenderModes;
 
 RenderSettings MakeSettings(const PointCloudView& points, int w, int h, const Mode& m, int depth)
 {
@@ -129,10 +113,7 @@ RenderSettings MakeSettings(const PointCloudView& points, int w, int h, const Mo
   OrbitCamera camera;
   camera.zoom = 1.3;
   camera.Apply(lo, hi, s);
-  s.blend = m.blend;
-  s.shade = m.shade;
-  s.shadows = m.shadows;
-  s.maxBounces = m.bounces;
+  m.ApplyTo(s);
   if (m.shadows)
   {
     Light sun;
