@@ -35,11 +35,18 @@ struct Timing
 // buffers and cold caches belong to no steady state), then `repeats` times
 // timed. The median is what gets reported: on a shared 2-core machine a
 // single slow run from a neighbour's burst must not move the figure.
-inline Timing Measure(const std::function<void()>& fn, int warmups, int repeats)
+// `after`, when given, runs untimed after every call (e.g. freeing a tree of
+// millions of nodes, which is not the build's cost).
+inline Timing Measure(const std::function<void()>& fn, int warmups, int repeats,
+  const std::function<void()>& after = nullptr)
 {
   for (int w = 0; w < warmups; ++w)
   {
     fn();
+    if (after)
+    {
+      after();
+    }
   }
   std::vector<double> seconds;
   for (int r = 0; r < std::max(1, repeats); ++r)
@@ -47,6 +54,10 @@ inline Timing Measure(const std::function<void()>& fn, int warmups, int repeats)
     const auto start = std::chrono::steady_clock::now();
     fn();
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (after)
+    {
+      after();
+    }
   }
   std::sort(seconds.begin(), seconds.end());
   Timing t;

@@ -56,32 +56,12 @@ struct Case
   std::size_t n = 0;
 };
 
-// Times `build` `repeats` times after `warmups`; `reset` runs untimed after
-// each call, so freeing a tree of millions of nodes is not charged to it.
+// Times `build` after `warmups`; `reset` runs untimed after each call, so
+// freeing a tree of millions of nodes is not charged to its build.
 Timing MeasureFresh(
   const std::function<void()>& build, const std::function<void()>& reset, int warmups, int repeats)
 {
-  for (int w = 0; w < warmups; ++w)
-  {
-    build();
-    reset();
-  }
-  std::vector<double> seconds;
-  for (int r = 0; r < repeats; ++r)
-  {
-    const auto start = std::chrono::steady_clock::now();
-    build();
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    reset();
-  }
-  std::sort(seconds.begin(), seconds.end());
-  Timing t;
-  const std::size_t m = seconds.size();
-  t.median = m % 2 ? seconds[m / 2] : 0.5 * (seconds[m / 2 - 1] + seconds[m / 2]);
-  t.min = seconds.front();
-  t.max = seconds.back();
-  t.repeats = static_cast<int>(m);
-  return t;
+  return Measure(build, warmups, repeats, reset);
 }
 
 std::string CpuBackendName(int threads)
