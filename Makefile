@@ -1,13 +1,14 @@
 # The two commands of the README, on a fresh Debian 12 machine:
 #   make demo   install what is missing, build, run the main job on bundled data
 #   make test   install what is missing, build, run every test
-# and `make bench` for the benchmarks (JSON into build/bench-results.json).
+# and `make bench` for the benchmarks (JSON into build/bench-results.json),
+# `make report` for Testing/Bench/RESULTS.md with its CSV files and plots.
 
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-asan demo bench clean
+.PHONY: all deps configure build test test-asan demo bench report clean
 
 all: build
 
@@ -71,6 +72,14 @@ demo: build
 # --verbose: the benchmarks' tables are the output wanted, pass or fail.
 bench: build
 	cd $(BUILD) && $(XVFB) ctest --verbose -L bench
+
+# Issue 7: regenerates Testing/Bench/RESULTS.md, its CSV files and plots
+# (Testing/Bench/report/) and the README's summary table from scratch on this
+# machine; GPU rows come from the committed GPU run in Testing/Bench/gpu/.
+# REPORT_ARGS, e.g. --only quality, to redo some sections.
+REPORT_ARGS ?=
+report: build
+	/usr/bin/python3 Testing/Report/make_report.py --build $(BUILD) $(REPORT_ARGS)
 
 clean:
 	rm -rf $(BUILD)

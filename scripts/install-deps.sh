@@ -35,6 +35,8 @@ packages=(
   python3-pandas
   # independent reference values for the DICOM tests
   python3-pydicom
+  # make report: plots, and SSIM from an independent implementation
+  python3-matplotlib python3-skimage
 )
 
 missing=()
