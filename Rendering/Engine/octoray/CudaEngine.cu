@@ -498,8 +498,7 @@ BuildStats CudaEngine::Build(const PointCloudView& points, const BuildOptions& o
     DeviceBuffer<std::uint8_t> raw;
     Upload(Pool, raw, points.color8, cc * n, "point colours");
     s.color8.Reserve(Pool, 4 * n, "point colours");
-    WidenColor8Kernel<<<Blocks(n), kBlock>>>(raw.Get(), cc, n, s.color8.Get());
-    CudaCheckLaunch("WidenColor8Kernel");
+    OCTORAY_LAUNCH(WidenColor8Kernel, Blocks(n), kBlock, raw.Get(), cc, n, s.color8.Get());
     CudaCheck(cudaDeviceSynchronize(), "WidenColor8Kernel");
   }
   else if (points.colorFloat)
@@ -507,8 +506,7 @@ BuildStats CudaEngine::Build(const PointCloudView& points, const BuildOptions& o
     DeviceBuffer<float> raw;
     Upload(Pool, raw, points.colorFloat, cc * n, "point colours");
     s.colorFloat.Reserve(Pool, n, "point colours");
-    WidenColorFloatKernel<<<Blocks(n), kBlock>>>(raw.Get(), cc, n, s.colorFloat.Get());
-    CudaCheckLaunch("WidenColorFloatKernel");
+    OCTORAY_LAUNCH(WidenColorFloatKernel, Blocks(n), kBlock, raw.Get(), cc, n, s.colorFloat.Get());
     CudaCheck(cudaDeviceSynchronize(), "WidenColorFloatKernel");
   }
   if (points.scalar)
@@ -528,8 +526,7 @@ BuildStats CudaEngine::Build(const PointCloudView& points, const BuildOptions& o
     DeviceBuffer<float> raw;
     Upload(Pool, raw, points.normal, 3 * n, "point normals");
     s.normal.Reserve(Pool, n, "point normals");
-    UnitNormalKernel<<<Blocks(n), kBlock>>>(raw.Get(), n, s.normal.Get());
-    CudaCheckLaunch("UnitNormalKernel");
+    OCTORAY_LAUNCH(UnitNormalKernel, Blocks(n), kBlock, raw.Get(), n, s.normal.Get());
     CudaCheck(cudaDeviceSynchronize(), "UnitNormalKernel");
   }
 
@@ -555,6 +552,7 @@ BuildStats CudaEngine::Build(const PointCloudView& points, const BuildOptions& o
   }
   BuildStats stats = BuildFromState(s, cube, options.depth);
   State = std::move(next);
+  DiscardedByUpdate = false;
   stats.bytes = Memory().Total();
   stats.seconds = SecondsSince(start);
   return stats;
@@ -623,9 +621,8 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
   flags.Reserve(Pool, 2 * kDepthHistogramBins, "counters");
   CudaCheck(cudaMemset(flags.Get(), 0xFF, sizeof(unsigned long long)), "cudaMemset");
   const int fullShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
-  KeysKernel<<<Blocks(n), kBlock>>>(pts, cube, fullShift, s.pointKey.Get(), SortKey[0].Get(), SortIndex[0].Get(),
+  OCTORAY_LAUNCH(KeysKernel, Blocks(n), kBlock, pts, cube, fullShift, s.pointKey.Get(), SortKey[0].Get(), SortIndex[0].Get(),
     flags.Get());
-  CudaCheckLaunch("KeysKernel");
   unsigned long long firstOutside = 0;
   CudaCheck(cudaMemcpy(&firstOutside, flags.Get(), sizeof(firstOutside), cudaMemcpyDeviceToHost), "KeysKernel");
   if (firstOutside != ~0ull)
@@ -653,8 +650,7 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
   unsigned long long histograms[2 * kDepthHistogramBins];
   auto histogram = [&](int toFull) {
     CudaCheck(cudaMemset(flags.Get(), 0, 2 * kDepthHistogramBins * sizeof(unsigned long long)), "cudaMemset");
-    NeighbourHistogramKernel<<<Blocks(n), kBlock>>>(sortedKey, n, toFull, flags.Get());
-    CudaCheckLaunch("NeighbourHistogramKernel");
+    OCTORAY_LAUNCH(NeighbourHistogramKernel, Blocks(n), kBlock, sortedKey, n, toFull, flags.Get());
     CudaCheck(cudaMemcpy(histograms, flags.Get(), sizeof(histograms), cudaMemcpyDeviceToHost),
       "NeighbourHistogramKernel");
   };
@@ -663,8 +659,7 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
     histogram(0);
     depth = ChooseDepthFromHistograms(reinterpret_cast<std::uint64_t*>(histograms),
       reinterpret_cast<std::uint64_t*>(histograms + kDepthHistogramBins));
-    ShiftKernel<<<Blocks(n), kBlock>>>(sortedKey, n, 3 * (kMaxLevel - depth));
-    CudaCheckLaunch("ShiftKernel");
+    OCTORAY_LAUNCH(ShiftKernel, Blocks(n), kBlock, sortedKey, n, 3 * (kMaxLevel - depth));
   }
   histogram(3 * (kMaxLevel - depth));
   stats.sortSeconds = SecondsSince(phase);
@@ -721,14 +716,12 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
     CudaCheck(cudaMemcpy(Starts.Get() + expected, &end, sizeof(end), cudaMemcpyHostToDevice), "run starts");
   };
   runStarts(sortedKey, n, 0, view.LevelSize(depth));
-  LeafKernel<<<Blocks(view.LevelSize(depth)), kBlock>>>(view, pts, sortedIndex, sortedKey, Starts.Get(),
+  OCTORAY_LAUNCH(LeafKernel, Blocks(view.LevelSize(depth)), kBlock, view, pts, sortedIndex, sortedKey, Starts.Get(),
     view.LevelSize(depth));
-  CudaCheckLaunch("LeafKernel");
   for (int l = depth - 1; l >= 0; --l)
   {
     runStarts(view.key + view.levelBegin[l + 1], view.LevelSize(l + 1), 3, view.LevelSize(l));
-    InnerKernel<<<Blocks(view.LevelSize(l)), kBlock>>>(view, l, Starts.Get());
-    CudaCheckLaunch("InnerKernel");
+    OCTORAY_LAUNCH(InnerKernel, Blocks(view.LevelSize(l)), kBlock, view, l, Starts.Get());
   }
   const std::uint32_t none = kInvalidIndex;
   CudaCheck(cudaMemcpy(view.parent, &none, sizeof(none), cudaMemcpyHostToDevice), "root parent");
@@ -746,8 +739,34 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
 
 UpdateStats CudaEngine::Update(const PositionsView& positions)
 {
-  DeviceState& s = *State;
-  ValidateUpdate(positions, s.count);
+  if (State->count == 0 && DiscardedByUpdate)
+  {
+    throw Error("octoray: update after a failed update discarded the octree; build again");
+  }
+  ValidateUpdate(positions, State->count);
+  // An update writes into the octree it updates. When it fails after the
+  // first write (a refused launch, out of memory), points and nodes may
+  // disagree and no picture drawn from them could be trusted, so the octree
+  // is dropped (its memory freed) and the caller is told to build again.
+  bool writing = false;
+  try
+  {
+    return UpdateState(*State, positions, writing);
+  }
+  catch (const Error& e)
+  {
+    if (!writing)
+    {
+      throw;
+    }
+    State = std::make_unique<DeviceState>();
+    DiscardedByUpdate = true;
+    throw Error(std::string(e.what()) + " (the update had begun: the octree was discarded; build again)");
+  }
+}
+
+UpdateStats CudaEngine::UpdateState(DeviceState& s, const PositionsView& positions, bool& writing)
+{
   const auto start = std::chrono::steady_clock::now();
   const std::size_t moved = positions.count;
   UpdateStats stats;
@@ -769,8 +788,7 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
     DeviceBuffer<unsigned long long> firstBad;
     firstBad.Reserve(Pool, 1, "counters");
     CudaCheck(cudaMemset(firstBad.Get(), 0xFF, sizeof(unsigned long long)), "cudaMemset");
-    FirstNonFiniteKernel<<<Blocks(moved), kBlock>>>(xyz.Get(), moved, firstBad.Get());
-    CudaCheckLaunch("FirstNonFiniteKernel");
+    OCTORAY_LAUNCH(FirstNonFiniteKernel, Blocks(moved), kBlock, xyz.Get(), moved, firstBad.Get());
     unsigned long long bad = 0;
     CudaCheck(cudaMemcpy(&bad, firstBad.Get(), sizeof(bad), cudaMemcpyDeviceToHost), "FirstNonFiniteKernel");
     if (bad != ~0ull)
@@ -778,8 +796,8 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
       const double p[3] = { double(host[3 * bad]), double(host[3 * bad + 1]), double(host[3 * bad + 2]) };
       throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, p));
     }
-    ScatterPositionsKernel<<<Blocks(moved), kBlock>>>(xyz.Get(), indices.Get(), moved, xyzFloat, xyzDouble);
-    CudaCheckLaunch("ScatterPositionsKernel");
+    writing = true;
+    OCTORAY_LAUNCH(ScatterPositionsKernel, Blocks(moved), kBlock, xyz.Get(), indices.Get(), moved, xyzFloat, xyzDouble);
     CudaCheck(cudaDeviceSynchronize(), "ScatterPositionsKernel");
   };
   if (positions.xyzDouble)
@@ -798,9 +816,8 @@ UpdateStats CudaEngine::Update(const PositionsView& positions)
   CudaCheck(cudaMemcpy(counters.Get(), init, sizeof(init), cudaMemcpyHostToDevice), "counters");
   DeviceBuffer<LeafMove> moves;
   moves.Reserve(Pool, moved, "update moves");
-  MovedKeysKernel<<<Blocks(moved), kBlock>>>(s.Points(), s.cube, leafShift, indices.Get(), moved, s.pointKey.Get(),
+  OCTORAY_LAUNCH(MovedKeysKernel, Blocks(moved), kBlock, s.Points(), s.cube, leafShift, indices.Get(), moved, s.pointKey.Get(),
     moves.Get(), counters.Get(), counters.Get() + 1);
-  CudaCheckLaunch("MovedKeysKernel");
   unsigned long long result[2];
   CudaCheck(cudaMemcpy(result, counters.Get(), sizeof(result), cudaMemcpyDeviceToHost), "MovedKeysKernel");
 
@@ -838,7 +855,8 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   const DeviceState& s = *State;
   if (s.count == 0)
   {
-    throw Error("octoray: render before any build");
+    throw Error(DiscardedByUpdate ? "octoray: render after a failed update discarded the octree; build again"
+                                  : "octoray: render before any build");
   }
   const auto start = std::chrono::steady_clock::now();
   const OctreeView view = s.View();
@@ -870,7 +888,7 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   const unsigned rows = (settings.height + block.y - 1) / block.y;
   const dim3 grid((settings.width + block.x - 1) / block.x, rows < 65535u ? rows : 65535u);
   DispatchFeatures(frame, [&](auto features) {
-    RenderKernel<decltype(features)><<<grid, block>>>(frame, view, settings.rgba8 ? nullptr : ImageRgba.Get(),
+    RenderKernel<decltype(features)><<<LaunchGrid("RenderKernel", grid), block>>>(frame, view, settings.rgba8 ? nullptr : ImageRgba.Get(),
       settings.rgba8 ? ImageRgba8.Get() : nullptr, ImageDepth.Get(), counter.Get());
   });
   CudaCheckLaunch("RenderKernel");
@@ -922,8 +940,7 @@ bool CudaEngine::UpdateInPlace(DeviceState& s, const void* deviceMoves, std::siz
   DeviceBuffer<unsigned> flags;
   flags.Reserve(Pool, 2, "counters");
   CudaCheck(cudaMemset(flags.Get(), 0, 2 * sizeof(unsigned)), "cudaMemset");
-  PathRecordsKernel<<<Blocks(changed), kBlock>>>(view, moves, changed, node[0].Get(), point[0].Get(), flags.Get());
-  CudaCheckLaunch("PathRecordsKernel");
+  OCTORAY_LAUNCH(PathRecordsKernel, Blocks(changed), kBlock, view, moves, changed, node[0].Get(), point[0].Get(), flags.Get());
   unsigned topologyChanged = 0;
   CudaCheck(cudaMemcpy(&topologyChanged, flags.Get(), sizeof(unsigned), cudaMemcpyDeviceToHost), "PathRecordsKernel");
   if (topologyChanged)
@@ -952,17 +969,15 @@ bool CudaEngine::UpdateInPlace(DeviceState& s, const void* deviceMoves, std::siz
   CudaCheck(cudaMemcpy(&runs, selected.Get(), sizeof(int), cudaMemcpyDeviceToHost), "cub::DeviceSelect (update)");
   const std::uint32_t end = static_cast<std::uint32_t>(records);
   CudaCheck(cudaMemcpy(Starts.Get() + runs, &end, sizeof(end), cudaMemcpyHostToDevice), "run starts");
-  EmptiedNodesKernel<<<Blocks(runs), kBlock>>>(view, keys.Current(), values.Current(), Starts.Get(), runs,
+  OCTORAY_LAUNCH(EmptiedNodesKernel, Blocks(runs), kBlock, view, keys.Current(), values.Current(), Starts.Get(), runs,
     flags.Get() + 1);
-  CudaCheckLaunch("EmptiedNodesKernel");
   unsigned emptied = 0;
   CudaCheck(cudaMemcpy(&emptied, flags.Get() + 1, sizeof(unsigned), cudaMemcpyDeviceToHost), "EmptiedNodesKernel");
   if (emptied)
   {
     return false;
   }
-  ApplyDeltasKernel<<<Blocks(runs), kBlock>>>(view, s.Points(), keys.Current(), values.Current(), Starts.Get(), runs);
-  CudaCheckLaunch("ApplyDeltasKernel");
+  OCTORAY_LAUNCH(ApplyDeltasKernel, Blocks(runs), kBlock, view, s.Points(), keys.Current(), values.Current(), Starts.Get(), runs);
   CudaCheck(cudaDeviceSynchronize(), "ApplyDeltasKernel");
   return true;
 }

@@ -71,11 +71,15 @@ private:
   // leaf (device array of LeafMove); false, with nothing changed, when a
   // node would appear or empty.
   bool UpdateInPlace(DeviceState& s, const void* moves, std::size_t changed);
+  // The update proper; sets `writing` before its first write to the state.
+  UpdateStats UpdateState(DeviceState& s, const PositionsView& positions, bool& writing);
 
   std::string DeviceName;
   // Declared before the buffers so that it outlives them.
   DeviceMemoryPool Pool;
   std::unique_ptr<DeviceState> State;
+  // Set when an update failed part-way and dropped the octree; cleared by a build.
+  bool DiscardedByUpdate = false;
   // Scratch kept across builds so that rebuilds of similar size reuse it.
   DeviceBuffer<std::uint64_t> SortKey[2];
   DeviceBuffer<std::uint32_t> SortIndex[2];

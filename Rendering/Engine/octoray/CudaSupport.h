@@ -2,6 +2,7 @@
 // Only compiled by nvcc (CudaEngine.cu and the CUDA renderer).
 #pragma once
 
+#include "FaultInjection.h"
 #include "Types.h"
 #include "Validation.h"
 
@@ -27,6 +28,23 @@ inline void CudaCheckLaunch(const char* kernel)
 {
   CudaCheck(cudaGetLastError(), (std::string("launch of ") + kernel).c_str());
 }
+
+// The grid a launch of `kernel` uses: `grid`, or an empty one that the
+// runtime refuses when a test has asked for this launch to fail
+// (InjectCudaLaunchFailure).
+inline dim3 LaunchGrid(const char* kernel, dim3 grid)
+{
+  return TakeInjectedLaunchFailure(kernel) ? dim3(0, 1, 1) : grid;
+}
+
+// Launches a (non-template) kernel and checks the launch, so that every
+// failure names the kernel it came from.
+#define OCTORAY_LAUNCH(kernel, grid, block, ...)                                                                       \
+  do                                                                                                                   \
+  {                                                                                                                    \
+    kernel<<<::octoray::LaunchGrid(#kernel, grid), block>>>(__VA_ARGS__);                                              \
+    ::octoray::CudaCheckLaunch(#kernel);                                                                               \
+  } while (0)
 
 // Every device allocation of one engine goes through this: it enforces a
 // budget (set to test and to live with out-of-memory) and reports what the

@@ -46,7 +46,9 @@ public:
   // the root cube, the octree is rebuilt around the new bounds
   // (UpdateStats::Path::NewCube) at the same depth. Throws Error for a
   // non-finite coordinate, an index out of range or listed twice, before
-  // changing anything.
+  // changing anything. When the device fails part-way through an update (out
+  // of memory, a refused kernel launch), the error says so and the octree is
+  // dropped: Render and Update then throw until the next Build.
   virtual UpdateStats Update(const PositionsView& positions) = 0;
 
   // Ray-traces the octree into `image` (resized to the viewport). Throws

@@ -1,0 +1,234 @@
+// A refused CUDA kernel launch (issue 8), injected at every kernel of build,
+// update and render (octoray/FaultInjection.h): the CUDA runtime refuses the
+// launch for real and the engine's own check reports it. Each failure must
+// name the kernel, leave no sticky error behind, and leave an octree that is
+// either the previous one, intact (build, render, an update refused before
+// its first write) or none at all, said so (an update that had begun).
+#include "TestSupport.h"
+
+#include <octoray/FaultInjection.h>
+#include <octoray/Frame.h>
+
+#include <cstring>
+#include <functional>
+
+using namespace octoray;
+using namespace octoray::test;
+
+namespace
+{
+// The engine's words for a refused launch of `kernel`, then CUDA's reason
+// (an empty grid is "invalid argument" in CUDA 13, "invalid configuration
+// argument" in earlier releases; the reason is CUDA's, not ours), then
+// `after`.
+::testing::AssertionResult IsRefusal(const std::string& message, const std::string& kernel,
+  const std::string& after = "")
+{
+  const std::string prefix = "octoray: CUDA launch of " + kernel + " failed: ";
+  const bool prefixOk = message.compare(0, prefix.size(), prefix) == 0;
+  const bool afterOk = message.size() >= prefix.size() + after.size() + 1 &&
+    message.compare(message.size() - after.size(), after.size(), after) == 0;
+  if (prefixOk && afterOk)
+  {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "\"" << message << "\" is not \"" << prefix << "<CUDA's reason>" << after
+                                       << "\"";
+}
+
+// What `call` threw, or "(no error)".
+std::string ErrorOf(const std::function<void()>& call)
+{
+  try
+  {
+    call();
+  }
+  catch (const Error& e)
+  {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+RenderSettings SmallView()
+{
+  RenderSettings s;
+  s.width = 64;
+  s.height = 48;
+  const double viewProjection[16] = { 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, -0.5, 0, 0, 0, 0, 1 };
+  Invert4x4(viewProjection, s.inverseViewProjection);
+  return s;
+}
+
+bool SameColours(const std::vector<Rgba>& a, const std::vector<Rgba>& b)
+{
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgba)) == 0);
+}
+
+std::vector<float> Picture(Engine& engine)
+{
+  Image image;
+  engine.Render(SmallView(), image);
+  return image.rgba;
+}
+
+// Every point twice, so that moving one copy of a point onto another point
+// empties no node and creates none: the in-place update path.
+Cloud Doubled(const Cloud& c)
+{
+  Cloud d = c;
+  d.xyz.insert(d.xyz.end(), c.xyz.begin(), c.xyz.end());
+  d.rgb.insert(d.rgb.end(), c.rgb.begin(), c.rgb.end());
+  d.scalar.insert(d.scalar.end(), c.scalar.begin(), c.scalar.end());
+  d.reflectivity.insert(d.reflectivity.end(), c.reflectivity.begin(), c.reflectivity.end());
+  d.refraction.insert(d.refraction.end(), c.refraction.begin(), c.refraction.end());
+  d.normal.insert(d.normal.end(), c.normal.begin(), c.normal.end());
+  return d;
+}
+
+class CudaFaultsLaunch : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    std::string why;
+    if (!CudaAvailable(&why))
+    {
+      GTEST_SKIP() << "CUDA backend not usable here: " << why;
+    }
+  }
+  void TearDown() override { InjectCudaLaunchFailure(""); }
+};
+}
+
+TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
+{
+  const Cloud first = UniformCloud(1500, 61);
+  const Cloud second = GaussianClusters(20000, 62);
+  std::vector<float> floatColour(4 * second.Size());
+  for (std::size_t i = 0; i < floatColour.size(); ++i)
+  {
+    floatColour[i] = static_cast<float>(i % 7) / 7.0f;
+  }
+  BuildOptions fixedDepth;
+  fixedDepth.depth = 6;
+  BuildOptions automaticDepth; // depth 0: the depth histogram and the key shift run too
+
+  for (const char* kernel : { "WidenColor8Kernel", "WidenColorFloatKernel", "UnitNormalKernel", "KeysKernel",
+         "NeighbourHistogramKernel", "ShiftKernel", "LeafKernel", "InnerKernel" })
+  {
+    SCOPED_TRACE(kernel);
+    auto engine = CreateEngine(Backend::CUDA);
+    engine->Build(first.View(), fixedDepth);
+    HostOctree before;
+    engine->CopyToHost(before);
+    const std::vector<float> picture = Picture(*engine);
+
+    PointCloudView next = second.View();
+    if (std::string(kernel) == "WidenColorFloatKernel")
+    {
+      next.color8 = nullptr;
+      next.colorFloat = floatColour.data();
+      next.colorComponents = 4;
+    }
+    InjectCudaLaunchFailure(kernel);
+    EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Build(next, automaticDepth); }), kernel));
+
+    HostOctree after;
+    engine->CopyToHost(after);
+    EXPECT_EQ(after.key, before.key);
+    EXPECT_EQ(after.pointCount, before.pointCount);
+    EXPECT_TRUE(SameColours(after.color, before.color));
+    EXPECT_EQ(Picture(*engine), picture);
+
+    // Nothing sticky: the same build now succeeds and is right.
+    engine->Build(second.View(), fixedDepth);
+    engine->CopyToHost(after);
+    ExpectMatchesReference(after, second);
+  }
+}
+
+TEST_F(CudaFaultsLaunch, RenderKeepsTheOctreeAndTheNextFrame)
+{
+  const Cloud cloud = UniformCloud(3000, 63);
+  BuildOptions options;
+  options.depth = 6;
+  auto engine = CreateEngine(Backend::CUDA);
+  engine->Build(cloud.View(), options);
+  const std::vector<float> picture = Picture(*engine);
+
+  InjectCudaLaunchFailure("RenderKernel");
+  EXPECT_TRUE(IsRefusal(ErrorOf([&] { Picture(*engine); }), "RenderKernel"));
+  EXPECT_EQ(Picture(*engine), picture);
+}
+
+TEST_F(CudaFaultsLaunch, UpdateSaysWhatBecameOfTheOctree)
+{
+  const Cloud base = UniformCloud(4000, 64);
+  const Cloud cloud = Doubled(base);
+  BuildOptions options;
+  options.depth = 6;
+  // The second copies of points 0..9 move onto points 100..109.
+  std::vector<std::uint32_t> indices;
+  std::vector<double> to;
+  for (std::uint32_t k = 0; k < 10; ++k)
+  {
+    indices.push_back(static_cast<std::uint32_t>(base.Size()) + k);
+    to.insert(to.end(), base.xyz.begin() + 3 * (100 + k), base.xyz.begin() + 3 * (100 + k) + 3);
+  }
+  PositionsView moves;
+  moves.count = indices.size();
+  moves.indices = indices.data();
+  moves.xyzDouble = to.data();
+
+  // Without a failure these moves take the in-place path, so its kernels
+  // (path records, emptied nodes, deltas) are the ones refused below.
+  {
+    auto engine = CreateEngine(Backend::CUDA);
+    engine->Build(cloud.View(), options);
+    ASSERT_EQ(engine->Update(moves).path, UpdateStats::Path::InPlace);
+  }
+
+  // Refused before the first write: the octree is the one before the update.
+  {
+    auto engine = CreateEngine(Backend::CUDA);
+    engine->Build(cloud.View(), options);
+    HostOctree before, after;
+    engine->CopyToHost(before);
+    const std::vector<float> picture = Picture(*engine);
+    InjectCudaLaunchFailure("FirstNonFiniteKernel");
+    EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Update(moves); }), "FirstNonFiniteKernel"));
+    engine->CopyToHost(after);
+    EXPECT_EQ(after.pointCount, before.pointCount);
+    EXPECT_TRUE(SameColours(after.color, before.color));
+    EXPECT_EQ(Picture(*engine), picture);
+  }
+
+  // Refused after it began writing: no octree, said so, until a build.
+  for (const char* kernel :
+    { "ScatterPositionsKernel", "MovedKeysKernel", "PathRecordsKernel", "EmptiedNodesKernel", "ApplyDeltasKernel" })
+  {
+    SCOPED_TRACE(kernel);
+    auto engine = CreateEngine(Backend::CUDA);
+    engine->Build(cloud.View(), options);
+    InjectCudaLaunchFailure(kernel);
+    EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Update(moves); }), kernel,
+      " (the update had begun: the octree was discarded; build again)"));
+    EXPECT_EQ(engine->PointCount(), 0u);
+    EXPECT_EQ(ErrorOf([&] { Picture(*engine); }),
+      "octoray: render after a failed update discarded the octree; build again");
+    EXPECT_EQ(ErrorOf([&] { engine->Update(moves); }),
+      "octoray: update after a failed update discarded the octree; build again");
+
+    engine->Build(cloud.View(), options);
+    engine->Update(moves);
+    HostOctree after;
+    engine->CopyToHost(after);
+    Cloud moved = cloud;
+    for (std::size_t k = 0; k < indices.size(); ++k)
+    {
+      std::copy(to.begin() + 3 * k, to.begin() + 3 * k + 3, moved.xyz.begin() + 3 * indices[k]);
+    }
+    ExpectMatchesReference(after, moved);
+  }
+}
