@@ -1,0 +1,103 @@
+"""The GPU run's checks: engine tests on both backends and compute-sanitizer.
+
+Nothing is measured here: the files come from Testing/Bench/gpu-check.sh on a
+GPU machine (copied into Testing/Bench/gpu/ with COMMAND.md)."""
+import os
+import re
+import xml.etree.ElementTree as ET
+
+from make_report import Section
+
+TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
+
+# (log name in summary.txt, what it checks)
+SANITIZERS = [
+    ("memcheck", "compute-sanitizer memcheck: out-of-bounds and misaligned device memory accesses"),
+    ("memcheck-refused", "memcheck over the refused-launch tests (API errors are the point there, so not reported)"),
+    ("racecheck", "racecheck: shared-memory data races"),
+    ("initcheck", "initcheck: reads of uninitialised device memory"),
+    ("synccheck", "synccheck: invalid uses of __syncthreads and warp synchronisation"),
+]
+
+
+def produce(ctx):
+    pass  # measured on the GPU machine only
+
+
+def test_counts(xml_path):
+    """(all, passed, failed, skipped) for the whole run and for the CUDA tests."""
+    root = ET.parse(xml_path).getroot()
+    counts = {"all": [0, 0, 0, 0], "cuda": [0, 0, 0, 0]}
+    for case in root.iter("testcase"):
+        name = f"{case.get('classname')}.{case.get('name')}"
+        failed = case.find("failure") is not None
+        skipped = case.get("result") == "skipped" or case.find("skipped") is not None
+        for group in ("all", "cuda"):
+            if group == "cuda" and "CUDA" not in name and "CudaFaults" not in name:
+                continue
+            c = counts[group]
+            c[0] += 1
+            c[2 if failed else 3 if skipped else 1] += 1
+    return counts
+
+
+def render(ctx):
+    summary_path = ctx.gpu_file("summary.txt")
+    if not summary_path:
+        return Section("Not run on a GPU yet: `Testing/Bench/gpu-check.sh OUTDIR` on a GPU machine writes the "
+                       "files this section reads.")
+    with open(summary_path) as f:
+        summary = f.read()
+    device = ""
+    if ctx.gpu_file("gpu.txt"):
+        with open(ctx.gpu_file("gpu.txt")) as f:
+            device = f.read().strip()
+    date = re.search(r"CUDA check, (\d{4}-\d\d-\d\d)", summary)
+
+    rows = []
+    if ctx.gpu_file("engine-tests.xml"):
+        counts = test_counts(ctx.gpu_file("engine-tests.xml"))
+        for group, label in (("all", "engine tests, both backends"), ("cuda", "of which CUDA tests")):
+            total, passed, failed, skipped = counts[group]
+            rows.append((label, f"{passed} passed, {failed} failed, {skipped} skipped of {total}"))
+    for log, what in SANITIZERS:
+        found = re.search(rf"{re.escape(log)}\.log:=+ (ERROR SUMMARY|RACECHECK SUMMARY): (.*)", summary)
+        step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", summary, re.M)
+        result = found.group(2) if found else "no summary line"
+        if step:
+            result += f" (exit status: {step.group(1)})"
+        rows.append((what, result))
+    steps = [line for line in summary.splitlines() if re.match(r"^[a-z-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
+
+    text = [
+        f"Device: {device or 'see gpu/gpu.txt'}; run of {date.group(1) if date else 'unknown date'}. Command: "
+        f"`{ctx.gpu_command() or 'Testing/Bench/gpu-check.sh OUTDIR'}`.",
+        "",
+        "gpu-check.sh configures `Rendering/Engine` on its own (the GPU machine has only CUDA, CMake and a",
+        "compiler), builds for sm_90, runs every engine test on both backends (the CPU backend is the",
+        "reference the CUDA pictures and octrees are compared with), then the CUDA tests under each",
+        "compute-sanitizer tool. The fault tests are among them: out of memory injected at every",
+        "allocation site of build, update and render through the engine's memory budget",
+        "(`CudaFaults.*`), and a launch refused by the CUDA runtime at every kernel of build, update",
+        "and render (`CudaFaultsLaunch.*`, through octoray/FaultInjection.h): each failure names what",
+        "failed; a failed build or render leaves the previous octree and the next frame intact; an",
+        "update refused after it began writing drops the octree and says so until the next build.",
+        "",
+        ctx.table(["check", "result"], rows, "ll"),
+        "",
+        "Steps and their wall time on the GPU machine:",
+        "",
+        "```",
+        *steps,
+        "```",
+        "",
+        "Not covered on the GPU: the VTK mapper and the ParaView plugin with the CUDA backend (the lent",
+        "GPU machine has no VTK or ParaView); their CPU backend runs in `make test`.",
+    ]
+    summary_rows = []
+    if ctx.gpu_file("engine-tests.xml"):
+        clean = [log for log, _ in SANITIZERS
+                 if re.search(rf"{re.escape(log)}\.log:=+ [A-Z ]+: 0 ", summary)]
+        summary_rows.append((f"engine tests on {device.split(',')[0] if device else 'the GPU'}", rows[0][1],
+                             "compute-sanitizer", f"{len(clean)} of {len(SANITIZERS)} tool runs clean"))
+    return Section("\n".join(text), summary_rows)
