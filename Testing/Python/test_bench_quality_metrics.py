@@ -50,7 +50,7 @@ def test_every_knob_of_every_scene_is_recorded(run):
     assert {r["scene"] for r in records} == {"ct5n", "lidar", "spheres"}
     for scene in ("ct5n", "lidar", "spheres"):
         knobs = {r["knob"] for r in records if r["scene"] == scene}
-        assert knobs == {"depth", "lod", "bounces", "shadows", "size"}
+        assert knobs == {"depth", "lod", "bounces", "shadows", "size", "reference-check"}
         # One reference row per knob, identical to its reference.
         refs = [r for r in records if r["scene"] == scene and r["is_reference"]]
         assert sorted(r["knob"] for r in refs) == ["bounces", "depth", "lod", "shadows", "size"]

@@ -34,7 +34,7 @@
 //            against 4x4 supersampling, 8 bounces against 16
 // Every scene is lit by one directional light and shaded with Phong.
 //
-// Time: the median over the repeats (after one warm-up frame) of the
+// Time: the median over R interleaved rounds (after an untimed one) of the
 // engine's own frame time, RenderStats::seconds: on the CPU the whole
 // frame; on CUDA the host clock around the kernel launch and the device
 // synchronise, with the picture in device memory (the copy to the host,
@@ -155,29 +155,6 @@ RenderSettings MakeSettings(const Scene& scene, const Quality& q)
   return s;
 }
 
-struct Frame
-{
-  RgbImage picture;
-  double seconds = 0.0; // median of RenderStats::seconds
-};
-
-Frame RenderTimed(Engine& engine, const RenderSettings& s, int repeats)
-{
-  Image image;
-  engine.Render(s, image); // warm-up: buffers grown, caches filled
-  std::vector<double> seconds;
-  for (int r = 0; r < repeats; ++r)
-  {
-    seconds.push_back(engine.Render(s, image).seconds);
-  }
-  std::sort(seconds.begin(), seconds.end());
-  const std::size_t m = seconds.size();
-  Frame f;
-  f.seconds = m % 2 ? seconds[m / 2] : 0.5 * (seconds[m / 2 - 1] + seconds[m / 2]);
-  f.picture = ToRgb(image);
-  return f;
-}
-
 struct Row
 {
   std::string scene, backend, device, knob, value, reference;
@@ -207,14 +184,21 @@ std::string ToJson(const Row& r)
   return o.str();
 }
 
-// The runs of one scene on one backend.
+// The runs of one scene on one backend. Every setting is a job; all jobs
+// are rendered once untimed, then `repeats` rounds render each job once in
+// turn, and a job's time is the median of its rounds. Interleaved rounds
+// rather than one job's repeats back to back: on a shared machine the load
+// drifts over a run, and a drift then shifts every job alike instead of
+// favouring whichever ran in a quiet moment. Each leaf depth has its own
+// engine (octree), so the depth jobs join the same rounds.
 class SceneRun
 {
 public:
-  SceneRun(Engine& engine, const std::string& backend, const Scene& scene, int width, int height, int repeats,
+  SceneRun(Backend backend, int threads, const Scene& scene, int width, int height, int repeats,
     const std::string& dump, std::vector<Row>& rows)
-    : TheEngine(engine)
-    , BackendName(backend)
+    : TheBackend(backend)
+    , Threads(threads)
+    , BackendName(backend == Backend::CPU ? "cpu" : "cuda")
     , TheScene(scene)
     , Width(width)
     , Height(height)
@@ -226,116 +210,213 @@ public:
 
   void Run()
   {
-    const BuildStats auto_ = TheEngine.Build(TheScene.points, BuildOptions{});
-    AutoDepth = auto_.depth;
-    std::printf("\n%s on %s: %zu points, depth %d (the engine's choice), %zu nodes, %dx%d, median of %d\n",
-      TheScene.name.c_str(), TheEngine.Description().c_str(), auto_.points, AutoDepth, auto_.nodes, Width, Height,
-      Repeats);
-    std::printf("| knob | value | ms | RMSE | PSNR (dB) | SSIM |\n| --- | --- | ---: | ---: | ---: | ---: |\n");
+    Engine& automatic = EngineAt(0);
+    std::printf("\n%s on %s: %zu points, depth %d (the engine's choice), %zu nodes, %dx%d, median of %d rounds\n",
+      TheScene.name.c_str(), automatic.Description().c_str(), TheScene.points.count, AutoDepth, AutoNodes, Width,
+      Height, Repeats);
 
+    // The jobs. Every quality field sits at its reference value unless the
+    // knob moves it.
     const Quality base = Base();
-    const Frame reference = RenderTimed(TheEngine, MakeSettings(TheScene, base), Repeats);
-    const std::string refName = Describe(base);
-    const std::string refFile = Save(reference.picture, "reference");
-
-    // Level of detail, bounces, shadows: one picture each against the base.
-    Add("lod", "0", reference, reference, refName, refFile, true);
+    const std::size_t reference = AddJob(base);
+    std::vector<std::pair<float, std::size_t>> lod;
     for (float k : { 1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f })
     {
       Quality q = base;
       q.lod = k;
-      Add("lod", Format("%g", k), RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats), reference, refName,
-        refFile, false);
+      lod.emplace_back(k, AddJob(q));
     }
+    std::vector<std::pair<int, std::size_t>> bounces;
     for (int b : { 0, 1, 2, 3, 4 })
     {
       Quality q = base;
       q.bounces = b;
-      Add("bounces", Format("%d", b), RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats), reference, refName,
-        refFile, false);
+      bounces.emplace_back(b, AddJob(q));
     }
-    Add("bounces", "8", reference, reference, refName, refFile, true);
+    Quality noShadows = base;
+    noShadows.shadows = false;
+    const std::size_t shadowsOff = AddJob(noShadows);
+    // Image size: s W x s H, each pixel repeated back to W x H, against the
+    // 2W x 2H picture box-filtered to W x H (2x2 supersampled).
+    Quality super = base;
+    super.width = 2 * Width;
+    super.height = 2 * Height;
+    const std::size_t supersampled = AddJob(super, 1, 2);
+    std::vector<std::pair<int, std::size_t>> sizes;
+    for (int divisor : { 4, 2, 1 })
     {
       Quality q = base;
-      q.shadows = false;
-      Add("shadows", "off", RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats), reference, refName, refFile,
-        false);
+      q.width = Width / divisor;
+      q.height = Height / divisor;
+      sizes.emplace_back(divisor, AddJob(q, divisor, 1));
     }
-    Add("shadows", "on", reference, reference, refName, refFile, true);
-
-    // Image size: against the 2x2 supersampled picture.
-    {
-      Quality q = base;
-      q.width = 2 * Width;
-      q.height = 2 * Height;
-      Frame super = RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats);
-      super.picture = DownsampleBox(super.picture, 2);
-      const std::string superName = Format("%dx%d, box-filtered from %dx%d (2x2 supersampled)", Width, Height,
-        2 * Width, 2 * Height);
-      const std::string superFile = Save(super.picture, "size-reference");
-      for (int divisor : { 4, 2, 1 })
-      {
-        q.width = Width / divisor;
-        q.height = Height / divisor;
-        Frame f = RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats);
-        f.picture = UpsampleNearest(f.picture, divisor);
-        Add("size", Format("%g", 1.0 / divisor), f, super, superName, superFile, false, q.width, q.height);
-      }
-      Add("size", "2", super, super, superName, superFile, true, 2 * Width, 2 * Height);
-
-      // How far the reference itself is from converged: 2x2 against 4x4
-      // supersampling (the finer one rendered once; the row's time is the
-      // 2x2 reference's).
-      q.width = 4 * Width;
-      q.height = 4 * Height;
-      Frame finer = RenderTimed(TheEngine, MakeSettings(TheScene, q), 1);
-      finer.picture = DownsampleBox(finer.picture, 4);
-      Add("reference-check", "size: 2x2 against 4x4 supersampled", super, finer,
-        Format("%dx%d, box-filtered from %dx%d (4x4 supersampled)", Width, Height, 4 * Width, 4 * Height),
-        Save(finer.picture, "size-check"), false, 2 * Width, 2 * Height);
-    }
-    {
-      // And 8 bounces against 16 (rendered once).
-      Quality q = base;
-      q.bounces = 16;
-      const Frame more = RenderTimed(TheEngine, MakeSettings(TheScene, q), 1);
-      Add("reference-check", "bounces: 8 against 16", reference, more,
-        Format("depth %d (auto), lod k 0, 16 bounces, shadows on, %dx%d", AutoDepth, Width, Height),
-        Save(more.picture, "bounces-check"), false);
-    }
-
-    // Leaf depth, last: each value rebuilds the octree.
+    std::vector<std::pair<int, std::size_t>> depths;
     for (int d = AutoDepth - 3; d <= AutoDepth + 3; ++d)
     {
-      if (d < 1 || d > kMaxLevel)
+      if (d >= 1 && d <= kMaxLevel && d != AutoDepth)
       {
-        continue;
+        Quality q = base;
+        q.depth = d;
+        depths.emplace_back(d, AddJob(q));
       }
-      if (d == AutoDepth)
-      {
-        Add("depth", Format("%d (auto)", d), reference, reference, refName, refFile, true);
-        continue;
-      }
-      TheEngine.Build(TheScene.points, BuildOptions{ d });
-      Quality q = base;
-      q.depth = d;
-      Add("depth", Format("%d (auto%+d)", d, d - AutoDepth), RenderTimed(TheEngine, MakeSettings(TheScene, q), Repeats),
-        reference, refName, refFile, false, Width, Height, d);
     }
+
+    for (Job& job : Jobs) // warm-up: buffers grown, caches filled; keeps the picture
+    {
+      Render(job, false);
+    }
+    for (int round = 0; round < Repeats; ++round)
+    {
+      for (Job& job : Jobs)
+      {
+        Render(job, true);
+      }
+    }
+
+    const std::string refName =
+      Format("depth %d (auto), lod k 0, 8 bounces, shadows on, %dx%d", AutoDepth, Width, Height);
+    const std::string superName =
+      Format("%dx%d, box-filtered from %dx%d (2x2 supersampled)", Width, Height, 2 * Width, 2 * Height);
+    const std::string refFile = Save(Jobs[reference].picture, "reference");
+    const std::string superFile = Save(Jobs[supersampled].picture, "size-reference");
+
+    std::printf("| knob | value | ms | RMSE | PSNR (dB) | SSIM |\n| --- | --- | ---: | ---: | ---: | ---: |\n");
+    bool autoRow = false;
+    for (const auto& [d, job] : depths)
+    {
+      if (d > AutoDepth && !autoRow)
+      {
+        Add("depth", Format("%d (auto)", AutoDepth), reference, reference, refName, refFile, true);
+        autoRow = true;
+      }
+      Add("depth", Format("%d (auto%+d)", d, d - AutoDepth), job, reference, refName, refFile, false);
+    }
+    if (!autoRow)
+    {
+      Add("depth", Format("%d (auto)", AutoDepth), reference, reference, refName, refFile, true);
+    }
+    Add("lod", "0", reference, reference, refName, refFile, true);
+    for (const auto& [k, job] : lod)
+    {
+      Add("lod", Format("%g", k), job, reference, refName, refFile, false);
+    }
+    for (const auto& [b, job] : bounces)
+    {
+      Add("bounces", Format("%d", b), job, reference, refName, refFile, false);
+    }
+    Add("bounces", "8", reference, reference, refName, refFile, true);
+    Add("shadows", "off", shadowsOff, reference, refName, refFile, false);
+    Add("shadows", "on", reference, reference, refName, refFile, true);
+    for (const auto& [divisor, job] : sizes)
+    {
+      Add("size", Format("%g", 1.0 / divisor), job, supersampled, superName, superFile, false);
+    }
+    Add("size", "2", supersampled, supersampled, superName, superFile, true);
+
+    // How far the references themselves are from converged, from one
+    // (untimed) frame each: 2x2 against 4x4 supersampling, 8 bounces
+    // against 16. The rows carry the reference's time.
+    Quality finer = base;
+    finer.width = 4 * Width;
+    finer.height = 4 * Height;
+    const std::size_t super4 = AddJob(finer, 1, 4);
+    Quality more = base;
+    more.bounces = 16;
+    const std::size_t bounces16 = AddJob(more);
+    Render(Jobs[super4], false);
+    Render(Jobs[bounces16], false);
+    Add("reference-check", "size: 2x2 against 4x4 supersampled", supersampled, super4,
+      Format("%dx%d, box-filtered from %dx%d (4x4 supersampled)", Width, Height, 4 * Width, 4 * Height),
+      Save(Jobs[super4].picture, "size-check"), false);
+    Add("reference-check", "bounces: 8 against 16", reference, bounces16,
+      Format("depth %d (auto), lod k 0, 16 bounces, shadows on, %dx%d", AutoDepth, Width, Height),
+      Save(Jobs[bounces16].picture, "bounces-check"), false);
   }
 
 private:
+  struct Job
+  {
+    Quality quality;
+    int upsample = 1, downsample = 1; // how the picture is brought to W x H
+    std::vector<double> seconds;
+    RgbImage picture;
+    double Median() const
+    {
+      std::vector<double> s = seconds;
+      std::sort(s.begin(), s.end());
+      const std::size_t m = s.size();
+      return m == 0 ? 0.0 : (m % 2 ? s[m / 2] : 0.5 * (s[m / 2 - 1] + s[m / 2]));
+    }
+  };
+
+  // The engine holding the octree of leaf depth `depth` (0: the engine's
+  // choice), built on first use.
+  Engine& EngineAt(int depth)
+  {
+    if (depth == AutoDepth && AutoDepth)
+    {
+      depth = 0;
+    }
+    for (auto& e : Engines)
+    {
+      if (e.first == depth)
+      {
+        return *e.second;
+      }
+    }
+    std::unique_ptr<Engine> engine = CreateEngine(TheBackend);
+    if (Threads > 0)
+    {
+      engine->SetThreadCount(Threads);
+    }
+    const BuildStats built = engine->Build(TheScene.points, BuildOptions{ depth });
+    if (depth == 0)
+    {
+      AutoDepth = built.depth;
+      AutoNodes = built.nodes;
+    }
+    Engines.emplace_back(depth, std::move(engine));
+    return *Engines.back().second;
+  }
+
+  std::size_t AddJob(const Quality& q, int upsample = 1, int downsample = 1)
+  {
+    Job job;
+    job.quality = q;
+    job.upsample = upsample;
+    job.downsample = downsample;
+    Jobs.push_back(job);
+    return Jobs.size() - 1;
+  }
+
+  void Render(Job& job, bool timed)
+  {
+    Image image;
+    const RenderStats stats = EngineAt(job.quality.depth).Render(MakeSettings(TheScene, job.quality), image);
+    if (timed)
+    {
+      job.seconds.push_back(stats.seconds);
+    }
+    else
+    {
+      job.picture = ToRgb(image);
+      if (job.upsample > 1)
+      {
+        job.picture = UpsampleNearest(job.picture, job.upsample);
+      }
+      if (job.downsample > 1)
+      {
+        job.picture = DownsampleBox(job.picture, job.downsample);
+      }
+    }
+  }
+
   Quality Base() const
   {
     Quality q;
     q.width = Width;
     q.height = Height;
     return q;
-  }
-
-  std::string Describe(const Quality& q) const
-  {
-    return Format("depth %d (auto), lod k 0, 8 bounces, shadows on, %dx%d", AutoDepth, q.width, q.height);
   }
 
   template <typename... Args>
@@ -352,43 +433,43 @@ private:
     {
       return "";
     }
-    const std::string name = TheScene.name + "-" + BackendName + "-" + what + ".pfm";
+    std::string name = TheScene.name + "-" + BackendName + "-" + what + ".pfm";
+    for (char& c : name)
+    {
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.')
+      {
+        c = '_';
+      }
+    }
     WritePfm(Dump + "/" + name, picture);
     return name;
   }
 
-  void Add(const std::string& knob, const std::string& value, const Frame& f, const Frame& reference,
-    const std::string& referenceName, const std::string& referenceFile, bool isReference, int width = 0,
-    int height = 0, int depth = 0)
+  void Add(const std::string& knob, const std::string& value, std::size_t job, std::size_t referenceJob,
+    const std::string& referenceName, const std::string& referenceFile, bool isReference)
   {
+    const Job& j = Jobs[job];
+    const RgbImage& reference = Jobs[referenceJob].picture;
     Row r;
     r.scene = TheScene.name;
     r.backend = BackendName;
-    r.device = TheEngine.Description();
+    r.device = EngineAt(0).Description();
     r.knob = knob;
     r.value = value;
     r.reference = referenceName;
     r.isReference = isReference;
-    r.seconds = f.seconds;
-    r.rmse = Rmse(f.picture, reference.picture);
-    r.psnr = Psnr(f.picture, reference.picture);
-    r.ssim = Ssim(f.picture, reference.picture);
-    r.width = width ? width : Width;
-    r.height = height ? height : Height;
-    r.depth = depth ? depth : AutoDepth;
+    r.seconds = j.Median();
+    r.rmse = Rmse(j.picture, reference);
+    r.psnr = Psnr(j.picture, reference);
+    r.ssim = Ssim(j.picture, reference);
+    r.width = j.quality.width;
+    r.height = j.quality.height;
+    r.depth = j.quality.depth ? j.quality.depth : AutoDepth;
     r.points = TheScene.points.count;
-    r.repeats = Repeats;
+    r.repeats = static_cast<int>(j.seconds.size());
     if (!Dump.empty())
     {
-      std::string tag = knob + "-" + value;
-      for (char& c : tag)
-      {
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.')
-        {
-          c = '_';
-        }
-      }
-      r.image = isReference ? referenceFile : Save(f.picture, tag);
+      r.image = isReference ? referenceFile : Save(j.picture, knob + "-" + value);
       r.referenceImage = referenceFile;
     }
     std::printf("| %s | %s | %.2f | %.5f | %.2f | %.5f |\n", knob.c_str(), value.c_str(), r.seconds * 1e3, r.rmse,
@@ -397,13 +478,17 @@ private:
     Rows.push_back(r);
   }
 
-  Engine& TheEngine;
+  Backend TheBackend;
+  int Threads;
   std::string BackendName;
   const Scene& TheScene;
   int Width, Height, Repeats;
   std::string Dump;
   std::vector<Row>& Rows;
+  std::vector<std::pair<int, std::unique_ptr<Engine>>> Engines;
+  std::vector<Job> Jobs;
   int AutoDepth = 0;
+  std::size_t AutoNodes = 0;
 };
 
 bool Wanted(const std::string& only, const std::string& name)
@@ -497,6 +582,12 @@ int main(int argc, char** argv)
     {
       backends.push_back(Backend::CUDA);
     }
+    else if (backend == "cuda")
+    {
+      // Asked for CUDA alone: an empty file would read as a GPU run.
+      std::fprintf(stderr, "octoray_bench_quality: CUDA not available: %s\n", why.c_str());
+      return 1;
+    }
     else
     {
       std::printf("CUDA skipped: %s\n", why.c_str());
@@ -542,16 +633,11 @@ int main(int argc, char** argv)
     std::vector<Row> rows;
     for (Backend b : backends)
     {
-      auto engine = CreateEngine(b);
-      if (threads > 0)
-      {
-        engine->SetThreadCount(threads);
-      }
-      // GPU frames take milliseconds: more repeats for the same confidence.
-      const int r = repeats > 0 ? repeats : (b == Backend::CPU ? 3 : 15);
+      // GPU frames take milliseconds: more rounds for the same confidence.
+      const int r = repeats > 0 ? repeats : (b == Backend::CPU ? 5 : 15);
       for (const Scene& s : scenes)
       {
-        SceneRun(*engine, b == Backend::CPU ? "cpu" : "cuda", s, width, height, r, dump, rows).Run();
+        SceneRun(b, threads, s, width, height, r, dump, rows).Run();
       }
     }
     if (!json.empty())
