@@ -1,16 +1,17 @@
 // octoray_bench_render: how fast the engine ray-traces, per shading and
-// blend mode, and what level of detail and the bounce limit trade in error
-// for time.
+// blend mode. (What the quality knobs trade in image error for time is
+// octoray_bench_quality's table.)
 //
 //   octoray_bench_render [--size 1920x1080] [--repeats 3] [--threads N]
 //                        [--backend cpu|cuda|all] [--lidar PATH]
-//                        [--sphere-points N] [--table-size WxH] [--json PATH]
+//                        [--sphere-points N] [--json PATH]
 //
 // Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
 // thesis's x y z r g b reflectivity refraction columns) and a synthetic
 // field of spheres (points on their surfaces, radial normals, reflectivity
 // 0.4). Mrays/s counts primary and secondary (shadow, mirror) rays; the
 // time is the median of the repeats after one warm-up frame.
+#include "BenchScenes.h"
 #include "BenchUtil.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
@@ -38,66 +39,8 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
-    "                            [--lidar PATH] [--sphere-points N] [--table-size WxH] [--json PATH]\n");
+    "                            [--lidar PATH] [--sphere-points N] [--json PATH]\n");
   return 2;
-}
-
-// Points on the surfaces of `spheres` spheres in the unit cube, their
-// count per sphere proportional to its area; radial normals.
-struct SphereField
-{
-  std::vector<double> xyz;
-  std::vector<std::uint8_t> rgb;
-  std::vector<float> normal, reflectivity;
-  PointCloudView View(bool withReflectivity, bool withNormals) const
-  {
-    PointCloudView v;
-    v.count = xyz.size() / 3;
-    v.xyzDouble = xyz.data();
-    v.color8 = rgb.data();
-    v.colorComponents = 3;
-    v.normal = withNormals ? normal.data() : nullptr;
-    v.reflectivity = withReflectivity ? reflectivity.data() : nullptr;
-    return v;
-  }
-};
-
-SphereField MakeSphereField(std::size_t points, int spheres = 48)
-{
-  Random random(kDefaultSeed);
-  std::vector<double> c(3 * spheres), r(spheres), area(spheres);
-  std::vector<std::uint8_t> colour(3 * spheres);
-  double total = 0;
-  for (int s = 0; s < spheres; ++s)
-  {
-    r[s] = 0.03 + 0.09 * random.Uniform();
-    for (int a = 0; a < 3; ++a)
-    {
-      c[3 * s + a] = r[s] + (1 - 2 * r[s]) * random.Uniform();
-      colour[3 * s + a] = static_cast<std::uint8_t>(60 + random.Next() % 196);
-    }
-    total += area[s] = r[s] * r[s];
-  }
-  SphereField f;
-  for (int s = 0; s < spheres; ++s)
-  {
-    const std::size_t n = static_cast<std::size_t>(points * area[s] / total);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      // Uniform on the sphere: z uniform in [-1, 1], angle uniform.
-      const double z = 2 * random.Uniform() - 1, phi = 6.283185307179586 * random.Uniform();
-      const double q = std::sqrt(1 - z * z);
-      const double d[3] = { q * std::cos(phi), q * std::sin(phi), z };
-      for (int a = 0; a < 3; ++a)
-      {
-        f.xyz.push_back(c[3 * s + a] + r[s] * d[a]);
-        f.normal.push_back(static_cast<float>(d[a]));
-        f.rgb.push_back(colour[3 * s + a]);
-      }
-      f.reflectivity.push_back(0.4f);
-    }
-  }
-  return f;
 }
 
 using Mode = NamedRenderMode;
@@ -145,21 +88,6 @@ double MraysPerSecond(const RenderStats& stats, double seconds)
   return static_cast<double>(stats.primaryRays + stats.secondaryRays) / seconds * 1e-6;
 }
 
-// RMSE over the premultiplied RGB of two pictures, values clamped to [0, 1].
-double Rmse(const Image& a, const Image& b)
-{
-  double sum = 0;
-  const std::size_t n = a.depth.size();
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-    {
-      const double x = std::min(1.0f, std::max(0.0f, a.rgba[4 * i + c]));
-      const double y = std::min(1.0f, std::max(0.0f, b.rgba[4 * i + c]));
-      sum += (x - y) * (x - y);
-    }
-  return std::sqrt(sum / (3.0 * n));
-}
-
 struct Scene
 {
   std::string name;
@@ -170,7 +98,7 @@ struct Scene
 
 int main(int argc, char** argv)
 {
-  int w = 1920, h = 1080, tw = 0, th = 0, repeats = 3, threads = 0;
+  int w = 1920, h = 1080, repeats = 3, threads = 0;
   std::size_t spherePoints = 1000000;
   std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json;
   for (int a = 1; a < argc; ++a)
@@ -182,11 +110,6 @@ int main(int argc, char** argv)
     if (arg == "--size")
     {
       if (std::sscanf(v, "%dx%d", &w, &h) != 2)
-        return Usage();
-    }
-    else if (arg == "--table-size")
-    {
-      if (std::sscanf(v, "%dx%d", &tw, &th) != 2)
         return Usage();
     }
     else if (arg == "--repeats")
@@ -204,8 +127,6 @@ int main(int argc, char** argv)
     else
       return Usage();
   }
-  if (tw == 0)
-    tw = w, th = h;
 
   std::vector<Backend> backends;
   if (backend == "cpu" || backend == "all")
@@ -283,41 +204,6 @@ int main(int argc, char** argv)
         std::printf("| bounces 4 + shadows asked, reflectivity attribute all 0, no lights | %.1f |\n", tz.median * 1e3);
         records.push_back(Record{ "render.spheres.everything-off", backendName + "-" + engine->Description(),
           std::size_t(w) * h, 8, ta.median, "render.spheres.plain-primary", tp.median });
-      }
-
-      // Error against time: level-of-detail threshold k and bounce limit,
-      // Phong with shadows and reflections on the sphere field, against the
-      // k = 0, 4-bounce picture.
-      {
-        engine->Build(spheres.View(true, true), BuildOptions{ 8 });
-        Mode m = kModes[4];
-        RenderSettings s = MakeSettings(spheres.View(true, true), tw, th, m, 8);
-        s.lodPixels = 0;
-        s.maxBounces = 4;
-        Image reference;
-        engine->Render(s, reference);
-        std::printf("\nerror against time (spheres, Phong + shadows + reflections, %dx%d, reference k = 0, 4 bounces):\n",
-          tw, th);
-        std::printf("| k (pixels) | bounces | ms / frame | RMSE | PSNR (dB) |\n| ---: | ---: | ---: | ---: | ---: |\n");
-        for (float k : { 0.0f, 0.5f, 1.0f, 2.0f, 4.0f, 8.0f })
-          for (int bounces : { 0, 1, 2, 4 })
-          {
-            s.lodPixels = k;
-            s.maxBounces = bounces;
-            Image image;
-            const Timing t = Measure([&] { engine->Render(s, image); }, 0, std::max(1, repeats / 2));
-            const double rmse = Rmse(image, reference);
-            if (rmse > 0)
-              std::printf("| %g | %d | %.1f | %.5f | %.1f |\n", k, bounces, t.median * 1e3, rmse,
-                20 * std::log10(1.0 / rmse));
-            else
-              std::printf("| %g | %d | %.1f | 0 | inf |\n", k, bounces, t.median * 1e3);
-            std::fflush(stdout);
-            char name[64];
-            std::snprintf(name, sizeof name, "render.spheres.lod%g.bounces%d", k, bounces);
-            records.push_back(Record{ name, backendName + "-" + engine->Description(), std::size_t(tw) * th, 8,
-              t.median, "", 0.0 });
-          }
       }
     }
     if (!json.empty())
