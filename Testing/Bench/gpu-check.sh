@@ -35,10 +35,16 @@ step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no -
 step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
 step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
 step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
+# The report's GPU rows (make report reads them from Testing/Bench/gpu/).
+# The CT scene is made here by `make report` (VTK reads the DICOM series)
+# and carried to the GPU machine as build/report/scenes/ct5n.particles.
+step quality build-gpu/bin/octoray_bench_quality --backend cuda --scenes build/report/scenes --json "$out/quality-cuda.json"
 
+{
 echo
-echo "== octoray CUDA check =="
+echo "== octoray CUDA check, $(date -u +%Y-%m-%d) =="
 grep -E "tests? (ran|from)|PASSED|FAILED" "$out/tests.log" | tail -3
 grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/memcheck-refused.log "$out"/racecheck.log "$out"/initcheck.log "$out"/synccheck.log
 grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
 printf '%s\n' "${status[@]}"
+} | tee "$out/summary.txt"
