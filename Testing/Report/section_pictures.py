@@ -81,6 +81,10 @@ def _ratio(a, b):
     return "%.1f× less" % (a / b) if a >= b else "%.1f× more" % (b / a)
 
 
+def _faster(peer, ours):
+    return "%.1f× faster" % (peer / ours) if peer >= ours else "%.1f× slower" % (ours / peer)
+
+
 def _records(data, scene):
     rows = [r for r in data["records"] if r["scene"] == scene]
     return sorted(rows, key=lambda r: (ORDER.index(r["method"]), r.get("grid") or 0))
@@ -195,7 +199,8 @@ def render(ctx):
         "octree's leaf voxels at the automatic leaf depth: cubes, lit by the renderer's headlight.\n"
         "- **vtkPointInterpolator** with a `vtkGaussianKernel` (sharpness 2; radius per scene below, at "
         "least one voxel) onto a `vtkImageData` with 128 and 256 voxels along the longest side and equal "
-        "spacing on every axis (what one sets up for a volume mapper), drawn by `vtkSmartVolumeMapper`. "
+        "spacing on every axis (what one sets up for a volume mapper; the CT scene only 128, already 8 "
+        "times finer than its 16×16×5 samples), drawn by `vtkSmartVolumeMapper`. "
         "The volume is RGBA: the interpolated colours (or the interpolated scalar through the same colour "
         "map) with the interpolator's valid-point mask as alpha; the colour of empty voxels beside a filled "
         "one is copied from it, because the ray caster interpolates colour and alpha separately and the "
@@ -208,6 +213,11 @@ def render(ctx):
         "- **vtkPointGaussianMapper** as an actor, splat radius = the scene's radius, with ParaView's "
         "\"Sphere\" splat shader (opaque lit discs; the default Gaussian blur is translucent); point "
         "colours directly or the same colour map.\n\n"
+        "Threads: ParaView 5.11's VTK on Debian defaults to the Sequential vtkSMPTools backend (one "
+        "thread). vtkPointInterpolator runs with the %s backend (%s threads), the same 2 cores as "
+        "octoray's CPU backend; vtkGaussianSplatter keeps Sequential, because with STDThread it took 65 s "
+        "instead of 0.8 s for the 200 k-point sphere field here (its threaded splat contends): each VTK "
+        "filter runs at its faster setting.\n\n"
         "*Time to first picture* starts with the points in memory and ends when the first frame is "
         "drawn (`Render()` + `WaitForCompletion()`): octree build and trace, or interpolation/splatting, "
         "texture upload, shader compilation and ray casting. *splat / interpolate* is the part before "
@@ -223,7 +233,8 @@ def render(ctx):
         "GPU the VTK methods' frames would be much faster, and octoray would use its CUDA backend. "
         "**The GPU rows are not measured**: the lent GPU machine has no VTK or ParaView, so neither "
         "octoray's CUDA mapper nor VTK's GPU ray caster can be run there."
-        % (cmd, w, h, data["frames"], _render_modes(data)))
+        % (cmd, w, h, data["frames"], data.get("smp_backend", "?"), data.get("smp_threads", "?"),
+           _render_modes(data)))
 
     csv_rows = []
     for scene in data["scenes"]:
@@ -282,10 +293,10 @@ def render(ctx):
         what = "%s-point sphere field, %d×%d, CPU (VTK in llvmpipe)" % (format(points, ","), w, h)
         summary.append(("time to first picture, " + what, _ms(octo["first_s"]),
                         "%s (vtkPointInterpolator %d + vtkSmartVolumeMapper)" % (_ms(peer["first_s"]), peer["grid"]),
-                        _ratio(peer["first_s"], octo["first_s"])))
+                        _faster(peer["first_s"], octo["first_s"])))
         summary.append(("median orbit frame, " + what, _ms(octo["frame_s"]),
                         "%s (vtkSmartVolumeMapper, %d grid)" % (_ms(peer["frame_s"]), peer["grid"]),
-                        _ratio(peer["frame_s"], octo["frame_s"])))
+                        _faster(peer["frame_s"], octo["frame_s"])))
     return Section("\n\n".join(md), summary)
 
 
