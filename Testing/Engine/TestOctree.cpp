@@ -8,49 +8,6 @@ using namespace octoray::test;
 
 using OctreeBuild = BackendTest;
 
-namespace
-{
-void BuildAndCompare(Engine& engine, const Cloud& c, int depth)
-{
-  BuildOptions options;
-  options.depth = depth;
-  const BuildStats stats = engine.Build(c.View(), options);
-  HostOctree t;
-  engine.CopyToHost(t);
-  if (depth)
-  {
-    EXPECT_EQ(t.depth, depth);
-  }
-  EXPECT_EQ(stats.depth, t.depth);
-  EXPECT_EQ(stats.nodes, t.NodeCount());
-  EXPECT_EQ(stats.points, c.Size());
-  ExpectMatchesReference(t, c);
-}
-}
-
-// The automatic depth rule (DepthChoice.h): at the chosen depth at least
-// half of the non-empty leaves hold one point, one level up fewer do, unless
-// deeper levels would separate nothing more.
-void ExpectDepthRule(const HostOctree& t, const Cloud& c)
-{
-  const auto levels = ReferenceLevels(c, t.cube, 21);
-  auto singles = [&](int l) {
-    std::size_t s = 0;
-    for (const auto& [key, node] : levels[l])
-    {
-      s += node.count == 1;
-    }
-    return s;
-  };
-  const bool separatesNothingDeeper = levels[t.depth].size() == levels[21].size();
-  EXPECT_TRUE(2 * singles(t.depth) >= levels[t.depth].size() || separatesNothingDeeper) << "depth " << t.depth;
-  if (t.depth > 1)
-  {
-    EXPECT_LT(2 * singles(t.depth - 1), levels[t.depth - 1].size()) << "depth " << t.depth;
-    EXPECT_LT(levels[t.depth - 1].size(), levels[21].size());
-  }
-}
-
 TEST_P(OctreeBuild, UniformRandom)
 {
   BuildAndCompare(*engine, UniformCloud(20000, 11), 6);
@@ -71,48 +28,11 @@ TEST_P(OctreeBuild, GaussianClusters)
   ExpectDepthRule(t, c);
 }
 
-TEST_P(OctreeBuild, PlaneAndLine)
-{
-  std::mt19937_64 rng(15);
-  std::uniform_real_distribution<double> u(-3, 3);
-  Cloud plane, line;
-  for (int i = 0; i < 5000; ++i)
-  {
-    const double a = u(rng), b = u(rng);
-    plane.Add(a, 0.25 * a + 0.5 * b, 2.0, rng); // tilted in y, flat in z
-    line.Add(a, 2 * a + 1, -a, rng);
-  }
-  BuildAndCompare(*engine, plane, 8);
-  BuildAndCompare(*engine, line, 12);
-  BuildAndCompare(*engine, line, 0);
-}
-
-TEST_P(OctreeBuild, CoincidentPoints)
-{
-  std::mt19937_64 rng(16);
-  Cloud c;
-  for (int i = 0; i < 1000; ++i)
-  {
-    c.Add(1.5, -2.5, 1e3, rng);
-  }
-  BuildAndCompare(*engine, c, 5);
-  BuildAndCompare(*engine, c, 21);
-  // Deeper levels separate nothing, so the automatic depth stops at 1.
-  BuildAndCompare(*engine, c, 0);
-  HostOctree t;
-  engine->CopyToHost(t);
-  EXPECT_EQ(t.depth, 1);
-  EXPECT_EQ(t.pointCount.back(), 1000u);
-}
-
-TEST_P(OctreeBuild, OnePointAndTwoOppositeCorners)
+// One point, coincident points, flat and collinear data and data far from
+// the origin are rows of the stability table (TestStability.cpp).
+TEST_P(OctreeBuild, TwoOppositeCorners)
 {
   std::mt19937_64 rng(17);
-  Cloud one;
-  one.Add(7, 8, 9, rng);
-  BuildAndCompare(*engine, one, 3);
-  BuildAndCompare(*engine, one, 0);
-
   Cloud two;
   two.Add(-1, -1, -1, rng);
   two.Add(1, 1, 1, rng);
@@ -127,31 +47,6 @@ TEST_P(OctreeBuild, OnePointAndTwoOppositeCorners)
   BuildAndCompare(*engine, two, 0);
   engine->CopyToHost(t);
   EXPECT_EQ(t.depth, 1);
-}
-
-TEST_P(OctreeBuild, FarFromTheOriginKeepsMillimetres)
-{
-  // A 20 x 20 x 5 grid of points 1 mm apart at 1e7 m: at depth 16 the
-  // leaves are ~0.3 mm, so every point has a leaf of its own.
-  std::mt19937_64 rng(18);
-  Cloud c;
-  for (int i = 0; i < 20; ++i)
-  {
-    for (int j = 0; j < 20; ++j)
-    {
-      for (int k = 0; k < 5; ++k)
-      {
-        c.Add(1e7 + 0.001 * i, -1e7 + 0.001 * j, 5e6 + 0.001 * k, rng);
-      }
-    }
-  }
-  BuildAndCompare(*engine, c, 16);
-  HostOctree t;
-  engine->CopyToHost(t);
-  EXPECT_EQ(t.levelBegin[17] - t.levelBegin[16], c.Size());
-  BuildAndCompare(*engine, c, 0);
-  engine->CopyToHost(t);
-  ExpectDepthRule(t, c);
 }
 
 TEST_P(OctreeBuild, EveryDepth)

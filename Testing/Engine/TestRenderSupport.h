@@ -249,4 +249,82 @@ inline BuildOptions UnitCubeOptions(int depth)
   o.cube.size = 1.0;
   return o;
 }
+
+// ---------------------------------------------------------------- scenes on the unit cube
+
+inline const double kZUp[3] = { 0, 0, 1 };
+inline const double kYUp[3] = { 0, 1, 0 };
+
+// Points with float colours and, when a test asks, normals, reflectivity
+// and scalars (each array is either complete or absent).
+struct Scene
+{
+  std::vector<double> xyz;
+  std::vector<float> rgb, normal, reflectivity, scalar;
+  bool withNormals = false, withReflectivity = false, withScalar = false;
+
+  void Add(double x, double y, double z, const float c[3], const float n[3] = nullptr, float refl = 0.0f,
+    float s = 0.0f)
+  {
+    xyz.insert(xyz.end(), { x, y, z });
+    rgb.insert(rgb.end(), { c[0], c[1], c[2] });
+    normal.insert(normal.end(), { n ? n[0] : 0.0f, n ? n[1] : 0.0f, n ? n[2] : 1.0f });
+    reflectivity.push_back(refl);
+    scalar.push_back(s);
+  }
+  // A point at the centre of cell (i, j, k) of the unit cube's grid at `level`.
+  void AddCell(int level, int i, int j, int k, const float c[3], const float n[3] = nullptr, float refl = 0.0f,
+    float s = 0.0f)
+  {
+    const double v = std::ldexp(1.0, -level);
+    Add((i + 0.5) * v, (j + 0.5) * v, (k + 0.5) * v, c, n, refl, s);
+  }
+  PointCloudView View() const
+  {
+    PointCloudView v;
+    v.count = xyz.size() / 3;
+    v.xyzDouble = xyz.data();
+    v.colorFloat = rgb.data();
+    v.colorComponents = 3;
+    v.normal = withNormals ? normal.data() : nullptr;
+    v.reflectivity = withReflectivity ? reflectivity.data() : nullptr;
+    v.scalar = withScalar ? scalar.data() : nullptr;
+    return v;
+  }
+};
+
+// Whether a ray (t >= tFrom) meets the box [lo, hi] grown by `margin` on
+// every side: +1 when it meets even the box shrunk by the margin, 0 when it
+// misses even the grown box, -1 in between (the band within `margin` of
+// the outline, where the pixel may go either way).
+inline int BoxHitWithMargin(const WorldRay& r, const double lo[3], const double hi[3], double margin, double tFrom = 0,
+  double tTo = 1)
+{
+  auto meets = [&](double m) {
+    double l[3], h[3], t0 = tFrom, t1 = tTo;
+    for (int a = 0; a < 3; ++a)
+      l[a] = lo[a] - m, h[a] = hi[a] + m;
+    return Slab(r, l, h, t0, t1);
+  };
+  if (meets(-margin))
+    return 1;
+  return meets(margin) ? -1 : 0;
+}
+
+inline double Length(const double v[3])
+{
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+inline void Normalize3(double v[3])
+{
+  const double l = Length(v);
+  for (int a = 0; a < 3; ++a)
+    v[a] /= l;
+}
+
+inline bool SameRgb(const float* pixel, const float c[3], float tol = 1e-6f)
+{
+  return std::fabs(pixel[0] - c[0]) <= tol && std::fabs(pixel[1] - c[1]) <= tol && std::fabs(pixel[2] - c[2]) <= tol;
+}
 }

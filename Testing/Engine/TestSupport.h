@@ -228,4 +228,46 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
     }
   }
 }
+
+// Builds c at `depth` (0: automatic) and checks the octree and the build
+// statistics against the brute-force reference.
+inline void BuildAndCompare(Engine& engine, const Cloud& c, int depth)
+{
+  BuildOptions options;
+  options.depth = depth;
+  const BuildStats stats = engine.Build(c.View(), options);
+  HostOctree t;
+  engine.CopyToHost(t);
+  if (depth)
+  {
+    EXPECT_EQ(t.depth, depth);
+  }
+  EXPECT_EQ(stats.depth, t.depth);
+  EXPECT_EQ(stats.nodes, t.NodeCount());
+  EXPECT_EQ(stats.points, c.Size());
+  ExpectMatchesReference(t, c);
+}
+
+// The automatic depth rule (DepthChoice.h): at the chosen depth at least
+// half of the non-empty leaves hold one point, one level up fewer do, unless
+// deeper levels would separate nothing more.
+inline void ExpectDepthRule(const HostOctree& t, const Cloud& c)
+{
+  const auto levels = ReferenceLevels(c, t.cube, 21);
+  auto singles = [&](int l) {
+    std::size_t s = 0;
+    for (const auto& [key, node] : levels[l])
+    {
+      s += node.count == 1;
+    }
+    return s;
+  };
+  const bool separatesNothingDeeper = levels[t.depth].size() == levels[21].size();
+  EXPECT_TRUE(2 * singles(t.depth) >= levels[t.depth].size() || separatesNothingDeeper) << "depth " << t.depth;
+  if (t.depth > 1)
+  {
+    EXPECT_LT(2 * singles(t.depth - 1), levels[t.depth - 1].size()) << "depth " << t.depth;
+    EXPECT_LT(levels[t.depth - 1].size(), levels[21].size());
+  }
+}
 }
