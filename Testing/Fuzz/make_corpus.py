@@ -2,7 +2,7 @@
 """Writes the seed corpus of the fuzz targets (run once; the files are
 committed). particle_text seeds carry one leading flag byte (bit 0 lenient,
 bit 1 double precision, bit 7 two threads); slice_stack seeds one byte that
-picks the extension (0 png, 1 tif, 2 bmp, 3 jpg, 4 dcm with OCTORAY_FUZZ_DICOM=1)."""
+picks the extension (0 png, 1 tif, 2 bmp, 3 jpg, 4 dcm)."""
 import gzip, os, subprocess, sys, tempfile
 
 here = os.path.dirname(os.path.abspath(__file__))
