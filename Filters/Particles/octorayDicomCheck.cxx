@@ -36,6 +36,12 @@ public:
   // Error set when the file cannot deliver them.
   bool Read(uint64_t off, void* dst, size_t n)
   {
+    if (off > this->Length || n > this->Length - off)
+    {
+      this->Error = "cannot read " + std::to_string(n) + " bytes at byte " + std::to_string(off) +
+        ": the file has " + std::to_string(this->Length);
+      return false;
+    }
     if (this->Memory)
     {
       std::memcpy(dst, this->Memory + off, n);

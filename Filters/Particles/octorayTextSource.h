@@ -107,9 +107,14 @@ public:
   std::string TruncationMessage(const std::string& name) const
   {
     struct stat now;
-    const std::string size = this->Fd >= 0 && ::fstat(this->Fd, &now) == 0
-      ? " to " + std::to_string(now.st_size) + " bytes"
-      : "";
+    std::string size;
+    if (this->Fd >= 0 && ::fstat(this->Fd, &now) == 0)
+    {
+      // Truncated and written again (a shell's `>`) by the time it is seen.
+      size = now.st_size < this->Opened.st_size
+        ? " to " + std::to_string(now.st_size) + " bytes"
+        : " (and written again, now " + std::to_string(now.st_size) + " bytes)";
+    }
     return name + ": the file was truncated" + size + " while it was being read (it had " +
       std::to_string(this->Opened.st_size) + " bytes); nothing was read (read it again)";
   }
