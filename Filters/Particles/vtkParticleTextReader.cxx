@@ -189,10 +189,9 @@ int vtkParticleTextReader::RequestData(
     ok = false;
   }
   // Truncated while mapped: the parse went on over zeros (and may have
-  // failed on them); what it found is not the file.
+  // failed on them, reported just before); what it found is not the file.
   if (source.Truncated())
   {
-    this->ErrorMessage.clear();
     this->Fail(source.TruncationMessage(this->FileName));
     ok = false;
   }
