@@ -36,21 +36,25 @@ test: build
 # LeakSanitizer on at exit) for the project's own code (CPU engine without
 # CUDA, readers, and the mappers where they exist); ParaView's libraries are
 # not instrumented. It runs the C++ tests of the engine, the readers and the
-# reliability tests, and each libFuzzer target for FUZZ_SECONDS. The Python
-# tests are not run here: the interpreter and ParaView's Python modules are
-# not instrumented (ASan would have to be preloaded into python3).
+# reliability tests, and each libFuzzer target for FUZZ_SECONDS; and the
+# Python reader suites (python.particle_reader, .slice_stack_reader,
+# .depth_and_normals) with the instrumented `octoray` modules: python3 and
+# ParaView's libraries are not instrumented, so the ASan runtime is preloaded
+# into python3 (LD_PRELOAD, set per test by Testing/Python/CMakeLists.txt),
+# with LeakSanitizer off there (the interpreter leaks by design).
 ASAN_BUILD ?= build-asan
 FUZZ_SECONDS ?= 30
 ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 # Coverage for libFuzzer in the project's code (the readers the fuzz targets
 # call), not only in the targets themselves.
 ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
-ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader \
+ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader TestDicomCheck \
   TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader octoray_fuzz_ParticleText \
-  octoray_fuzz_SliceStackMetadata
+  octoray_fuzz_SliceStackMetadata octorayFiltersParticlesPython octorayRenderingVolumePython
 test-asan: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DOCTORAY_ENABLE_CUDA=OFF -DOCTORAY_FUZZ_SECONDS=$(FUZZ_SECONDS) \
+	  -DOCTORAY_PYTHON_ASAN_PRELOAD=$$(clang++-14 -print-file-name=libclang_rt.asan-x86_64.so) \
 	  -DCMAKE_C_FLAGS="$(ASAN_FLAGS)" -DCMAKE_CXX_FLAGS="$(ASAN_CXX_FLAGS)" \
 	  -DCMAKE_EXE_LINKER_FLAGS="$(ASAN_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(ASAN_FLAGS)" $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j $(JOBS) --target $(ASAN_TARGETS)
@@ -58,7 +62,8 @@ test-asan: deps
 	  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
-	  ctest --output-on-failure -j $(JOBS) -R '^(engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|reliability\.|fuzz\.)'
+	  ctest --output-on-failure -j $(JOBS) \
+	  -R '^(engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|reliability\.|fuzz\.|python\.(particle_reader|slice_stack_reader|depth_and_normals)$$)'
 
 # The LiDAR tile's reflectivity column is the scanner's intensity (0.3-0.6):
 # taken as mirror weight it would blend every voxel with the empty sky, so

@@ -1,8 +1,16 @@
 // The bytes of a text file: memory-mapped when plain, inflated into memory
 // when gzip-compressed (recognised by its magic bytes, not its name).
 // Private to the module; not wrapped.
+//
+// Memory-mapped rather than read(): the parse makes two passes over the
+// bytes and a 10 GB file need not fit in memory. The mapping is guarded
+// (octorayMappedFileGuard.h): if another process truncates the file while
+// it is read, the vanished pages read as zeros instead of raising SIGBUS,
+// and Truncated() tells the reader to report it.
 #ifndef octorayTextSource_h
 #define octorayTextSource_h
+
+#include "octorayMappedFileGuard.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -62,6 +70,7 @@ public:
       this->Map = static_cast<const char*>(m);
       // The parse reads front to back; tell the kernel so it reads ahead.
       ::madvise(m, this->MapSize, MADV_SEQUENTIAL);
+      this->Guard.Watch(m, this->MapSize);
     }
     this->Fd = fd;
     this->Opened = st;
@@ -70,6 +79,13 @@ public:
     {
       this->Compressed = true;
       bool ok = this->Inflate(name, error);
+      if (this->Guard.Truncated())
+      {
+        error = this->TruncationMessage(name);
+        this->Inflated.clear();
+        ok = false;
+      }
+      this->Guard.Release();
       ::munmap(const_cast<char*>(this->Map), this->MapSize);
       this->Map = nullptr;
       this->MapSize = 0;
@@ -81,6 +97,26 @@ public:
       return ok;
     }
     return true;
+  }
+
+  // True when the mapped file lost pages while it was read: some of what
+  // was parsed is zeros, not the file.
+  bool Truncated() const { return this->Guard.Truncated(); }
+
+  // "<name>: the file was truncated while it was being read ..."
+  std::string TruncationMessage(const std::string& name) const
+  {
+    struct stat now;
+    std::string size;
+    if (this->Fd >= 0 && ::fstat(this->Fd, &now) == 0)
+    {
+      // Truncated and written again (a shell's `>`) by the time it is seen.
+      size = now.st_size < this->Opened.st_size
+        ? " to " + std::to_string(now.st_size) + " bytes"
+        : " (and written again, now " + std::to_string(now.st_size) + " bytes)";
+    }
+    return name + ": the file was truncated" + size + " while it was being read (it had " +
+      std::to_string(this->Opened.st_size) + " bytes); nothing was read (read it again)";
   }
 
   // True when the open file's size or modification time differ from what
@@ -104,6 +140,7 @@ public:
       ::close(this->Fd);
     }
     this->Fd = -1;
+    this->Guard.Release();
     if (this->Map)
     {
       ::munmap(const_cast<char*>(this->Map), this->MapSize);
@@ -184,6 +221,7 @@ private:
   bool Compressed = false;
   int Fd = -1;
   struct stat Opened = {};
+  MappedFileGuard Guard;
 };
 } // namespace octoray
 

@@ -188,7 +188,14 @@ int vtkParticleTextReader::RequestData(
       std::to_string(source.Size()) + " bytes");
     ok = false;
   }
-  if (ok && source.ChangedSinceOpen())
+  // Truncated while mapped: the parse went on over zeros (and may have
+  // failed on them, reported just before); what it found is not the file.
+  if (source.Truncated())
+  {
+    this->Fail(source.TruncationMessage(this->FileName));
+    ok = false;
+  }
+  else if (ok && source.ChangedSinceOpen())
   {
     this->Fail(std::string(this->FileName) +
       ": the file changed while it was being read; nothing was read (read it again)");
@@ -441,6 +448,7 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   const bool lenient = this->Lenient;
   const size_t keep = static_cast<size_t>(this->MaximumReportedLines);
   std::atomic<int> firstFailedChunk{ std::numeric_limits<int>::max() };
+  std::atomic<bool> changedBetweenPasses{ false };
   ParallelChunks(
     nchunks, threads,
     [&](int c) {
@@ -449,6 +457,10 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
       const char* ce = starts[c + 1];
       vtkIdType ln = r.FirstLine - 1;
       vtkIdType pt = r.FirstPoint;
+      // Pass 1 counted this chunk's data lines; a file written to between
+      // the passes can hold more or fewer now, and the chunk must not write
+      // into its neighbour's points (or past the arrays).
+      const vtkIdType ptEnd = r.FirstPoint + r.DataLines;
       std::vector<Real> values(ncols);
       auto bad = [&](const char* lineStart, const char* at, const std::string& what) {
         ++r.Bad;
@@ -485,6 +497,11 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
         if (q == e || *q == '#')
         {
           continue;
+        }
+        if (pt >= ptEnd)
+        {
+          changedBetweenPasses = true;
+          return;
         }
         // Tokens: numbers separated by blanks or one comma.
         int field = 0;
@@ -640,6 +657,10 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
         }
         ++pt;
       }
+      if (pt != ptEnd)
+      {
+        changedBetweenPasses = true;
+      }
     },
     [&](int done) {
       this->UpdateProgress(0.1 + 0.85 * done / nchunks);
@@ -652,6 +673,12 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   if (aborted)
   {
     this->Fail(file + ": reading was aborted");
+    return false;
+  }
+  if (changedBetweenPasses)
+  {
+    this->Fail(file +
+      ": the file changed while it was being read; nothing was read (read it again)");
     return false;
   }
 

@@ -1,5 +1,6 @@
 #include "vtkSliceStackReader.h"
 
+#include "octorayDicomCheck.h"
 #include "octorayNaturalSort.h"
 
 #include "vtkCellArray.h"
@@ -595,6 +596,13 @@ bool vtkSliceStackReader::ReadDICOM(const std::vector<std::string>& files, vtkIm
       this->Fail("DICOM slice '" + f + "' does not exist");
       return false;
     }
+    // GDCM aborts on some damaged files: their structure is checked first.
+    const std::string damage = octoray::CheckDicomStructure(f);
+    if (!damage.empty())
+    {
+      this->Fail("cannot read DICOM slice '" + f + "': " + damage);
+      return false;
+    }
     gdcm::ImageReader reader;
     reader.SetFileName(f.c_str());
     if (!reader.Read())
@@ -814,6 +822,15 @@ int vtkSliceStackReader::RequestInformation(
     if (!fs::exists(files.front(), ec))
     {
       this->Fail("DICOM slice '" + files.front() + "' does not exist");
+      return 0;
+    }
+    // GDCM aborts on some damaged files (an assert()) or allocates what a
+    // damaged length claims: the structure is checked first, without
+    // reading values.
+    const std::string damage = octoray::CheckDicomStructure(files.front());
+    if (!damage.empty())
+    {
+      this->Fail("cannot read DICOM slice '" + files.front() + "': " + damage);
       return 0;
     }
     // The header only: reading stops before the pixel data (a damaged

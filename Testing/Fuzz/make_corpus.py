@@ -2,7 +2,7 @@
 """Writes the seed corpus of the fuzz targets (run once; the files are
 committed). particle_text seeds carry one leading flag byte (bit 0 lenient,
 bit 1 double precision, bit 7 two threads); slice_stack seeds one byte that
-picks the extension (0 png, 1 tif, 2 bmp, 3 jpg, 4 dcm with OCTORAY_FUZZ_DICOM=1)."""
+picks the extension (0 png, 1 tif, 2 bmp, 3 jpg, 4 dcm)."""
 import gzip, os, subprocess, sys, tempfile
 
 here = os.path.dirname(os.path.abspath(__file__))
@@ -66,3 +66,54 @@ with tempfile.TemporaryDirectory() as tmp:
         open(os.path.join(here, "corpus/slice_stack", "seed_" + ext), "wb").write(bytes([i]) + data)
         # the reader tests' corrupt slice: a PNG signature and garbage
     open(os.path.join(here, "corpus/slice_stack/corrupt_png"), "wb").write(b"\0\x89PNG\r\n\x1a\n garbage")
+
+# DICOM in the other encodings and shapes the structure check walks (written
+# by pydicom from the bundled slice): implicit VR little endian, explicit VR
+# big endian, and nested undefined-length sequences with an undefined-length
+# UN and encapsulated (JPEG-labelled) pixel data.
+import pydicom
+from pydicom.dataset import Dataset
+from pydicom.encaps import encapsulate
+from pydicom.sequence import Sequence
+from pydicom.uid import ImplicitVRLittleEndian, ExplicitVRBigEndian, JPEGBaseline8Bit
+
+
+def dicom_seed(name, syntax, edit=None):
+    ds = pydicom.dcmread(os.path.join(root, "Data/DICOM/CT5N/2062.dcm"))
+    ds.file_meta.TransferSyntaxUID = syntax
+    ds.is_implicit_VR = syntax == ImplicitVRLittleEndian
+    ds.is_little_endian = syntax != ExplicitVRBigEndian
+    if edit:
+        edit(ds)
+    path = os.path.join(here, "corpus/slice_stack", name)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "s.dcm")
+        ds.save_as(out, write_like_original=False)
+        data = open(out, "rb").read()
+    open(path, "wb").write(b"\4" + data)
+
+
+def nested(ds):
+    inner = Dataset()
+    inner.CodeValue = "T-D1100"
+    inner.CodingSchemeDesignator = "SRT"
+    item = Dataset()
+    item.ReferencedSOPInstanceUID = ds.SOPInstanceUID
+    item.ConceptNameCodeSequence = Sequence([inner])
+    ds.ReferencedImageSequence = Sequence([item, Dataset()])
+    ds.ReferencedImageSequence.is_undefined_length = True
+    for i in ds.ReferencedImageSequence:
+        i.is_undefined_length_sequence_item = True
+    # an undefined-length UN: an implicit VR item (pydicom adds the
+    # sequence delimiter)
+    ds.add_new(0x00091010, "UN", b"\xfe\xff\x00\xe0\xff\xff\xff\xff\x09\x00\x01\x10\x02\x00\x00\x00ab"
+               b"\xfe\xff\x0d\xe0\x00\x00\x00\x00")
+    ds[0x00091010].is_undefined_length = True
+    ds.PixelData = encapsulate([b"\xff\xd8\xff\xd9"])
+    ds[0x7FE00010].VR = "OB"
+    ds[0x7FE00010].is_undefined_length = True
+
+
+dicom_seed("seed_dcm_implicit", ImplicitVRLittleEndian)
+dicom_seed("seed_dcm_bigendian", ExplicitVRBigEndian)
+dicom_seed("seed_dcm_sequences", JPEGBaseline8Bit, nested)

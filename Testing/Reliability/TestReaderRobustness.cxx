@@ -73,6 +73,9 @@ struct Progress
   std::vector<double> Values;
   double AbortAt = 2; // abort at the first progress above this
   std::string AppendTo; // append a line to this file during the read
+  std::string Truncate; // truncate this file to TruncateTo bytes at the
+  off_t TruncateTo = 0; // first progress above TruncateAbove
+  double TruncateAbove = 2;
 };
 
 void Observe(vtkAlgorithm* a, Progress& p)
@@ -91,6 +94,14 @@ void Observe(vtkAlgorithm* a, Progress& p)
     {
       std::ofstream(pr->AppendTo, std::ios::app) << "7 8 9\n";
       pr->AppendTo.clear();
+    }
+    if (!pr->Truncate.empty() && v > pr->TruncateAbove)
+    {
+      if (::truncate(pr->Truncate.c_str(), pr->TruncateTo) != 0)
+      {
+        std::perror("truncate");
+      }
+      pr->Truncate.clear();
     }
   });
   a->AddObserver(vtkCommand::ProgressEvent, cb);
@@ -215,6 +226,52 @@ int main(int argc, char* argv[])
     double pt[3];
     r->GetOutput()->GetPoint(2, pt);
     CHECK(pt[0] == 7 && pt[1] == 8 && pt[2] == 9);
+  }
+
+  // A file truncated by another writer while it is memory-mapped and
+  // parsed: its pages past the new end vanish (a bare mmap would raise
+  // SIGBUS); a clear error, the previous output kept. The truncation is
+  // done by a progress observer, so it falls at a known point: with one
+  // thread in the middle of the parse (some chunks done, the next one
+  // gone), with two threads before the worker threads have started (they
+  // are the ones that meet the vanished pages).
+  {
+    // 12 MiB of 16-byte lines: 8 chunks of 1.5 MiB with one thread.
+    std::string text;
+    for (int i = 0; text.size() < (12u << 20); ++i)
+    {
+      char line[32];
+      std::snprintf(line, sizeof(line), "%05d 1.50 2.50\n", i % 100000);
+      text += line;
+    }
+    const std::string path = Dir + "/truncated.txt";
+    for (int threads : { 1, 2 })
+    {
+      Write("truncated.txt", text);
+      vtkNew<vtkParticleTextReader> r;
+      Quiet(r);
+      r->SetFileName(good.c_str());
+      r->Update();
+      Progress p;
+      p.Truncate = path;
+      p.TruncateTo = 4096; // 256 whole lines
+      p.TruncateAbove = threads == 1 ? 0.3 : 0.0;
+      Observe(r, p);
+      r->SetNumberOfThreads(threads);
+      r->SetFileName(path.c_str());
+      r->Update();
+      CHECK(p.Truncate.empty()); // the observer did truncate
+      CHECK(std::string(r->GetErrorMessage()) ==
+        path + ": the file was truncated to 4096 bytes while it was being read (it had " +
+          std::to_string(text.size()) + " bytes); nothing was read (read it again)");
+      CHECK(r->GetOutput()->GetNumberOfPoints() == 3); // the previous output
+      double pt[3];
+      r->GetOutput()->GetPoint(2, pt);
+      CHECK(pt[0] == 7 && pt[1] == 8 && pt[2] == 10);
+      r->Update(); // the file changed: read again, what is left of it
+      CHECK(std::string(r->GetErrorMessage()).empty());
+      CHECK(r->GetOutput()->GetNumberOfPoints() == 256);
+    }
   }
 
   // A directory where a file was expected.
