@@ -4,13 +4,19 @@
 //
 //   octoray_bench_render [--size 1920x1080] [--repeats 3] [--threads N]
 //                        [--backend cpu|cuda|all] [--lidar PATH]
-//                        [--sphere-points N] [--table-size WxH] [--json PATH]
+//                        [--sphere-points N] [--table-size WxH]
+//                        [--parts modes,off,error] [--json PATH]
+//
+// --parts picks what runs: `modes` (throughput per mode and scene), `off`
+// (the everything-off frames), `error` (the level-of-detail / bounce error
+// table); default all three.
 //
 // Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
 // thesis's x y z r g b reflectivity refraction columns) and a synthetic
 // field of spheres (points on their surfaces, radial normals, reflectivity
 // 0.4). Mrays/s counts primary and secondary (shadow, mirror) rays; the
 // time is the median of the repeats after one warm-up frame.
+#include "BenchScenes.h"
 #include "BenchUtil.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
@@ -38,66 +44,9 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
-    "                            [--lidar PATH] [--sphere-points N] [--table-size WxH] [--json PATH]\n");
+    "                            [--lidar PATH] [--sphere-points N] [--table-size WxH]\n"
+    "                            [--parts modes,off,error] [--json PATH]\n");
   return 2;
-}
-
-// Points on the surfaces of `spheres` spheres in the unit cube, their
-// count per sphere proportional to its area; radial normals.
-struct SphereField
-{
-  std::vector<double> xyz;
-  std::vector<std::uint8_t> rgb;
-  std::vector<float> normal, reflectivity;
-  PointCloudView View(bool withReflectivity, bool withNormals) const
-  {
-    PointCloudView v;
-    v.count = xyz.size() / 3;
-    v.xyzDouble = xyz.data();
-    v.color8 = rgb.data();
-    v.colorComponents = 3;
-    v.normal = withNormals ? normal.data() : nullptr;
-    v.reflectivity = withReflectivity ? reflectivity.data() : nullptr;
-    return v;
-  }
-};
-
-SphereField MakeSphereField(std::size_t points, int spheres = 48)
-{
-  Random random(kDefaultSeed);
-  std::vector<double> c(3 * spheres), r(spheres), area(spheres);
-  std::vector<std::uint8_t> colour(3 * spheres);
-  double total = 0;
-  for (int s = 0; s < spheres; ++s)
-  {
-    r[s] = 0.03 + 0.09 * random.Uniform();
-    for (int a = 0; a < 3; ++a)
-    {
-      c[3 * s + a] = r[s] + (1 - 2 * r[s]) * random.Uniform();
-      colour[3 * s + a] = static_cast<std::uint8_t>(60 + random.Next() % 196);
-    }
-    total += area[s] = r[s] * r[s];
-  }
-  SphereField f;
-  for (int s = 0; s < spheres; ++s)
-  {
-    const std::size_t n = static_cast<std::size_t>(points * area[s] / total);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      // Uniform on the sphere: z uniform in [-1, 1], angle uniform.
-      const double z = 2 * random.Uniform() - 1, phi = 6.283185307179586 * random.Uniform();
-      const double q = std::sqrt(1 - z * z);
-      const double d[3] = { q * std::cos(phi), q * std::sin(phi), z };
-      for (int a = 0; a < 3; ++a)
-      {
-        f.xyz.push_back(c[3 * s + a] + r[s] * d[a]);
-        f.normal.push_back(static_cast<float>(d[a]));
-        f.rgb.push_back(colour[3 * s + a]);
-      }
-      f.reflectivity.push_back(0.4f);
-    }
-  }
-  return f;
 }
 
 using Mode = NamedRenderMode;
@@ -172,7 +121,7 @@ int main(int argc, char** argv)
 {
   int w = 1920, h = 1080, tw = 0, th = 0, repeats = 3, threads = 0;
   std::size_t spherePoints = 1000000;
-  std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json;
+  std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json, parts = "modes,off,error";
   for (int a = 1; a < argc; ++a)
   {
     const std::string arg = argv[a];
@@ -199,6 +148,8 @@ int main(int argc, char** argv)
       lidar = v;
     else if (arg == "--sphere-points")
       spherePoints = std::strtoull(v, nullptr, 10);
+    else if (arg == "--parts")
+      parts = v;
     else if (arg == "--json")
       json = v;
     else
@@ -206,6 +157,8 @@ int main(int argc, char** argv)
   }
   if (tw == 0)
     tw = w, th = h;
+  parts = "," + parts + ",";
+  const auto wanted = [&](const char* part) { return parts.find(std::string(",") + part + ",") != std::string::npos; };
 
   std::vector<Backend> backends;
   if (backend == "cpu" || backend == "all")
@@ -235,6 +188,8 @@ int main(int argc, char** argv)
         repeats);
       for (const Scene& scene : scenes)
       {
+        if (!wanted("modes"))
+          break;
         BuildOptions options;
         options.depth = scene.depth;
         const BuildStats build = engine->Build(scene.points, options);
@@ -251,14 +206,21 @@ int main(int argc, char** argv)
           std::printf("| %s | %.1f | %.2f | %.2f | %.2f |\n", m.name, t.median * 1e3, MraysPerSecond(stats, t.median),
             stats.primaryRays / t.median * 1e-6, double(stats.secondaryRays) / stats.primaryRays);
           std::fflush(stdout);
-          records.push_back(Record{ "render." + scene.name + "." + m.name, backendName + "-" + engine->Description(),
-            std::size_t(w) * h, build.depth, t.median, "", 0.0 });
+          Record r{ "render." + scene.name + "." + m.name, backendName + "-" + engine->Description(),
+            std::size_t(w) * h, build.depth, t.median, "", 0.0 };
+          r.With("primary_rays", double(stats.primaryRays))
+            .With("secondary_rays", double(stats.secondaryRays))
+            .With("min_seconds", t.min)
+            .With("points", double(build.points))
+            .With("nodes", double(build.nodes));
+          records.push_back(r);
         }
       }
 
       // Everything off: the sphere field without reflectivity, rendered
       // with settings that ask for bounces and shadows but give no light,
       // against the plain primary-ray path (flat, nothing asked for).
+      if (wanted("off"))
       {
         const PointCloudView plainPoints = spheres.View(false, true);
         engine->Build(plainPoints, BuildOptions{ 8 });
@@ -288,6 +250,7 @@ int main(int argc, char** argv)
       // Error against time: level-of-detail threshold k and bounce limit,
       // Phong with shadows and reflections on the sphere field, against the
       // k = 0, 4-bounce picture.
+      if (wanted("error"))
       {
         engine->Build(spheres.View(true, true), BuildOptions{ 8 });
         Mode m = kModes[4];
