@@ -12,7 +12,9 @@
 //
 //   octoray_bench_peers [--cases uniform:1e6,uniform:1e7,clustered:1e6]
 //                       [--depth 0] [--threads N] [--repeats 5]
-//                       [--peer-repeats 3] [--json PATH]
+//                       [--peer-repeats 3] [--octree-locator-max N] [--json PATH]
+// --octree-locator-max: leave vtkOctreePointLocator out of cases with more
+// than N points (about a minute per build at 10 M on 2 cores).
 #include "BenchUtil.h"
 
 #include <octoray/Engine.h>
@@ -45,7 +47,7 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: octoray_bench_peers [--cases SET:N[,SET:N...]] [--depth L (0: automatic)] [--threads N]\n"
-    "                           [--repeats R] [--peer-repeats R] [--json PATH]\n"
+    "                           [--repeats R] [--peer-repeats R] [--octree-locator-max N] [--json PATH]\n"
     "  SET is uniform or clustered; N may be written 1e7\n");
   return 2;
 }
@@ -75,6 +77,7 @@ struct Row
   std::string backend; // octoray's configuration this peer is compared with
   Timing timing;
   std::string note;
+  double leaves = 0; // the peer's leaves or buckets, for the report
 };
 }
 
@@ -85,6 +88,7 @@ int main(int argc, char** argv)
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   int repeats = 5;
   int peerRepeats = 3;
+  double octreeLocatorMax = 1e300;
   std::string json;
   for (int a = 1; a < argc; ++a)
   {
@@ -129,6 +133,10 @@ int main(int argc, char** argv)
     else if (arg == "--peer-repeats")
     {
       peerRepeats = std::max(1, std::atoi(value.c_str()));
+    }
+    else if (arg == "--octree-locator-max")
+    {
+      octreeLocatorMax = std::strtod(value.c_str(), nullptr);
     }
     else if (arg == "--json")
     {
@@ -238,7 +246,7 @@ int main(int argc, char** argv)
       char pclNote[160];
       std::snprintf(pclNote, sizeof pclNote, "depth %u, %zu leaves, %zu branches: %s", pclDepth, pclLeaves,
         pclBranches, same ? "same tree as octoray" : "DIFFERS from octoray");
-      rows.push_back(Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), pcl, pclNote });
+      rows.push_back(Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), pcl, pclNote, double(pclLeaves) });
       pclCloud.reset();
 
       // VTK locators read a vtkPolyData's points; wrap our array, no copy.
@@ -250,26 +258,33 @@ int main(int argc, char** argv)
       vtkNew<vtkPolyData> polyData;
       polyData->SetPoints(points);
 
-      vtkSmartPointer<vtkOctreePointLocator> octreeLocator;
-      int vtkLeaves = 0;
-      vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
-      const Timing vtkOctree = MeasureFresh(
-        [&] {
-          octreeLocator = vtkSmartPointer<vtkOctreePointLocator>::New();
-          octreeLocator->SetDataSet(polyData);
-          octreeLocator->SetMaximumPointsPerRegion(perRegion);
-          octreeLocator->BuildLocator();
-        },
-        [&] {
-          vtkLeaves = octreeLocator->GetNumberOfLeafNodes();
-          octreeLocator = nullptr;
-        },
-        // About a minute per build at 10 M points on this 2-core machine.
-        0, n >= 5000000 ? 1 : peerRepeats);
-      char octreeNote[160];
-      std::snprintf(octreeNote, sizeof octreeNote, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
-        perRegion, meanPerLeaf, vtkLeaves);
-      rows.push_back(Row{ "vtkOctreePointLocator", CpuBackendName(1), vtkOctree, octreeNote });
+      if (double(n) <= octreeLocatorMax)
+      {
+        vtkSmartPointer<vtkOctreePointLocator> octreeLocator;
+        int vtkLeaves = 0;
+        vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
+        const Timing vtkOctree = MeasureFresh(
+          [&] {
+            octreeLocator = vtkSmartPointer<vtkOctreePointLocator>::New();
+            octreeLocator->SetDataSet(polyData);
+            octreeLocator->SetMaximumPointsPerRegion(perRegion);
+            octreeLocator->BuildLocator();
+          },
+          [&] {
+            vtkLeaves = octreeLocator->GetNumberOfLeafNodes();
+            octreeLocator = nullptr;
+          },
+          // About a minute per build at 10 M points on this 2-core machine.
+          0, n >= 5000000 ? 1 : peerRepeats);
+        char octreeNote[160];
+        std::snprintf(octreeNote, sizeof octreeNote, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
+          perRegion, meanPerLeaf, vtkLeaves);
+        rows.push_back(Row{ "vtkOctreePointLocator", CpuBackendName(1), vtkOctree, octreeNote, double(vtkLeaves) });
+      }
+      else
+      {
+        std::printf("vtkOctreePointLocator left out: %zu points > --octree-locator-max %.0f\n", n, octreeLocatorMax);
+      }
 
       for (int t = 0; t < (threads > 1 ? 2 : 1); ++t)
       {
@@ -292,7 +307,8 @@ int main(int argc, char** argv)
         char staticNote[160];
         std::snprintf(staticNote, sizeof staticNote, "NumberOfPointsPerBucket %d: %dx%dx%d buckets, %d SMP threads",
           perRegion, divisions[0], divisions[1], divisions[2], vtkSMPTools::GetEstimatedNumberOfThreads());
-        rows.push_back(Row{ "vtkStaticPointLocator", CpuBackendName(threadCounts[t]), vtkStatic, staticNote });
+        rows.push_back(Row{ "vtkStaticPointLocator", CpuBackendName(threadCounts[t]), vtkStatic, staticNote,
+          double(divisions[0]) * divisions[1] * divisions[2] });
       }
       vtkSMPTools::Initialize(0);
 
@@ -320,6 +336,17 @@ int main(int argc, char** argv)
           r.seconds = mine.median;
           r.peer = row.what;
           r.peerSeconds = row.timing.median;
+          r.With("min_seconds", mine.min)
+            .With("peer_min_seconds", row.timing.min)
+            .With("peer_runs", row.timing.repeats)
+            .With("leaves", double(leaves))
+            .With("branches", double(branches))
+            .With("peer_leaves", row.leaves)
+            .With("engine_bytes", double(engineBytes));
+          if (row.what == "pcl::octree::OctreePointCloudPointVector")
+          {
+            r.With("same_tree", same ? 1.0 : 0.0);
+          }
           records.push_back(r);
         }
       }
