@@ -224,7 +224,7 @@ def _plot_peers(png, plot, nthreads):
               ("vtkStaticPointLocator %s threads" % nthreads, 6, "#98df8a")]
     x = np.arange(len(plot))
     width = 0.8 / len(series)
-    fig, ax = plt.subplots(figsize=(8, 4.2))
+    fig, ax = plt.subplots(figsize=(8, 4.8))
     for k, (name, i, colour) in enumerate(series):
         values = [p[i] if p[i] else np.nan for p in plot]
         ax.bar(x + (k - len(series) / 2 + 0.5) * width, values, width, label=name, color=colour)
@@ -233,7 +233,7 @@ def _plot_peers(png, plot, nthreads):
     ax.set_yscale("log")
     ax.set_ylabel("build time, s (log)")
     ax.set_title("Octree / locator build from the same points, one run (median)")
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.14))
     ax.grid(axis="y", which="both", alpha=0.3)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
@@ -448,9 +448,9 @@ octoray: median of {peer_repeats} after 1 warm-up. PCL and vtkOctreePointLocator
 octoray's mean points per leaf rounded up; vtkStaticPointLocator the same NumberOfPointsPerBucket. Ratio = peer time
 / octoray time with the same thread count; for PCL it is the median over its builds of PCL's time / the time of a
 single-threaded octoray build run right after it (with glibc's free lists consolidated in between, untimed), so that
-load drifting on this shared machine between the octoray block and the PCL block does not move it. vtkOctreePointLocator is left out above {octl} points: it takes about a
-minute per 10 M build on this machine, more than the report's time budget allows
-(`octoray_bench_peers --cases uniform:1e7` measures it).
+load drifting on this shared machine between the octoray block and the PCL block does not move it.
+vtkOctreePointLocator is left out above {octl} points: it takes about a minute per 10 M build on this machine, more
+than the report's time budget allows (`octoray_bench_peers --cases uniform:1e7` measures it).
 
 {peers}
 

@@ -118,7 +118,7 @@ def _plot(png, plot):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 0.5 + 0.45 * len(plot)))
+    fig, ax = plt.subplots(figsize=(7, 1.2 + 0.45 * len(plot)))
     names = [p[0] for p in plot]
     ax.barh(range(len(plot)), [p[1] for p in plot], color=["#1f77b4" if n.startswith("octoray") else "#999999"
                                                             for n in names])

@@ -123,9 +123,11 @@ def _plot(png, plot, cpu_name):
     for ax, scene in zip(axes[0], scenes):
         rows = [p for p in plot if p[0] == scene]
         y = np.arange(len(rows))
-        ax.barh(y, [p[2] for p in rows], color="#1f77b4", label=cpu_name)
-        if any(p[3] for p in rows):
-            ax.barh(y + 0.4, [p[3] or np.nan for p in rows], height=0.4, color="#d62728", label="CUDA")
+        with_gpu = any(p[3] for p in rows)
+        h = 0.4 if with_gpu else 0.8
+        ax.barh(y - (h / 2 if with_gpu else 0), [p[2] for p in rows], height=h, color="#1f77b4", label=cpu_name)
+        if with_gpu:
+            ax.barh(y + h / 2, [p[3] or np.nan for p in rows], height=h, color="#d62728", label="CUDA")
             ax.set_xscale("log")
         ax.set_yticks(y)
         ax.set_yticklabels([p[1] for p in rows])
@@ -133,7 +135,7 @@ def _plot(png, plot, cpu_name):
         ax.set_xlabel("Mrays/s (primary + secondary)")
         ax.set_title("scene: " + scene)
         ax.grid(axis="x", alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)
