@@ -35,6 +35,7 @@ def _who(backend):
         "octoray-vtkSliceStackReader": "octoray vtkSliceStackReader",
         "vtkPNGReader+vtkThreshold": "vtkPNGReader + vtkThreshold",
         "vtkPNGReader+vtkThresholdPoints": "vtkPNGReader + vtkThresholdPoints",
+        "pandas-pyarrow": "pandas read_csv (pyarrow engine)",
     }
     if backend in names:
         return names[backend]
@@ -54,7 +55,8 @@ def render(ctx):
     for r in records:
         if r["name"] == "reader/particle_text":
             if r.get("mb_per_s") is None:
-                text_rows.append([_who(r["backend"]), "–", "–", "–", "–", "–", r.get("note", "")])
+                text_rows.append([_who(r["backend"]) + ": not measured, " + r.get("note", ""), "–", "–", "–", "–",
+                                  "–", "–"])
                 continue
             speedup = octo["mb_per_s"] / r["mb_per_s"] if octo else None
             text_rows.append([_who(r["backend"]), "%.0f" % (r["bytes"] / 1e6), count(r["n"]),
