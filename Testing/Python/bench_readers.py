@@ -30,14 +30,27 @@ import octoray
 from vtk.util.numpy_support import numpy_to_vtk
 
 
-def best_of(fn, repeats):
+class Timing:
+    def __init__(self, times):
+        self.median = float(np.median(times))
+        self.min = min(times)
+        self.runs = len(times)
+
+    def fields(self):
+        return dict(seconds=self.median, min_seconds=self.min, runs=self.runs)
+
+
+def timed(fn, repeats):
+    """Runs fn `repeats` times: (Timing, result). Records give the median, not
+    the best run: on a shared machine one lucky or unlucky run must not be the
+    figure; the fastest is kept beside it."""
     times = []
     result = None
     for _ in range(repeats):
         t = time.perf_counter()
         result = fn()
         times.append(time.perf_counter() - t)
-    return min(times), result
+    return Timing(times), result
 
 
 def make_particle_file(path, target_bytes):
@@ -95,13 +108,13 @@ def bench_particles(workdir, mb, vtk_mb, repeats):
         r.Update()
         return r.GetOutput().GetNumberOfPoints()
 
-    secs, n = best_of(lambda: octo(0), repeats)
+    t, n = timed(lambda: octo(0), repeats)
     records.append(dict(name="reader/particle_text", backend="octoray-%dthreads" % cores, n=n,
-                        bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
+                        bytes=size, mb_per_s=size / 1e6 / t.median, **t.fields()))
     octo_all = records[-1]
-    secs1, _ = best_of(lambda: octo(1), 1)
+    t1, _ = timed(lambda: octo(1), 1)
     records.append(dict(name="reader/particle_text", backend="octoray-1thread", n=n, bytes=size,
-                        seconds=secs1, mb_per_s=size / 1e6 / secs1))
+                        mb_per_s=size / 1e6 / t1.median, **t1.fields()))
 
     import pandas as pd
 
@@ -110,29 +123,29 @@ def bench_particles(workdir, mb, vtk_mb, repeats):
         df = pd.read_csv(path, sep=" ", skiprows=1, header=None, engine=engine)
         return len(df)
 
-    secs, m = best_of(lambda: pandas_read("c"), 1)
+    t, m = timed(lambda: pandas_read("c"), 1)
     assert m == n, (m, n)
     records.append(dict(name="reader/particle_text", backend="pandas-%s-c" % pd.__version__, n=n,
-                        bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
+                        bytes=size, mb_per_s=size / 1e6 / t.median, **t.fields()))
     try:
         import pyarrow  # noqa: F401
         import pyarrow.csv as pacsv
-        secs, m = best_of(lambda: pandas_read("pyarrow"), 1)
+        t, m = timed(lambda: pandas_read("pyarrow"), 1)
         assert m == n, (m, n)
         records.append(dict(name="reader/particle_text",
                             backend="pandas-%s-pyarrow-%s" % (pd.__version__, pyarrow.__version__),
-                            n=n, bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
+                            n=n, bytes=size, mb_per_s=size / 1e6 / t.median, **t.fields()))
 
         def arrow_read():
             return pacsv.read_csv(path, read_options=pacsv.ReadOptions(
                 skip_rows=1, autogenerate_column_names=True),
                 parse_options=pacsv.ParseOptions(delimiter=" ")).num_rows
 
-        secs, m = best_of(arrow_read, repeats)
+        t, m = timed(arrow_read, repeats)
         assert m == n, (m, n)
         records.append(dict(name="reader/particle_text",
                             backend="pyarrow-%s-csv" % pyarrow.__version__,
-                            n=n, bytes=size, seconds=secs, mb_per_s=size / 1e6 / secs))
+                            n=n, bytes=size, mb_per_s=size / 1e6 / t.median, **t.fields()))
     except ImportError:
         records.append(dict(name="reader/particle_text", backend="pandas-pyarrow", n=n,
                             bytes=size, seconds=None, mb_per_s=None,
@@ -156,10 +169,10 @@ def bench_particles(workdir, mb, vtk_mb, repeats):
         t2p.Update()
         return t2p.GetOutput().GetNumberOfPoints()
 
-    secs, m = best_of(vtk_read, 1)
+    t, m = timed(vtk_read, 1)
     records.append(dict(name="reader/particle_text",
                         backend="vtkDelimitedTextReader+vtkTableToPolyData", n=m, bytes=psize,
-                        seconds=secs, mb_per_s=psize / 1e6 / secs,
+                        mb_per_s=psize / 1e6 / t.median, **t.fields(),
                         note="first %d MB of the same file" % vtk_mb))
     for r in records:
         if r is not octo_all and r.get("mb_per_s"):
@@ -197,9 +210,9 @@ def bench_slices(workdir, slices, size, repeats):
         r.Update()
         return r.GetOutput().GetNumberOfPoints()
 
-    secs, n = best_of(octo, repeats)
+    t, n = timed(octo, repeats)
     octo_rec = dict(name="reader/slice_stack", backend="octoray-vtkSliceStackReader", n=n,
-                    voxels=slices * size * size, seconds=secs)
+                    voxels=slices * size * size, **t.fields())
     records.append(octo_rec)
 
     # The names and the reader must outlive the pipeline's Update: with only
@@ -235,11 +248,11 @@ def bench_slices(workdir, slices, size, repeats):
 
     for label, fn in (("vtkPNGReader+vtkThreshold", vtk_threshold),
                       ("vtkPNGReader+vtkThresholdPoints", vtk_threshold_points)):
-        secs, m = best_of(fn, repeats)
+        t, m = timed(fn, repeats)
         records.append(dict(name="reader/slice_stack", backend=label, n=m,
-                            voxels=slices * size * size, seconds=secs,
+                            voxels=slices * size * size,
                             peer=octo_rec["backend"], peer_seconds=octo_rec["seconds"],
-                            octoray_speedup=secs / octo_rec["seconds"]))
+                            octoray_speedup=t.median / octo_rec["seconds"], **t.fields()))
     return records
 
 

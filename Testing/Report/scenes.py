@@ -33,6 +33,11 @@ def python_dir(build):
     raise RuntimeError(f"no octoray Python package under {build}/lib (build the project first)")
 
 
+def python_env(ctx):
+    """The environment in which /usr/bin/python3 finds the build tree's `octoray` package."""
+    return {"PYTHONPATH": python_dir(ctx.build), "VTK_LOGGING_LEVEL": "ERROR"}
+
+
 def ct_particles(ctx):
     """build/report/scenes/ct5n.particles: the CT series as points (x y z
     HU), air removed. Written by this file run as a program, through
@@ -40,8 +45,7 @@ def ct_particles(ctx):
     out = os.path.join(scenes_dir(ctx), "ct5n.particles")
     if not os.path.exists(out) or "scene-ct5n" not in ctx.commands:
         os.makedirs(os.path.dirname(out), exist_ok=True)
-        ctx.run("scene-ct5n", [sys.executable, os.path.abspath(__file__), "ct5n", out],
-                env={"PYTHONPATH": python_dir(ctx.build), "VTK_LOGGING_LEVEL": "ERROR"})
+        ctx.run("scene-ct5n", [sys.executable, os.path.abspath(__file__), "ct5n", out], env=python_env(ctx))
     return out
 
 

@@ -11,6 +11,8 @@
 #include <octoray/Frame.h>
 #include <octoray/Morton.h>
 
+#include "BenchScenes.h"
+
 #include <cub/device/device_radix_sort.cuh>
 
 #include <algorithm>
@@ -50,22 +52,7 @@ double TimeMedian(int repeats, const std::function<void()>& work)
 
 // Gaussian clusters with colours and reflectivity: a cloud like scanned or
 // simulated data, not uniform noise.
-struct Cloud
-{
-  std::vector<float> xyz;
-  std::vector<std::uint8_t> rgb;
-  std::vector<float> reflectivity;
-  PointCloudView View() const
-  {
-    PointCloudView v;
-    v.count = xyz.size() / 3;
-    v.xyzFloat = xyz.data();
-    v.color8 = rgb.data();
-    v.colorComponents = 3;
-    v.reflectivity = reflectivity.data();
-    return v;
-  }
-};
+using Cloud = bench::ColouredCloud;
 
 Cloud MakeCloud(std::size_t n, std::uint64_t seed)
 {
@@ -149,36 +136,7 @@ double SortFloorSeconds(const Cloud& c, int bits)
 
 RenderSettings Camera(const HostOctree& t, int w, int h)
 {
-  // Looking at the cube's centre from outside, 30 degrees vertical view.
-  const double c[3] = { t.cube.origin[0] + t.cube.size / 2, t.cube.origin[1] + t.cube.size / 2,
-    t.cube.origin[2] + t.cube.size / 2 };
-  const double eye[3] = { c[0] + 1.2 * t.cube.size, c[1] - 1.5 * t.cube.size, c[2] + 0.8 * t.cube.size };
-  double f[3] = { c[0] - eye[0], c[1] - eye[1], c[2] - eye[2] };
-  double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  for (double& v : f)
-    v /= fl;
-  const double up[3] = { 0, 0, 1 };
-  double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
-  double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-  for (double& v : s)
-    v /= sl;
-  const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
-  const double view[16] = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
-    -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2], f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2],
-    0, 0, 0, 1 };
-  const double zn = 0.1 * t.cube.size, zf = 10 * t.cube.size, tn = 1 / std::tan(15 * M_PI / 180), aspect = double(w) / h;
-  const double proj[16] = { tn / aspect, 0, 0, 0, 0, tn, 0, 0, 0, 0, -(zf + zn) / (zf - zn), -2 * zf * zn / (zf - zn), 0,
-    0, -1, 0 };
-  double vp[16] = {};
-  for (int r = 0; r < 4; ++r)
-    for (int col = 0; col < 4; ++col)
-      for (int k = 0; k < 4; ++k)
-        vp[4 * r + col] += proj[4 * r + k] * view[4 * k + col];
-  RenderSettings rs;
-  rs.width = w;
-  rs.height = h;
-  Invert4x4(vp, rs.inverseViewProjection);
-  return rs;
+  return bench::CubeCamera(t.cube, w, h);
 }
 
 struct Record
@@ -189,6 +147,9 @@ struct Record
   double seconds;
   std::string peer;
   double peerSeconds;
+  // Further figures of the same measurement, written as extra members
+  // (the report reads them; see BenchUtil.h's Record::extra).
+  std::vector<std::pair<std::string, double>> extra = {};
 };
 }
 
@@ -252,7 +213,9 @@ int Run(int argc, char** argv)
                   "sort %.3f ms, ratio %.2f, %zu nodes, %.1f GPU bytes/point\n",
         n, depth, t * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3, last.levelSeconds * 1e3, floor * 1e3,
         t / floor, last.nodes, bytesPerPoint);
-      records.push_back({ "octree build", n, depth, t, "cub radix sort", floor });
+      records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
+        { { "key_seconds", last.keySeconds }, { "sort_seconds", last.sortSeconds },
+          { "level_seconds", last.levelSeconds }, { "nodes", double(last.nodes) } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0 });
     }
     if (n == 10000000)
@@ -367,22 +330,9 @@ int Run(int argc, char** argv)
   // A fresh engine, so that buffers kept from the 100 M builds above do not
   // count in its memory.
   engine = CreateEngine(Backend::CUDA);
-  for (std::size_t n : { 30641ul, 303374ul, 951879ul, 1076596ul, 3283639ul })
+  for (std::size_t n : bench::ThesisTable2Counts())
   {
-    // Grid spacing such that the ellipsoid (semi-axes 1, 0.8, 0.6) holds
-    // about n points; the first n in slice order are kept.
-    const double volume = 4.0 / 3.0 * M_PI * 1.0 * 0.8 * 0.6;
-    const double h = std::cbrt(volume / (n * 1.02));
-    Cloud c;
-    for (double z = -0.6; z <= 0.6 && c.xyz.size() < 3 * n; z += h)
-      for (double y = -0.8; y <= 0.8 && c.xyz.size() < 3 * n; y += h)
-        for (double x = -1.0; x <= 1.0 && c.xyz.size() < 3 * n; x += h)
-          if (x * x + y * y / 0.64 + z * z / 0.36 <= 1.0)
-          {
-            c.xyz.insert(c.xyz.end(), { float(x), float(y), float(z) });
-            c.rgb.insert(c.rgb.end(), { 200, 180, 160 });
-            c.reflectivity.push_back(0.0f);
-          }
+    const Cloud c = bench::ThesisSliceStack(n);
     const std::size_t count = c.xyz.size() / 3;
     BuildOptions o;
     o.depth = 7;
@@ -403,7 +353,8 @@ int Run(int argc, char** argv)
     const double trace = Median(frames);
     std::printf("  %zu points: build %.2f ms, trace %.3f ms/image, %.1f MB\n", count, build * 1e3, trace * 1e3,
       engine->Memory().Total() / 1e6);
-    records.push_back({ "thesis table 2 build", count, 7, build, "", 0 });
+    records.push_back({ "thesis table 2 build", count, 7, build, "", 0,
+      { { "bytes", double(engine->Memory().Total()) } } });
     records.push_back({ "thesis table 2 trace 800x600", count, 7, trace, "", 0 });
   }
 
@@ -415,8 +366,10 @@ int Run(int argc, char** argv)
     {
       const Record& r = records[i];
       out << "  {\"name\": \"" << r.name << "\", \"backend\": \"CUDA\", \"n\": " << r.n << ", \"depth\": " << r.depth
-          << ", \"seconds\": " << r.seconds << ", \"peer\": \"" << r.peer << "\", \"peer_seconds\": " << r.peerSeconds
-          << "}" << (i + 1 < records.size() ? "," : "") << "\n";
+          << ", \"seconds\": " << r.seconds << ", \"peer\": \"" << r.peer << "\", \"peer_seconds\": " << r.peerSeconds;
+      for (const auto& e : r.extra)
+        out << ", \"" << e.first << "\": " << e.second;
+      out << "}" << (i + 1 < records.size() ? "," : "") << "\n";
     }
     out << "]\n";
   }

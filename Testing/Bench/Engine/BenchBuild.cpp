@@ -233,6 +233,15 @@ int main(int argc, char** argv)
           r.n = n;
           r.depth = s.depth;
           r.seconds = run.timing.median;
+          r.With("min_seconds", run.timing.min)
+            .With("leaves", double(leaves))
+            .With("nodes", double(s.nodes))
+            .With("key_seconds", run.keySeconds)
+            .With("sort_seconds", run.sortSeconds)
+            .With("level_seconds", run.levelSeconds)
+            .With("engine_bytes", double(run.engineBytes))
+            .With("node_bytes", double(run.nodeBytes))
+            .With("dense_skeleton_bytes", DenseSkeletonBytes(s.depth));
           if (single && &run != single)
           {
             // Speed-ups are read against the single-threaded CPU build.

@@ -4,7 +4,11 @@
 //
 //   octoray_bench_render [--size 1920x1080] [--repeats 3] [--threads N]
 //                        [--backend cpu|cuda|all] [--lidar PATH]
-//                        [--sphere-points N] [--json PATH]
+//                        [--sphere-points N] [--parts modes,off] [--json PATH]
+//
+// --parts picks what runs: `modes` (throughput per mode and scene), `off`
+// (the everything-off frames); default both. Image error against time is
+// octoray_bench_quality's.
 //
 // Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
 // thesis's x y z r g b reflectivity refraction columns) and a synthetic
@@ -39,7 +43,7 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
-    "                            [--lidar PATH] [--sphere-points N] [--json PATH]\n");
+    "                            [--lidar PATH] [--sphere-points N] [--parts modes,off] [--json PATH]\n");
   return 2;
 }
 
@@ -100,7 +104,7 @@ int main(int argc, char** argv)
 {
   int w = 1920, h = 1080, repeats = 3, threads = 0;
   std::size_t spherePoints = 1000000;
-  std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json;
+  std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json, parts = "modes,off";
   for (int a = 1; a < argc; ++a)
   {
     const std::string arg = argv[a];
@@ -122,11 +126,15 @@ int main(int argc, char** argv)
       lidar = v;
     else if (arg == "--sphere-points")
       spherePoints = std::strtoull(v, nullptr, 10);
+    else if (arg == "--parts")
+      parts = v;
     else if (arg == "--json")
       json = v;
     else
       return Usage();
   }
+  parts = "," + parts + ",";
+  const auto wanted = [&](const char* part) { return parts.find(std::string(",") + part + ",") != std::string::npos; };
 
   std::vector<Backend> backends;
   if (backend == "cpu" || backend == "all")
@@ -156,6 +164,8 @@ int main(int argc, char** argv)
         repeats);
       for (const Scene& scene : scenes)
       {
+        if (!wanted("modes"))
+          break;
         BuildOptions options;
         options.depth = scene.depth;
         const BuildStats build = engine->Build(scene.points, options);
@@ -172,14 +182,21 @@ int main(int argc, char** argv)
           std::printf("| %s | %.1f | %.2f | %.2f | %.2f |\n", m.name, t.median * 1e3, MraysPerSecond(stats, t.median),
             stats.primaryRays / t.median * 1e-6, double(stats.secondaryRays) / stats.primaryRays);
           std::fflush(stdout);
-          records.push_back(Record{ "render." + scene.name + "." + m.name, backendName + "-" + engine->Description(),
-            std::size_t(w) * h, build.depth, t.median, "", 0.0 });
+          Record r{ "render." + scene.name + "." + m.name, backendName + "-" + engine->Description(),
+            std::size_t(w) * h, build.depth, t.median, "", 0.0 };
+          r.With("primary_rays", double(stats.primaryRays))
+            .With("secondary_rays", double(stats.secondaryRays))
+            .With("min_seconds", t.min)
+            .With("points", double(build.points))
+            .With("nodes", double(build.nodes));
+          records.push_back(r);
         }
       }
 
       // Everything off: the sphere field without reflectivity, rendered
       // with settings that ask for bounces and shadows but give no light,
       // against the plain primary-ray path (flat, nothing asked for).
+      if (wanted("off"))
       {
         const PointCloudView plainPoints = spheres.View(false, true);
         engine->Build(plainPoints, BuildOptions{ 8 });

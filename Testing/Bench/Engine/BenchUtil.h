@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace octoray
@@ -176,6 +177,15 @@ struct Record
   double seconds = 0.0;
   std::string peer;
   double peerSeconds = 0.0;
+  // Further figures of the same measurement (node counts, bytes, phases,
+  // rays), written as extra members so the report needs no second file.
+  std::vector<std::pair<std::string, double>> extra;
+
+  Record& With(const std::string& key, double value)
+  {
+    extra.emplace_back(key, value);
+    return *this;
+  }
 };
 
 namespace detail
@@ -224,7 +234,12 @@ inline std::string ToJson(const Record& r)
   o << "{\"name\": " << Quote(r.name) << ", \"backend\": " << Quote(r.backend) << ", \"n\": " << r.n
     << ", \"depth\": " << r.depth << ", \"seconds\": " << Number(r.seconds)
     << ", \"peer\": " << (r.peer.empty() ? "null" : Quote(r.peer))
-    << ", \"peer_seconds\": " << (r.peer.empty() ? "null" : Number(r.peerSeconds)) << "}";
+    << ", \"peer_seconds\": " << (r.peer.empty() ? "null" : Number(r.peerSeconds));
+  for (const auto& e : r.extra)
+  {
+    o << ", " << Quote(e.first) << ": " << Number(e.second);
+  }
+  o << "}";
   return o.str();
 }
 

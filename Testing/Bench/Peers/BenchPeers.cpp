@@ -12,7 +12,9 @@
 //
 //   octoray_bench_peers [--cases uniform:1e6,uniform:1e7,clustered:1e6]
 //                       [--depth 0] [--threads N] [--repeats 5]
-//                       [--peer-repeats 3] [--json PATH]
+//                       [--peer-repeats 3] [--octree-locator-max N] [--json PATH]
+// --octree-locator-max: leave vtkOctreePointLocator out of cases with more
+// than N points (about a minute per build at 10 M on 2 cores).
 #include "BenchUtil.h"
 
 #include <octoray/Engine.h>
@@ -29,6 +31,10 @@
 #include <vtkSMPTools.h>
 #include <vtkStaticPointLocator.h>
 
+#include <chrono>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -45,7 +51,7 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: octoray_bench_peers [--cases SET:N[,SET:N...]] [--depth L (0: automatic)] [--threads N]\n"
-    "                           [--repeats R] [--peer-repeats R] [--json PATH]\n"
+    "                           [--repeats R] [--peer-repeats R] [--octree-locator-max N] [--json PATH]\n"
     "  SET is uniform or clustered; N may be written 1e7\n");
   return 2;
 }
@@ -75,6 +81,7 @@ struct Row
   std::string backend; // octoray's configuration this peer is compared with
   Timing timing;
   std::string note;
+  double leaves = 0; // the peer's leaves or buckets, for the report
 };
 }
 
@@ -85,6 +92,7 @@ int main(int argc, char** argv)
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   int repeats = 5;
   int peerRepeats = 3;
+  double octreeLocatorMax = 1e300;
   std::string json;
   for (int a = 1; a < argc; ++a)
   {
@@ -129,6 +137,10 @@ int main(int argc, char** argv)
     else if (arg == "--peer-repeats")
     {
       peerRepeats = std::max(1, std::atoi(value.c_str()));
+    }
+    else if (arg == "--octree-locator-max")
+    {
+      octreeLocatorMax = std::strtod(value.c_str(), nullptr);
     }
     else if (arg == "--json")
     {
@@ -219,26 +231,51 @@ int main(int argc, char** argv)
       std::unique_ptr<PclOctree> pclTree;
       std::size_t pclLeaves = 0, pclBranches = 0;
       unsigned pclDepth = 0;
+      // Each PCL build is paired with a single-threaded octoray build run
+      // right after it (untimed for PCL): on a shared machine the load
+      // drifts between the octoray and PCL blocks above and below, and the
+      // median of the per-pair ratios is what that drift does not move.
+      std::vector<double> pairedRatios;
+      double pclSeconds = 0.0;
       const Timing pcl = MeasureFresh(
         [&] {
+          const auto start = std::chrono::steady_clock::now();
           pclTree = std::make_unique<PclOctree>(leafSize);
           pclTree->setInputCloud(pclCloud);
           pclTree->defineBoundingBox(cube.origin[0], cube.origin[1], cube.origin[2], cube.origin[0] + cube.size,
             cube.origin[1] + cube.size, cube.origin[2] + cube.size);
           pclTree->addPointsFromInputCloud();
+          pclSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         },
         [&] {
           pclLeaves = pclTree->getLeafCount();
           pclBranches = pclTree->getBranchCount();
           pclDepth = pclTree->getTreeDepth();
           pclTree.reset();
+#if defined(__GLIBC__)
+          // Freeing PCL's tree leaves a million small chunks in glibc's
+          // fast bins; the next large allocation consolidates them (about
+          // 0.5 s at 1 M points here). That is a cost of PCL's teardown, not
+          // of whatever builds next: pay it here, untimed.
+          malloc_trim(0);
+#endif
+          auto engine = CreateEngine(Backend::CPU);
+          engine->SetThreadCount(1);
+          const auto start = std::chrono::steady_clock::now();
+          engine->Build(cloud, options);
+          pairedRatios.push_back(
+            pclSeconds / std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         },
         0, peerRepeats);
+      std::sort(pairedRatios.begin(), pairedRatios.end());
+      const std::size_t pairs = pairedRatios.size();
+      const double pairedRatio = pairs % 2 ? pairedRatios[pairs / 2]
+                                           : 0.5 * (pairedRatios[pairs / 2 - 1] + pairedRatios[pairs / 2]);
       const bool same = pclLeaves == leaves && pclBranches == branches && pclDepth == unsigned(depth);
       char pclNote[160];
       std::snprintf(pclNote, sizeof pclNote, "depth %u, %zu leaves, %zu branches: %s", pclDepth, pclLeaves,
         pclBranches, same ? "same tree as octoray" : "DIFFERS from octoray");
-      rows.push_back(Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), pcl, pclNote });
+      rows.push_back(Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), pcl, pclNote, double(pclLeaves) });
       pclCloud.reset();
 
       // VTK locators read a vtkPolyData's points; wrap our array, no copy.
@@ -250,26 +287,33 @@ int main(int argc, char** argv)
       vtkNew<vtkPolyData> polyData;
       polyData->SetPoints(points);
 
-      vtkSmartPointer<vtkOctreePointLocator> octreeLocator;
-      int vtkLeaves = 0;
-      vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
-      const Timing vtkOctree = MeasureFresh(
-        [&] {
-          octreeLocator = vtkSmartPointer<vtkOctreePointLocator>::New();
-          octreeLocator->SetDataSet(polyData);
-          octreeLocator->SetMaximumPointsPerRegion(perRegion);
-          octreeLocator->BuildLocator();
-        },
-        [&] {
-          vtkLeaves = octreeLocator->GetNumberOfLeafNodes();
-          octreeLocator = nullptr;
-        },
-        // About a minute per build at 10 M points on this 2-core machine.
-        0, n >= 5000000 ? 1 : peerRepeats);
-      char octreeNote[160];
-      std::snprintf(octreeNote, sizeof octreeNote, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
-        perRegion, meanPerLeaf, vtkLeaves);
-      rows.push_back(Row{ "vtkOctreePointLocator", CpuBackendName(1), vtkOctree, octreeNote });
+      if (double(n) <= octreeLocatorMax)
+      {
+        vtkSmartPointer<vtkOctreePointLocator> octreeLocator;
+        int vtkLeaves = 0;
+        vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
+        const Timing vtkOctree = MeasureFresh(
+          [&] {
+            octreeLocator = vtkSmartPointer<vtkOctreePointLocator>::New();
+            octreeLocator->SetDataSet(polyData);
+            octreeLocator->SetMaximumPointsPerRegion(perRegion);
+            octreeLocator->BuildLocator();
+          },
+          [&] {
+            vtkLeaves = octreeLocator->GetNumberOfLeafNodes();
+            octreeLocator = nullptr;
+          },
+          // About a minute per build at 10 M points on this 2-core machine.
+          0, n >= 5000000 ? 1 : peerRepeats);
+        char octreeNote[160];
+        std::snprintf(octreeNote, sizeof octreeNote, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
+          perRegion, meanPerLeaf, vtkLeaves);
+        rows.push_back(Row{ "vtkOctreePointLocator", CpuBackendName(1), vtkOctree, octreeNote, double(vtkLeaves) });
+      }
+      else
+      {
+        std::printf("vtkOctreePointLocator left out: %zu points > --octree-locator-max %.0f\n", n, octreeLocatorMax);
+      }
 
       for (int t = 0; t < (threads > 1 ? 2 : 1); ++t)
       {
@@ -292,7 +336,8 @@ int main(int argc, char** argv)
         char staticNote[160];
         std::snprintf(staticNote, sizeof staticNote, "NumberOfPointsPerBucket %d: %dx%dx%d buckets, %d SMP threads",
           perRegion, divisions[0], divisions[1], divisions[2], vtkSMPTools::GetEstimatedNumberOfThreads());
-        rows.push_back(Row{ "vtkStaticPointLocator", CpuBackendName(threadCounts[t]), vtkStatic, staticNote });
+        rows.push_back(Row{ "vtkStaticPointLocator", CpuBackendName(threadCounts[t]), vtkStatic, staticNote,
+          double(divisions[0]) * divisions[1] * divisions[2] });
       }
       vtkSMPTools::Initialize(0);
 
@@ -320,9 +365,22 @@ int main(int argc, char** argv)
           r.seconds = mine.median;
           r.peer = row.what;
           r.peerSeconds = row.timing.median;
+          r.With("min_seconds", mine.min)
+            .With("peer_min_seconds", row.timing.min)
+            .With("peer_runs", row.timing.repeats)
+            .With("leaves", double(leaves))
+            .With("branches", double(branches))
+            .With("peer_leaves", row.leaves)
+            .With("engine_bytes", double(engineBytes));
+          if (row.what == "pcl::octree::OctreePointCloudPointVector")
+          {
+            r.With("same_tree", same ? 1.0 : 0.0).With("paired_ratio", pairedRatio);
+          }
           records.push_back(r);
         }
       }
+      std::printf("PCL / octoray (1 thread), median of %zu builds each paired with an octoray build: %.2fx\n", pairs,
+        pairedRatio);
       if (threads > 1)
       {
         std::printf("octoray %d threads vs PCL (1 thread): %.2fx\n", threads, pcl.median / ours[1].median);

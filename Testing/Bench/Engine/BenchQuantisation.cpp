@@ -1,0 +1,168 @@
+// octoray_bench_quantisation: the octree's geometric error against its
+// depth. For each leaf depth, the largest and the mean distance from a point
+// to the centre of its leaf voxel (data units), beside the build time, the
+// node count and the engine's memory, on three scenes:
+//   ct      a CT stack as points (a particle file, --ct PATH; the report
+//           writes Data/DICOM/CT5N through vtkSliceStackReader and
+//           vtkParticleTextWriter),
+//   lidar   the bundled LiDAR tile (Data/Particles/lidar_simple.particles),
+//   spheres the synthetic sphere field of the render benchmark.
+// The distances are measured on the engine's own octree (Quantisation.h)
+// and checked against the analytic bound, half the leaf voxel's diagonal;
+// a distance past it fails the run.
+//
+//   octoray_bench_quantisation [--backend cpu|cuda] [--depths 1-21]
+//                              [--ct PATH] [--lidar PATH] [--sphere-points N]
+//                              [--repeats 3] [--json PATH]
+#include "BenchScenes.h"
+#include "BenchUtil.h"
+#include "PointFile.h"
+#include "Quantisation.h"
+
+#include <octoray/Engine.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#ifndef OCTORAY_LIDAR_FILE
+#define OCTORAY_LIDAR_FILE "Data/Particles/lidar_simple.particles"
+#endif
+
+namespace
+{
+using namespace octoray;
+using namespace octoray::bench;
+
+int Usage()
+{
+  std::fprintf(stderr,
+    "usage: octoray_bench_quantisation [--backend cpu|cuda] [--depths FIRST-LAST] [--ct PATH] [--lidar PATH]\n"
+    "                                  [--sphere-points N] [--repeats R] [--json PATH]\n");
+  return 2;
+}
+
+struct Scene
+{
+  std::string name;
+  PointCloudView points;
+};
+}
+
+int main(int argc, char** argv)
+{
+  std::string backend = "cpu", ct, lidar = OCTORAY_LIDAR_FILE, json;
+  int first = 1, last = kMaxLevel, repeats = 3;
+  std::size_t spherePoints = 200000;
+  for (int a = 1; a < argc; ++a)
+  {
+    const std::string arg = argv[a];
+    if (a + 1 >= argc)
+      return Usage();
+    const char* v = argv[++a];
+    if (arg == "--backend")
+      backend = v;
+    else if (arg == "--depths")
+    {
+      if (std::sscanf(v, "%d-%d", &first, &last) != 2 || first < 1 || last > kMaxLevel || first > last)
+        return Usage();
+    }
+    else if (arg == "--ct")
+      ct = v;
+    else if (arg == "--lidar")
+      lidar = v;
+    else if (arg == "--sphere-points")
+      spherePoints = static_cast<std::size_t>(std::strtod(v, nullptr));
+    else if (arg == "--repeats")
+      repeats = std::max(1, std::atoi(v));
+    else if (arg == "--json")
+      json = v;
+    else
+      return Usage();
+  }
+  if (backend != "cpu" && backend != "cuda")
+    return Usage();
+
+  try
+  {
+    std::string why;
+    if (backend == "cuda" && !CudaAvailable(&why))
+    {
+      std::printf("no usable GPU: %s\n", why.c_str());
+      return 0;
+    }
+    auto engine = CreateEngine(backend == "cuda" ? Backend::CUDA : Backend::CPU);
+    std::printf("octoray_bench_quantisation: %s; build time median of %d after a warm-up\n",
+      engine->Description().c_str(), repeats);
+
+    PointFile ctFile, lidarFile = PointFile::Load(lidar);
+    const SphereField spheres = MakeSphereField(spherePoints);
+    std::vector<Scene> scenes;
+    if (!ct.empty())
+    {
+      ctFile = PointFile::Load(ct);
+      scenes.push_back({ "ct", ctFile.View() });
+    }
+    scenes.push_back({ "lidar", lidarFile.View() });
+    scenes.push_back({ "spheres", spheres.View(true, true) });
+
+    std::vector<Record> records;
+    bool withinBound = true;
+    for (const Scene& scene : scenes)
+    {
+      std::printf("\nscene %s, %zu points\n", scene.name.c_str(), scene.points.count);
+      std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB |\n");
+      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+      for (int depth = first; depth <= last; ++depth)
+      {
+        // A fresh engine per depth: one reused across depths keeps the
+        // largest buffers it ever needed, and its memory would not be this
+        // depth's.
+        engine = CreateEngine(backend == "cuda" ? Backend::CUDA : Backend::CPU);
+        BuildOptions options;
+        options.depth = depth;
+        BuildStats stats;
+        const Timing t = Measure([&] { stats = engine->Build(scene.points, options); }, 1, repeats);
+        HostOctree tree;
+        engine->CopyToHost(tree);
+        const QuantisationError q = MeasureQuantisation(tree, scene.points);
+        const double bytes = double(engine->Memory().Total());
+        // The bound, less a relative 1e-12 for the rounding of the centre.
+        const bool ok = q.max <= q.bound * (1 + 1e-12);
+        withinBound = withinBound && ok;
+        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f |%s\n", depth, q.leafSide, q.max, q.mean,
+          q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, ok ? "" : " PAST THE BOUND");
+        std::fflush(stdout);
+        Record r{ "quantisation/" + scene.name, backend, scene.points.count, depth, t.median, "", 0.0 };
+        r.With("max_distance", q.max)
+          .With("mean_distance", q.mean)
+          .With("bound", q.bound)
+          .With("leaf_side", q.leafSide)
+          .With("cube_size", tree.cube.size)
+          .With("nodes", double(stats.nodes))
+          .With("bytes", bytes)
+          .With("min_seconds", t.min);
+        records.push_back(r);
+      }
+    }
+    if (!json.empty())
+    {
+      MergeRecords(json, records);
+      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
+    }
+    if (!withinBound)
+    {
+      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal\n");
+      return 1;
+    }
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "octoray_bench_quantisation: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,108 @@
+// How far the octree moves each point: the distance, in data units, from a
+// point to the centre of the leaf voxel the engine put it in. This is the
+// geometric error of drawing a point as its leaf, and the octree's depth is
+// the knob that trades it for nodes and memory.
+//
+// Measured on the engine's own octree (Engine::CopyToHost): each point's
+// full-depth cell comes from the engine's root cube (the double-precision
+// transform the engine keys points with), the point is walked from the root
+// through the stored child masks and child offsets down to its leaf, and the
+// leaf's centre is taken from the leaf's stored Morton key. A point whose
+// leaf is missing from the tree is an error, not a figure.
+// Header-only and VTK-free (the GPU machine runs it too).
+#pragma once
+
+#include <octoray/Octree.h>
+#include <octoray/PointCloud.h>
+#include <octoray/Types.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace octoray
+{
+namespace bench
+{
+struct QuantisationError
+{
+  double max = 0.0;   // largest point-to-leaf-centre distance, data units
+  double mean = 0.0;  // mean of the same distances
+  double bound = 0.0; // half the leaf voxel's diagonal: sqrt(3)/2 * side / 2^depth
+  double leafSide = 0.0;
+  std::size_t points = 0;
+};
+
+inline double PointCoordinate(const PointCloudView& points, std::size_t i, int axis)
+{
+  return points.xyzDouble ? points.xyzDouble[3 * i + axis] : double(points.xyzFloat[3 * i + axis]);
+}
+
+// The centre of the voxel of `levelKey` (a level-local Morton key) at
+// `level`, in data coordinates.
+inline void VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey, double centre[3])
+{
+  std::uint32_t cell[3];
+  DecodeMorton(levelKey, cell[0], cell[1], cell[2]);
+  const double side = cube.size / std::ldexp(1.0, level);
+  for (int a = 0; a < 3; ++a)
+  {
+    centre[a] = cube.origin[a] + (cell[a] + 0.5) * side;
+  }
+}
+
+// The leaf of point i, found by walking the tree from the root; its node
+// index. Throws when the walk leaves the tree (the engine lost the point).
+inline std::uint32_t LeafOf(const HostOctree& tree, const PointCloudView& points, std::size_t i)
+{
+  std::uint64_t full = 0;
+  if (!tree.cube.FullKey(PointCoordinate(points, i, 0), PointCoordinate(points, i, 1), PointCoordinate(points, i, 2),
+        full))
+  {
+    throw std::runtime_error("point " + std::to_string(i) + " lies outside the engine's root cube");
+  }
+  std::uint32_t node = 0;
+  for (int level = 1; level <= tree.depth; ++level)
+  {
+    const unsigned octant = static_cast<unsigned>(AncestorKey(full, level) & 7u);
+    if (!(tree.childMask[node] & (1u << octant)))
+    {
+      throw std::runtime_error("point " + std::to_string(i) + " has no node at level " + std::to_string(level));
+    }
+    node = ChildIndex(tree.childMask[node], tree.firstChild[node], octant);
+  }
+  if (tree.key[node] != AncestorKey(full, tree.depth))
+  {
+    throw std::runtime_error("point " + std::to_string(i) + ": the leaf reached has another key");
+  }
+  return node;
+}
+
+inline QuantisationError MeasureQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  QuantisationError q;
+  q.points = points.count;
+  q.leafSide = tree.cube.size / std::ldexp(1.0, tree.depth);
+  q.bound = 0.5 * std::sqrt(3.0) * q.leafSide;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < points.count; ++i)
+  {
+    const std::uint32_t leaf = LeafOf(tree, points, i);
+    double centre[3];
+    VoxelCentre(tree.cube, tree.depth, tree.key[leaf], centre);
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = PointCoordinate(points, i, a) - centre[a];
+      d2 += d * d;
+    }
+    const double d = std::sqrt(d2);
+    q.max = std::max(q.max, d);
+    sum += d;
+  }
+  q.mean = points.count ? sum / double(points.count) : 0.0;
+  return q;
+}
+}
+}
