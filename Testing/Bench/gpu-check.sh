@@ -39,6 +39,9 @@ step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json
 # The CT scene is made here by `make report` (VTK reads the DICOM series)
 # and carried to the GPU machine as build/report/scenes/ct5n.particles.
 step quality build-gpu/bin/octoray_bench_quality --backend cuda --scenes build/report/scenes --json "$out/quality-cuda.json"
+step bench-render build-gpu/bin/octoray_bench_render --backend cuda --size 1920x1080 --parts modes --json "$out/bench-render-cuda.json"
+step bench-thesis build-gpu/bin/octoray_bench_thesis --backend cuda --json "$out/bench-thesis-cuda.json"
+step bench-quantisation build-gpu/bin/octoray_bench_quantisation --backend cuda --json "$out/bench-quantisation-cuda.json"
 
 {
 echo
