@@ -4,7 +4,8 @@
 # Debian's sources copied to .deps/googletest (scripts/install-deps.sh
 # installs the googletest package; cp -r /usr/src/googletest .deps/).
 #   Testing/Bench/gpu-check.sh [OUTDIR]
-# Prints a short table last; full logs go to OUTDIR (default build-gpu/logs).
+# Prints a short table last; full logs go to OUTDIR (default build-gpu/logs),
+# the files `make report` reads to OUTDIR/report-files.tgz.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-build-gpu/logs}
@@ -51,3 +52,7 @@ grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/memcheck-re
 grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
 printf '%s\n' "${status[@]}"
 } | tee "$out/summary.txt"
+# What `make report` reads, in one archive (the device tool brings back only
+# a limited number of files): unpack it into Testing/Bench/gpu/.
+tar czf "$out/report-files.tgz" -C "$out" summary.txt gpu.txt engine-tests.xml bench-results-cuda.json \
+  quality-cuda.json bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json
