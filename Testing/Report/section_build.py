@@ -327,10 +327,20 @@ def _cuda(ctx):
     summary = []
     ten = [r for r in builds if r["n"] == 10000000 and r["depth"] == 10]
     if ten:
+        # The device phases against the sort they contain are what the build
+        # itself costs; the whole call is mostly the upload from pageable
+        # memory, which a caller with pinned or device-resident points skips.
         r = ten[0]
-        summary.append(("CUDA octree build, 10 M points, depth 10 (whole call, GPU run)", seconds(r["seconds"]),
-                        "bare CUB radix sort " + seconds(r["peer_seconds"]),
-                        "%.0f× the sort" % (r["seconds"] / r["peer_seconds"])))
+        if phases:
+            device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+            summary.append(("CUDA octree build, 10 M points, depth 10, device phases (GPU run; whole call with "
+                            "the upload: %s)" % seconds(r["seconds"]), seconds(device),
+                            "bare CUB radix sort " + seconds(r["peer_seconds"]),
+                            "%.1f× the sort" % (device / r["peer_seconds"])))
+        else:
+            summary.append(("CUDA octree build, 10 M points, depth 10 (whole call, GPU run)", seconds(r["seconds"]),
+                            "bare CUB radix sort " + seconds(r["peer_seconds"]),
+                            "%.0f× the sort" % (r["seconds"] / r["peer_seconds"])))
     return "\n".join(text) + "\n", summary
 
 
