@@ -12,9 +12,21 @@
 #include "Octree.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace octoray
 {
+// 2^e for -126 <= e <= 127, exactly, built from its bits: what ldexpf(1, e)
+// returns, without the library call that the CPU pays per visited node.
+OCTORAY_HD float PowerOfTwo(int e)
+{
+  const std::uint32_t bits = static_cast<std::uint32_t>(e + 127) << 23;
+  float f;
+  memcpy(&f, &bits, sizeof f);
+  return f;
+}
+
 struct Ray
 {
   float origin[3];
@@ -74,13 +86,13 @@ struct LevelOfDetail
   float footprintSlope = 0.0f;
   float pixels = 0.0f; // 0: always down to the leaves
 
-  OCTORAY_HD bool StopAt(int level, float t) const
+  // `voxel`: the node's side in the unit cube.
+  OCTORAY_HD bool StopAt(float voxel, float t) const
   {
     if (pixels <= 0.0f)
     {
       return false;
     }
-    const float voxel = ldexpf(1.0f, -level);
     return voxel < pixels * (footprint0 + footprintSlope * (t > 0.0f ? t : 0.0f));
   }
 };
@@ -150,14 +162,14 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     NodeHit hit;
     hit.node = e.node;
     hit.level = e.level;
-    hit.size = ldexpf(1.0f, -e.level);
+    hit.size = PowerOfTwo(-e.level);
     std::uint32_t cell[3];
     DecodeMorton(tree.key[e.node], cell[0], cell[1], cell[2]);
     for (int a = 0; a < 3; ++a)
     {
       hit.lo[a] = static_cast<float>(cell[a]) * hit.size;
     }
-    if (e.level == tree.depth || lod.StopAt(e.level, e.tEnter))
+    if (e.level == tree.depth || lod.StopAt(hit.size, e.tEnter))
     {
       IntersectBox(ray, hit.lo, hit.size, hit.tEnter, hit.tExit, hit.axis);
       if (visitor.Visit(hit))
@@ -214,7 +226,7 @@ OCTORAY_HD bool Occupied(const OctreeView& tree, int level, const float p[3])
       return false;
     }
   }
-  const float scale = ldexpf(1.0f, level);
+  const float scale = PowerOfTwo(level);
   const std::uint64_t key =
     EncodeMorton(static_cast<std::uint32_t>(p[0] * scale), static_cast<std::uint32_t>(p[1] * scale),
       static_cast<std::uint32_t>(p[2] * scale));
