@@ -30,20 +30,6 @@ int Usage()
   return 2;
 }
 
-std::vector<std::string> Split(const std::string& list)
-{
-  std::vector<std::string> items;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ','))
-  {
-    if (!item.empty())
-    {
-      items.push_back(item);
-    }
-  }
-  return items;
-}
 
 std::string CpuBackendName(int threads)
 {
@@ -115,61 +101,31 @@ int main(int argc, char** argv)
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   int repeats = 5;
   std::string json;
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-    {
-      return Usage();
-    }
-    const std::string value = argv[++a];
-    if (arg == "--points")
-    {
-      counts.clear();
-      for (const std::string& c : Split(value))
-      {
-        counts.push_back(static_cast<std::size_t>(std::strtod(c.c_str(), nullptr))); // 1e7 works too
-      }
-    }
-    else if (arg == "--sets")
-    {
-      sets = Split(value);
-    }
-    else if (arg == "--depth")
-    {
-      depth = std::atoi(value.c_str());
-    }
-    else if (arg == "--backend")
-    {
-      backend = value;
-    }
-    else if (arg == "--threads")
-    {
-      threads = std::max(1, std::atoi(value.c_str()));
-    }
-    else if (arg == "--repeats")
-    {
-      repeats = std::max(1, std::atoi(value.c_str()));
-    }
-    else if (arg == "--json")
-    {
-      json = value;
-    }
-    else
-    {
-      return Usage();
-    }
-  }
-  if (backend != "cpu" && backend != "cuda" && backend != "all")
+  CommandLine options;
+  options
+    .Option("--points",
+      [&](const std::string& v) {
+        counts.clear();
+        for (const std::string& c : SplitList(v))
+        {
+          counts.push_back(static_cast<std::size_t>(std::strtod(c.c_str(), nullptr))); // 1e7 works too
+        }
+        return true;
+      })
+    .Option("--sets",
+      [&](const std::string& v) {
+        sets = SplitList(v);
+        return std::all_of(
+          sets.begin(), sets.end(), [](const std::string& set) { return set == "uniform" || set == "clustered"; });
+      })
+    .Integer("--depth", depth)
+    .Choice("--backend", backend, { "cpu", "cuda", "all" })
+    .Integer("--threads", threads, 1)
+    .Integer("--repeats", repeats, 1)
+    .Text("--json", json);
+  if (!options.Parse(argc, argv))
   {
     return Usage();
-  }
-  for (const std::string& set : sets)
-  {
-    if (set != "uniform" && set != "clustered")
-    {
-      return Usage();
-    }
   }
 
   std::string why;
@@ -262,11 +218,7 @@ int main(int argc, char** argv)
     }
     std::printf("\nB/pt: all the engine holds (points, keys, sort buffers, nodes) per point; nodeB/pt: the node "
                 "arrays alone;\ndense: the thesis's pointer skeleton of the same depth, 8 B x (8^(L+1)-1)/7.\n");
-    if (!json.empty())
-    {
-      MergeRecords(json, records);
-      std::printf("%zu records merged into %s\n", records.size(), json.c_str());
-    }
+    SaveRecords(json, records);
   }
   catch (const std::exception& e)
   {

@@ -502,63 +502,18 @@ int main(int argc, char** argv)
   int width = 512, height = 288, repeats = 0, threads = 0;
   std::size_t spherePoints = 300000;
   std::string backend = "cpu", scenesDir, lidar = OCTORAY_LIDAR_FILE, only, json, dump;
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-    {
-      return Usage();
-    }
-    const char* v = argv[++a];
-    if (arg == "--backend")
-    {
-      backend = v;
-    }
-    else if (arg == "--scenes")
-    {
-      scenesDir = v;
-    }
-    else if (arg == "--lidar")
-    {
-      lidar = v;
-    }
-    else if (arg == "--only")
-    {
-      only = v;
-    }
-    else if (arg == "--size")
-    {
-      if (std::sscanf(v, "%dx%d", &width, &height) != 2)
-      {
-        return Usage();
-      }
-    }
-    else if (arg == "--repeats")
-    {
-      repeats = std::atoi(v);
-    }
-    else if (arg == "--threads")
-    {
-      threads = std::atoi(v);
-    }
-    else if (arg == "--sphere-points")
-    {
-      spherePoints = std::strtoull(v, nullptr, 10);
-    }
-    else if (arg == "--json")
-    {
-      json = v;
-    }
-    else if (arg == "--dump")
-    {
-      dump = v;
-    }
-    else
-    {
-      return Usage();
-    }
-  }
-  if (backend != "cpu" && backend != "cuda" && backend != "all")
+  CommandLine options;
+  options.Choice("--backend", backend, { "cpu", "cuda", "all" })
+    .Text("--scenes", scenesDir)
+    .Text("--lidar", lidar)
+    .Text("--only", only)
+    .Size("--size", width, height)
+    .Integer("--repeats", repeats)
+    .Integer("--threads", threads)
+    .Count("--sphere-points", spherePoints)
+    .Text("--json", json)
+    .Text("--dump", dump);
+  if (!options.Parse(argc, argv))
   {
     return Usage();
   }

@@ -57,33 +57,19 @@ int main(int argc, char** argv)
   std::string backend = "cpu", ct, lidar = OCTORAY_LIDAR_FILE, json;
   int first = 1, last = kMaxLevel, repeats = 3;
   std::size_t spherePoints = 200000;
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-      return Usage();
-    const char* v = argv[++a];
-    if (arg == "--backend")
-      backend = v;
-    else if (arg == "--depths")
-    {
-      if (std::sscanf(v, "%d-%d", &first, &last) != 2 || first < 1 || last > kMaxLevel || first > last)
-        return Usage();
-    }
-    else if (arg == "--ct")
-      ct = v;
-    else if (arg == "--lidar")
-      lidar = v;
-    else if (arg == "--sphere-points")
-      spherePoints = static_cast<std::size_t>(std::strtod(v, nullptr));
-    else if (arg == "--repeats")
-      repeats = std::max(1, std::atoi(v));
-    else if (arg == "--json")
-      json = v;
-    else
-      return Usage();
-  }
-  if (backend != "cpu" && backend != "cuda")
+  CommandLine options;
+  options.Choice("--backend", backend, { "cpu", "cuda" })
+    .Option("--depths",
+      [&](const std::string& v) {
+        return std::sscanf(v.c_str(), "%d-%d", &first, &last) == 2 && first >= 1 && last <= kMaxLevel &&
+          first <= last;
+      })
+    .Text("--ct", ct)
+    .Text("--lidar", lidar)
+    .Count("--sphere-points", spherePoints)
+    .Integer("--repeats", repeats, 1)
+    .Text("--json", json);
+  if (!options.Parse(argc, argv))
     return Usage();
 
   try
@@ -148,11 +134,7 @@ int main(int argc, char** argv)
         records.push_back(r);
       }
     }
-    if (!json.empty())
-    {
-      MergeRecords(json, records);
-      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
-    }
+    SaveRecords(json, records);
     if (!withinBound)
     {
       std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal\n");

@@ -105,34 +105,17 @@ int main(int argc, char** argv)
   int w = 1920, h = 1080, repeats = 3, threads = 0;
   std::size_t spherePoints = 1000000;
   std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json, parts = "modes,off";
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-      return Usage();
-    const char* v = argv[++a];
-    if (arg == "--size")
-    {
-      if (std::sscanf(v, "%dx%d", &w, &h) != 2)
-        return Usage();
-    }
-    else if (arg == "--repeats")
-      repeats = std::atoi(v);
-    else if (arg == "--threads")
-      threads = std::atoi(v);
-    else if (arg == "--backend")
-      backend = v;
-    else if (arg == "--lidar")
-      lidar = v;
-    else if (arg == "--sphere-points")
-      spherePoints = std::strtoull(v, nullptr, 10);
-    else if (arg == "--parts")
-      parts = v;
-    else if (arg == "--json")
-      json = v;
-    else
-      return Usage();
-  }
+  CommandLine options;
+  options.Size("--size", w, h)
+    .Integer("--repeats", repeats)
+    .Integer("--threads", threads)
+    .Choice("--backend", backend, { "cpu", "cuda", "all" })
+    .Text("--lidar", lidar)
+    .Count("--sphere-points", spherePoints)
+    .Text("--parts", parts)
+    .Text("--json", json);
+  if (!options.Parse(argc, argv))
+    return Usage();
   parts = "," + parts + ",";
   const auto wanted = [&](const char* part) { return parts.find(std::string(",") + part + ",") != std::string::npos; };
 
@@ -223,11 +206,7 @@ int main(int argc, char** argv)
           std::size_t(w) * h, 8, ta.median, "render.spheres.plain-primary", tp.median });
       }
     }
-    if (!json.empty())
-    {
-      MergeRecords(json, records);
-      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
-    }
+    SaveRecords(json, records);
   }
   catch (const std::exception& e)
   {

@@ -61,24 +61,12 @@ int main(int argc, char** argv)
   std::string backend = "cpu", json;
   int repeats = 5;
   std::size_t spherePoints = 1000000;
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-      return Usage();
-    const char* v = argv[++a];
-    if (arg == "--backend")
-      backend = v;
-    else if (arg == "--repeats")
-      repeats = std::max(1, std::atoi(v));
-    else if (arg == "--sphere-points")
-      spherePoints = static_cast<std::size_t>(std::strtod(v, nullptr));
-    else if (arg == "--json")
-      json = v;
-    else
-      return Usage();
-  }
-  if (backend != "cpu" && backend != "cuda")
+  CommandLine options;
+  options.Choice("--backend", backend, { "cpu", "cuda" })
+    .Integer("--repeats", repeats, 1)
+    .Count("--sphere-points", spherePoints)
+    .Text("--json", json);
+  if (!options.Parse(argc, argv))
     return Usage();
 
   try
@@ -162,11 +150,7 @@ int main(int argc, char** argv)
           .With("rays", double(fullStats.primaryRays + fullStats.secondaryRays)));
     }
 
-    if (!json.empty())
-    {
-      MergeRecords(json, records);
-      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
-    }
+    SaveRecords(json, records);
   }
   catch (const std::exception& e)
   {

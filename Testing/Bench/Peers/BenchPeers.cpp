@@ -94,62 +94,36 @@ int main(int argc, char** argv)
   int peerRepeats = 3;
   double octreeLocatorMax = 1e300;
   std::string json;
-  for (int a = 1; a < argc; ++a)
+  CommandLine options;
+  options
+    .Option("--cases",
+      [&](const std::string& v) {
+        cases.clear();
+        for (const std::string& item : SplitList(v))
+        {
+          const std::size_t colon = item.find(':');
+          if (colon == std::string::npos)
+          {
+            return false;
+          }
+          Case c{ item.substr(0, colon), static_cast<std::size_t>(std::strtod(item.c_str() + colon + 1, nullptr)) };
+          if ((c.set != "uniform" && c.set != "clustered") || c.n == 0)
+          {
+            return false;
+          }
+          cases.push_back(c);
+        }
+        return true;
+      })
+    .Integer("--depth", requestedDepth)
+    .Integer("--threads", threads, 1)
+    .Integer("--repeats", repeats, 1)
+    .Integer("--peer-repeats", peerRepeats, 1)
+    .Real("--octree-locator-max", octreeLocatorMax)
+    .Text("--json", json);
+  if (!options.Parse(argc, argv))
   {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-    {
-      return Usage();
-    }
-    const std::string value = argv[++a];
-    if (arg == "--cases")
-    {
-      cases.clear();
-      std::stringstream in(value);
-      std::string item;
-      while (std::getline(in, item, ','))
-      {
-        const std::size_t colon = item.find(':');
-        if (colon == std::string::npos)
-        {
-          return Usage();
-        }
-        Case c{ item.substr(0, colon), static_cast<std::size_t>(std::strtod(item.c_str() + colon + 1, nullptr)) };
-        if ((c.set != "uniform" && c.set != "clustered") || c.n == 0)
-        {
-          return Usage();
-        }
-        cases.push_back(c);
-      }
-    }
-    else if (arg == "--depth")
-    {
-      requestedDepth = std::atoi(value.c_str());
-    }
-    else if (arg == "--threads")
-    {
-      threads = std::max(1, std::atoi(value.c_str()));
-    }
-    else if (arg == "--repeats")
-    {
-      repeats = std::max(1, std::atoi(value.c_str()));
-    }
-    else if (arg == "--peer-repeats")
-    {
-      peerRepeats = std::max(1, std::atoi(value.c_str()));
-    }
-    else if (arg == "--octree-locator-max")
-    {
-      octreeLocatorMax = std::strtod(value.c_str(), nullptr);
-    }
-    else if (arg == "--json")
-    {
-      json = value;
-    }
-    else
-    {
-      return Usage();
-    }
+    return Usage();
   }
 
   std::printf("octoray_bench_peers: octoray median of %d fresh builds after 1 warm-up; PCL and VTK median of %d "
@@ -392,11 +366,7 @@ int main(int argc, char** argv)
       std::printf("octoray: %zu leaves, %zu branches; PCL: %zu leaves, %zu branches%s\n", leaves, branches, pclLeaves,
         pclBranches, same ? "" : "  <-- MISMATCH");
     }
-    if (!json.empty())
-    {
-      MergeRecords(json, records);
-      std::printf("\n%zu records merged into %s\n", records.size(), json.c_str());
-    }
+    SaveRecords(json, records);
   }
   catch (const std::exception& e)
   {
