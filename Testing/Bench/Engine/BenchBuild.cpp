@@ -36,13 +36,6 @@ std::string CpuBackendName(int threads)
   return "cpu-" + std::to_string(threads) + (threads == 1 ? "thread" : "threads");
 }
 
-double Median(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size();
-  return m == 0 ? 0.0 : m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
-}
-
 struct Run
 {
   std::string backend;
@@ -76,9 +69,9 @@ Run Time(Engine& engine, const std::string& backend, const PointCloudView& cloud
       warm = true; // the first call is Measure's warm-up
     },
     1, repeats);
-  run.keySeconds = Median(keys);
-  run.sortSeconds = Median(sorts);
-  run.levelSeconds = Median(levels);
+  run.keySeconds = Summarise(keys).median;
+  run.sortSeconds = Summarise(sorts).median;
+  run.levelSeconds = Summarise(levels).median;
   const MemoryReport memory = engine.Memory();
   run.engineBytes = memory.Total();
   for (const auto& array : memory.arrays)

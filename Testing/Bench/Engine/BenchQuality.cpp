@@ -340,13 +340,7 @@ private:
     int upsample = 1, downsample = 1; // how the picture is brought to W x H
     std::vector<double> seconds;
     RgbImage picture;
-    double Median() const
-    {
-      std::vector<double> s = seconds;
-      std::sort(s.begin(), s.end());
-      const std::size_t m = s.size();
-      return m == 0 ? 0.0 : (m % 2 ? s[m / 2] : 0.5 * (s[m / 2 - 1] + s[m / 2]));
-    }
+    double Median() const { return Summarise(seconds).median; }
   };
 
   // The engine holding the octree of leaf depth `depth` (0: the engine's

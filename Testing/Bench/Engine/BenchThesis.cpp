@@ -45,14 +45,7 @@ Timing TraceTime(Engine& engine, const RenderSettings& s, int repeats, RenderSta
     stats = engine.Render(s, image);
     seconds.push_back(stats.seconds);
   }
-  std::sort(seconds.begin(), seconds.end());
-  Timing t;
-  const std::size_t m = seconds.size();
-  t.median = m % 2 ? seconds[m / 2] : 0.5 * (seconds[m / 2 - 1] + seconds[m / 2]);
-  t.min = seconds.front();
-  t.max = seconds.back();
-  t.repeats = static_cast<int>(m);
-  return t;
+  return Summarise(std::move(seconds));
 }
 }
 

@@ -34,6 +34,23 @@ struct Timing
   int repeats = 0;
 };
 
+// Median, min and max of measured times (seconds); zeros when there are none.
+inline Timing Summarise(std::vector<double> seconds)
+{
+  Timing t;
+  const std::size_t m = seconds.size();
+  if (m == 0)
+  {
+    return t;
+  }
+  std::sort(seconds.begin(), seconds.end());
+  t.median = m % 2 ? seconds[m / 2] : 0.5 * (seconds[m / 2 - 1] + seconds[m / 2]);
+  t.min = seconds.front();
+  t.max = seconds.back();
+  t.repeats = static_cast<int>(m);
+  return t;
+}
+
 // Runs fn `warmups` times untimed (first-touch page faults, lazily grown
 // buffers and cold caches belong to no steady state), then `repeats` times
 // timed. The median is what gets reported: on a shared 2-core machine a
@@ -62,14 +79,7 @@ inline Timing Measure(const std::function<void()>& fn, int warmups, int repeats,
       after();
     }
   }
-  std::sort(seconds.begin(), seconds.end());
-  Timing t;
-  const std::size_t m = seconds.size();
-  t.median = m % 2 ? seconds[m / 2] : 0.5 * (seconds[m / 2 - 1] + seconds[m / 2]);
-  t.min = seconds.front();
-  t.max = seconds.back();
-  t.repeats = static_cast<int>(m);
-  return t;
+  return Summarise(std::move(seconds));
 }
 
 // ---------------------------------------------------------------- point sets
