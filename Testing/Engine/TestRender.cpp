@@ -120,44 +120,20 @@ TEST_P(RenderTest, MaximumIntensityMatchesBruteForce)
   }
   Image image;
   engine->Render(s, image);
-  double inv[16];
-  Invert4x4(vp.data(), inv);
   int checked = 0;
   for (int y = 0; y < h; ++y)
   {
     for (int x = 0; x < w; ++x)
     {
       // Brute force: the largest scalar of every leaf the ray passes.
-      auto unproject = [&](double z, double p[3]) {
-        const double ndc[4] = { 2.0 * (x + 0.5) / w - 1, 2.0 * (y + 0.5) / h - 1, z, 1 };
-        double r[4] = {};
-        for (int i = 0; i < 4; ++i)
-          for (int k = 0; k < 4; ++k)
-            r[i] += inv[4 * i + k] * ndc[k];
-        for (int a = 0; a < 3; ++a)
-          p[a] = r[a] / r[3];
-      };
-      double o[3], e[3];
-      unproject(-1, o);
-      unproject(1, e);
+      const WorldRay ray = PixelRay(vp, w, h, x, y);
       float maxScalar = -INFINITY;
-      const double voxel = t.cube.size / 16;
       for (std::uint32_t n = t.levelBegin[4]; n < t.levelBegin[5]; ++n)
       {
-        std::uint32_t cell[3];
-        DecodeMorton(t.key[n], cell[0], cell[1], cell[2]);
-        double t0 = 0, t1 = 1;
-        for (int a = 0; a < 3; ++a)
-        {
-          const double lo = t.cube.origin[a] + cell[a] * voxel, hi = lo + voxel, d = e[a] - o[a];
-          double ta = (lo - o[a]) / d, tb = (hi - o[a]) / d;
-          if (ta > tb)
-            std::swap(ta, tb);
-          t0 = std::max(t0, ta);
-          t1 = std::min(t1, tb);
-        }
+        double lo[3], hi[3], t0 = 0, t1 = 1;
+        NodeBox(t, n, 4, lo, hi);
         // Skip grazing contacts, where the two methods may differ.
-        if (t1 - t0 > 1e-6)
+        if (Slab(ray, lo, hi, t0, t1) && t1 - t0 > 1e-6)
           maxScalar = std::max(maxScalar, t.scalar[n]);
       }
       const std::size_t i = std::size_t(y) * w + x;
