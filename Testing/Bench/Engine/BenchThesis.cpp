@@ -49,6 +49,23 @@ Timing TraceTime(Engine& engine, const RenderSettings& s, int repeats, RenderSta
 }
 }
 
+// Builds `c` at the thesis's depth 7 (median of `repeats` after a warm-up)
+// and returns the thesis's view of it: 800x600, Phong, the picture left in
+// the backend's memory.
+RenderSettings BuildThesisScene(
+  Engine& engine, const ColouredCloud& c, int repeats, Timing& build, BuildStats& stats)
+{
+  BuildOptions o;
+  o.depth = 7;
+  build = Measure([&] { stats = engine.Build(c.View(), o); }, 1, repeats);
+  HostOctree t;
+  engine.CopyToHost(t);
+  RenderSettings s = CubeCamera(t.cube, 800, 600);
+  s.shade = ShadeMode::Phong;
+  s.copyToHost = false;
+  return s;
+}
+
 int main(int argc, char** argv)
 {
   std::string backend = "cpu", json;
@@ -80,15 +97,9 @@ int main(int argc, char** argv)
     for (const std::size_t n : ThesisTable2Counts())
     {
       const ColouredCloud c = ThesisSliceStack(n);
-      BuildOptions o;
-      o.depth = 7;
+      Timing build;
       BuildStats stats;
-      const Timing build = Measure([&] { stats = engine->Build(c.View(), o); }, 1, repeats);
-      HostOctree t;
-      engine->CopyToHost(t);
-      RenderSettings s = CubeCamera(t.cube, 800, 600);
-      s.shade = ShadeMode::Phong;
-      s.copyToHost = false;
+      const RenderSettings s = BuildThesisScene(*engine, c, repeats, build, stats);
       RenderStats rs;
       const Timing trace = TraceTime(*engine, s, repeats, rs);
       const double bytes = double(engine->Memory().Total());
@@ -107,15 +118,9 @@ int main(int argc, char** argv)
       // A fresh engine: its memory is then this scene's alone.
       engine = CreateEngine(backend == "cuda" ? Backend::CUDA : Backend::CPU);
       const ColouredCloud c = TwoSpheres(spherePoints);
-      BuildOptions o;
-      o.depth = 7;
+      Timing build;
       BuildStats stats;
-      const Timing build = Measure([&] { stats = engine->Build(c.View(), o); }, 1, repeats);
-      HostOctree t;
-      engine->CopyToHost(t);
-      RenderSettings s = CubeCamera(t.cube, 800, 600);
-      s.shade = ShadeMode::Phong;
-      s.copyToHost = false;
+      RenderSettings s = BuildThesisScene(*engine, c, repeats, build, stats);
       s.maxBounces = 0;
       RenderStats phongStats, fullStats;
       const Timing phong = TraceTime(*engine, s, repeats, phongStats);
