@@ -301,6 +301,26 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   const int nchunks = static_cast<int>(starts.size());
   starts.push_back(end);
   std::vector<ChunkResult> results(nchunks);
+  // Progress of a pass over the chunks, mapped onto [from, to]; an abort
+  // asked for through VTK stops the chunks still to come.
+  auto passProgress = [&](double from, double to) {
+    return [this, &aborted, from, to, nchunks](int done) {
+      this->UpdateProgress(from + (to - from) * done / nchunks);
+      if (this->GetAbortExecute())
+      {
+        aborted = true;
+      }
+    };
+  };
+  // After a pass: false, with the reader's error, when it was aborted.
+  auto notAborted = [&]() {
+    if (aborted)
+    {
+      this->Fail(file + ": reading was aborted");
+      return false;
+    }
+    return true;
+  };
 
   // Pass 1: lines and data lines per chunk, for line numbers and the place of
   // each chunk's points in the output arrays.
@@ -343,16 +363,9 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
         s = nl ? nl + 1 : ce;
       }
     },
-    [&](int done) {
-      this->UpdateProgress(0.05 + 0.05 * done / nchunks);
-      if (this->GetAbortExecute())
-      {
-        aborted = true;
-      }
-    });
-  if (aborted)
+    passProgress(0.05, 0.1));
+  if (!notAborted())
   {
-    this->Fail(file + ": reading was aborted");
     return false;
   }
   vtkIdType total = 0;
@@ -662,17 +675,9 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
         changedBetweenPasses = true;
       }
     },
-    [&](int done) {
-      this->UpdateProgress(0.1 + 0.85 * done / nchunks);
-      if (this->GetAbortExecute())
-      {
-        aborted = true;
-      }
-    });
-
-  if (aborted)
+    passProgress(0.1, 0.95));
+  if (!notAborted())
   {
-    this->Fail(file + ": reading was aborted");
     return false;
   }
   if (changedBetweenPasses)
