@@ -50,7 +50,8 @@ ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fr
 ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
 ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader TestDicomCheck \
   TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader octoray_fuzz_ParticleText \
-  octoray_fuzz_SliceStackMetadata octorayFiltersParticlesPython octorayRenderingVolumePython
+  octoray_fuzz_SliceStackMetadata octorayIOParticlesPython octorayIOImageStackPython octorayFiltersPCLPython \
+  octorayRenderingVolumePython
 test-asan: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DOCTORAY_ENABLE_CUDA=OFF -DOCTORAY_FUZZ_SECONDS=$(FUZZ_SECONDS) \

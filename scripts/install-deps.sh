@@ -19,6 +19,10 @@ packages=(
   libutfcpp-dev libogg-dev libtheora-dev libavformat-dev libavcodec-dev
   libavutil-dev libswscale-dev libgdal-dev libgl2ps-dev libglew-dev
   libnetcdf-dev libtiff-dev libdouble-conversion-dev
+  # ParaView's VTK config asks for Qt5OpenGL; VTK's FreeType module finds
+  # freetype's -dev files; ParaView's plugin macros run xmllint; Qt5X11Extras'
+  # config names libXcomposite. None is a Depends of the packages above.
+  libqt5opengl5-dev libfreetype-dev libxml2-utils libxcomposite1
   # point-cloud algorithms and the comparison octree (runtime libraries only)
   libpcl-common1.13 libpcl-octree1.13 libpcl-kdtree1.13 libpcl-search1.13
   libpcl-features1.13 libeigen3-dev libflann-dev libboost-dev

@@ -8,8 +8,3 @@ vtkCPUOctreeVolumeMapper::vtkCPUOctreeVolumeMapper()
 {
   this->RequestedBackend = BACKEND_CPU;
 }
-
-void vtkCPUOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
-{
-  this->Superclass::PrintSelf(os, indent);
-}

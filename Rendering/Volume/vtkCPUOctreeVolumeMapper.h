@@ -1,10 +1,11 @@
 /**
  * @class   vtkCPUOctreeVolumeMapper
- * @brief   vtkOctreeVolumeMapper on the engine's CPU backend
+ * @brief   vtkOctreeVolumeMapper with RequestedBackend preset to the CPU
  *
  * The fallback when no CUDA device is usable, and the reference in tests:
  * the CPU backend runs the same per-pixel functions as the CUDA one on all
- * cores.
+ * cores. The same as a vtkOctreeVolumeMapper with
+ * SetRequestedBackendToCPU(); kept for its name.
  *
  * @sa vtkOctreeVolumeMapper vtkCudaOctreeVolumeMapper
  */
@@ -19,7 +20,6 @@ class OCTORAYRENDERINGVOLUME_EXPORT vtkCPUOctreeVolumeMapper : public vtkOctreeV
 public:
   static vtkCPUOctreeVolumeMapper* New();
   vtkTypeMacro(vtkCPUOctreeVolumeMapper, vtkOctreeVolumeMapper);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
 
 protected:
   vtkCPUOctreeVolumeMapper();

@@ -1,15 +1,13 @@
 /**
  * @class   vtkCudaOctreeVolumeMapper
- * @brief   vtkOctreeVolumeMapper on the engine's CUDA backend
+ * @brief   vtkOctreeVolumeMapper with RequestedBackend preset to CUDA
  *
- * Builds, updates and traces the octree on the GPU. When no device is
- * usable, or the device fails at run time (e.g. out of memory), it warns and
- * carries on with the CPU backend: GetLastUsedBackend() says which one made
- * the picture.
- *
- * The picture is copied to the host and uploaded as a texture for the
- * composite draw; drawing straight from device memory through CUDA-OpenGL
- * interop is a later optimisation.
+ * Builds, updates and traces the octree on the GPU, and copies the picture
+ * into the compositing textures on the GPU (UseCudaGLInterop). When no
+ * device is usable, or the device fails at run time (e.g. out of memory), it
+ * warns and carries on with the CPU backend: GetLastUsedBackend() says which
+ * one made the picture. The same as a vtkOctreeVolumeMapper with
+ * SetRequestedBackendToCuda(); kept for its name.
  *
  * @sa vtkOctreeVolumeMapper vtkCPUOctreeVolumeMapper
  */
@@ -24,7 +22,6 @@ class OCTORAYRENDERINGVOLUME_EXPORT vtkCudaOctreeVolumeMapper : public vtkOctree
 public:
   static vtkCudaOctreeVolumeMapper* New();
   vtkTypeMacro(vtkCudaOctreeVolumeMapper, vtkOctreeVolumeMapper);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
 
 protected:
   vtkCudaOctreeVolumeMapper();

@@ -29,13 +29,23 @@
  *   (animation), and the picture is re-traced only when the camera, lights,
  *   properties, settings or the opaque depth change.
  *
- * New() returns a vtkCudaOctreeVolumeMapper when a CUDA device is usable and
- * a vtkCPUOctreeVolumeMapper otherwise (unless an object factory overrides
- * it). RequestedBackend chooses at run time; a CUDA failure (no device,
- * out of memory) falls back to the CPU backend with a warning.
- * GetLastUsedBackend() says which backend made the last picture.
+ * RequestedBackend chooses the engine at run time, as vtkSmartVolumeMapper's
+ * RequestedRenderMode does: AUTO (the default) takes CUDA where a device is
+ * usable; a CUDA failure (no device, out of memory, a lost device) falls
+ * back to the CPU backend with one warning. GetLastUsedBackend() says which
+ * backend made the last picture. On CUDA, the picture goes from device
+ * memory straight into the OpenGL textures (CUDA-OpenGL interop) where the
+ * window's OpenGL runs on the same GPU, and through host memory otherwise.
+ * Each process picks its CUDA device by its rank on its host (CudaDevice).
+ *
+ * Render() fires VolumeMapperRenderStartEvent and VolumeMapperRenderEndEvent
+ * and sets TimeToDraw, so VTK's interactive-rate logic sees what a frame
+ * costs.
  *
  * Positional lights are treated as point lights without cone or attenuation.
+ *
+ * vtkCPUOctreeVolumeMapper and vtkCudaOctreeVolumeMapper are this class
+ * with the backend preset, kept for their names.
  *
  * @sa vtkCPUOctreeVolumeMapper vtkCudaOctreeVolumeMapper
  */
@@ -45,12 +55,7 @@
 #include "octorayRenderingVolumeModule.h" // for export macro
 #include "vtkVolumeMapper.h"
 
-#include <functional> // for std::function
-#include <vector>     // for std::vector
-
-class vtkOpenGLRenderWindow;
 class vtkPolyData;
-class vtkVolumeProperty;
 
 class OCTORAYRENDERINGVOLUME_EXPORT vtkOctreeVolumeMapper : public vtkVolumeMapper
 {
@@ -105,6 +110,44 @@ public:
    * present).
    */
   static bool IsCudaAvailable();
+
+  ///@{
+  /**
+   * The CUDA device to work on. -1 (the default) picks one by the process's
+   * rank on its host, local rank % device count, so that pvbatch ranks on a
+   * multi-GPU host spread over its GPUs: the local rank comes from the MPI
+   * launcher's environment (Open MPI, MPICH, Intel MPI, MVAPICH2, Slurm, Cray
+   * PALS) or else from VTK's global controller. The environment variable
+   * OCTORAY_CUDA_DEVICE sets it for every mapper of a process. An index past
+   * the devices wraps around. GetCudaDeviceInUse() is the device of the last
+   * picture (-1 on the CPU).
+   */
+  vtkSetClampMacro(CudaDevice, int, -1, VTK_INT_MAX);
+  vtkGetMacro(CudaDevice, int);
+  int GetCudaDeviceInUse();
+  ///@}
+
+  ///@{
+  /**
+   * CUDA: copy the traced picture from device memory into the compositing
+   * textures on the GPU (CUDA-OpenGL interop) rather than through host
+   * memory. On by default; where the window's OpenGL is not driven by the
+   * engine's GPU (Mesa's software OpenGL, another GPU), the mapper says so
+   * once and takes the host path. GetLastPictureTransfer() says which path
+   * the last traced picture took.
+   */
+  vtkSetMacro(UseCudaGLInterop, bool);
+  vtkGetMacro(UseCudaGLInterop, bool);
+  vtkBooleanMacro(UseCudaGLInterop, bool);
+  enum PictureTransfer
+  {
+    TRANSFER_NONE = 0,  // nothing traced yet
+    TRANSFER_HOST = 1,  // host memory, then a texture upload
+    TRANSFER_DEVICE = 2 // device to device through CUDA-OpenGL interop
+  };
+  int GetLastPictureTransfer();
+  const char* GetLastPictureTransferName(); // "none", "host" or "CUDA-OpenGL interop"
+  ///@}
 
   ///@{
   /**
@@ -217,9 +260,10 @@ public:
 
   ///@{
   /**
-   * Seconds spent in the last build or update, the engine's last trace, and
-   * the VTK layer's share of the last render: depth read-back, texture
-   * upload and the composite draw.
+   * Seconds spent in the last build or update, the engine's last trace
+   * (with its copy to the host, where it made one), and the VTK layer's
+   * share of the last render: depth read-back, the picture's way into the
+   * textures (upload or device copy) and the composite draw.
    */
   vtkGetMacro(LastBuildSeconds, double);
   vtkGetMacro(LastTraceSeconds, double);
@@ -266,6 +310,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
 
   int RequestedBackend = BACKEND_AUTO;
+  int CudaDevice = -1;
+  bool UseCudaGLInterop = true;
   int LeafDepth = 0;
   double LODPixelThreshold = 0.0;
   double RootBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
@@ -291,12 +337,10 @@ private:
   vtkOctreeVolumeMapper(const vtkOctreeVolumeMapper&) = delete;
   void operator=(const vtkOctreeVolumeMapper&) = delete;
 
-  int PrepareOctree(vtkDataSet* input, vtkVolumeProperty* property);
-  bool Guarded(const char* what, const std::function<void()>& call);
-  void ReadDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
-    std::vector<float>& depth);
-  void Draw(vtkRenderer* ren, vtkOpenGLRenderWindow* window);
+  vtkDataSet* UpdatedInput();
 
+  // The engine, the input helper, the frame and the compositor; it does the
+  // work of Render() (vtkOctreeVolumeMapper.cxx).
   class vtkInternals;
   vtkInternals* Internals;
 };

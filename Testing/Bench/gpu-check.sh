@@ -1,14 +1,29 @@
 #!/usr/bin/env bash
-# Builds, tests and benchmarks the CUDA backend in one go on a GPU machine
-# that has only the CUDA toolkit, CMake and a compiler. GoogleTest comes as
-# Debian's sources copied to .deps/googletest (scripts/install-deps.sh
-# installs the googletest package; cp -r /usr/src/googletest .deps/).
-#   Testing/Bench/gpu-check.sh [OUTDIR]
-# Prints a short table last; full logs go to OUTDIR (default build-gpu/logs),
-# the files `make report` reads to OUTDIR/report-files.tgz.
+# Everything the GPU machine proves, in one call: it builds the project with
+# CUDA against VTK with EGL (the engine, the VTK layer, their tests and
+# benchmarks), runs the engine tests and the mapper tests on both backends,
+# compute-sanitizer, and the benchmarks, and prints a short table last.
+#
+# The GPU machine (Ubuntu 24.04, GCC 13, CUDA, CMake, ninja) has no VTK and no
+# network. What it needs travels in the ignored folder .gpu-vtk/, made here by
+# scripts/gpu/fetch-vtk.sh [--prebuilt] and named in the device call's carry:
+#   gl/*.deb             Debian's EGL/OpenGL loaders and headers
+#   vtk-egl.tar.xz       VTK 9.2 built with EGL (--prebuilt); else it is built
+#   vtk92-subset.tar.xz  from these sources here (about 5 minutes, 16 cores)
+#   googletest/          Debian's GoogleTest sources
+# A VTK found in /tmp/vtk-egl (an earlier call on the same machine) is reused.
+#
+#   Testing/Bench/gpu-check.sh OUTDIR [PARTS]
+# PARTS, comma-separated (default all): tests (engine and mapper tests, both
+# backends), sanitize (compute-sanitizer on the engine's and the mapper's CUDA
+# tests), bench (engine benchmarks), report (the report's engine programs),
+# orbit (the mapper against VTK's GPU mappers; ORBIT_ARGS adds arguments).
+# Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
+# report` reads (unpack it into Testing/Bench/gpu/).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-out=${1:-build-gpu/logs}
+out=$(realpath -m "${1:-build-gpu/logs}")
+parts=",${2:-tests,sanitize,bench,report,orbit},"
 mkdir -p "$out"
 status=()
 step() { # name, command...
@@ -16,43 +31,90 @@ step() { # name, command...
   local t0=$(date +%s%N)
   if "$@" >"$out/$name.log" 2>&1; then r=pass; else r=FAIL; fi
   local t1=$(date +%s%N)
-  status+=("$(printf '%-22s %-5s %6d ms' "$name" "$r" "$(( (t1 - t0) / 1000000 ))")")
-  tail -n 5 "$out/$name.log"
+  status+=("$(printf '%-24s %-5s %7d ms' "$name" "$r" "$(( (t1 - t0) / 1000000 ))")")
+  tail -n 3 "$out/$name.log"
 }
+want() { [[ $parts == *",$1,"* ]]; }
 
+# ---- OpenGL through EGL on the NVIDIA driver, and VTK.
+carried=$PWD/.gpu-vtk
+for f in "$carried"/gl/*.deb; do dpkg -x "$f" /; done
+ldconfig
+export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+vtk=/tmp/vtk-egl
+if [ ! -f "$vtk/lib/cmake/vtk-9.2/vtk-config.cmake" ]; then
+  if [ -f "$carried/vtk-egl.tar.xz" ]; then
+    step vtk-unpack bash -c "mkdir -p /tmp && tar -xJf '$carried/vtk-egl.tar.xz' -C /tmp"
+  else
+    step vtk-build scripts/gpu/build-vtk-egl.sh "$carried" "$vtk"
+  fi
+fi
+export LD_LIBRARY_PATH=$vtk/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
-step configure cmake -S Rendering/Engine -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DOCTORAY_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DOCTORAY_GTEST_SOURCE_DIR="$PWD/.deps/googletest"
-step build cmake --build build-gpu -j 16
-step tests build-gpu/bin/octoray_engine_tests --gtest_output=xml:"$out/engine-tests.xml"
-# CudaFaultsLaunch makes the CUDA runtime refuse launches on purpose, which
-# compute-sanitizer counts as API errors; it runs under memcheck on its own,
-# with API errors not reported, so the error paths are still checked for
-# memory faults.
-tests='*CUDA*:CudaFaults*'
-step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
-step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-CudaFaultsLaunch*"
-step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter='CudaFaultsLaunch*'
-step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
-step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 build-gpu/bin/octoray_engine_tests --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
-step bench build-gpu/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
-# The report's GPU rows (make report reads them from Testing/Bench/gpu/).
-# The CT scene is made here by `make report` (VTK reads the DICOM series)
-# and carried to the GPU machine as build/report/scenes/ct5n.particles.
-step quality build-gpu/bin/octoray_bench_quality --backend cuda --scenes build/report/scenes --json "$out/quality-cuda.json"
-step bench-render build-gpu/bin/octoray_bench_render --backend cuda --size 1920x1080 --parts modes --json "$out/bench-render-cuda.json"
-step bench-thesis build-gpu/bin/octoray_bench_thesis --backend cuda --json "$out/bench-thesis-cuda.json"
-step bench-quantisation build-gpu/bin/octoray_bench_quantisation --backend cuda --json "$out/bench-quantisation-cuda.json"
+
+# ---- One build: engine, VTK modules (those VTK alone serves: the mapper and
+# the particle reader), tests and benchmarks. -include cstdint: VTK 9.2's
+# headers predate GCC 13.
+build=build-gpu
+step configure cmake -S . -B $build -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
+  -DCMAKE_CUDA_ARCHITECTURES=90 -DVTK_DIR="$vtk/lib/cmake/vtk-9.2" -DCMAKE_CXX_FLAGS="-include cstdint" \
+  -DOCTORAY_GTEST_SOURCE_DIR="$carried/googletest"
+step build cmake --build $build -j "$(nproc)"
+
+# The mapper tests: the CPU ones (label vtk) and the CUDA ones (label gpu).
+mapper_tests='RenderingVolumeCxx'
+if want tests; then
+  step engine-tests $build/bin/octoray_engine_tests --gtest_output=xml:"$out/engine-tests.xml"
+  step mapper-tests bash -c "cd $build && ctest -R '$mapper_tests' --output-on-failure --output-junit '$out/mapper-tests.xml'"
+fi
+
+if want sanitize; then
+  # CudaFaultsLaunch makes the CUDA runtime refuse launches on purpose, which
+  # compute-sanitizer counts as API errors; it runs under memcheck on its
+  # own, with API errors not reported, so the error paths are still checked.
+  tests='*CUDA*:CudaFaults*'
+  engine=$build/bin/octoray_engine_tests
+  step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 $engine --gtest_filter="$tests:-CudaFaultsLaunch*"
+  step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 1 $engine --gtest_filter='CudaFaultsLaunch*'
+  step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
+  step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
+  step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
+  # Every CUDA mapper test under memcheck, with the command CTest runs.
+  (cd $build && ctest -L gpu -R "$mapper_tests" -N -V) | sed -n 's/^[0-9]*: Test command: //p' > "$out/mapper-commands.txt"
+  step memcheck-mapper bash -c "set -e; while read -r cmd; do eval compute-sanitizer --tool memcheck --error-exitcode 1 \$cmd; done < '$out/mapper-commands.txt'"
+fi
+
+if want bench; then
+  step bench $build/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
+fi
+if want report; then
+  # The CT scene is made here by `make report` (VTK reads the DICOM series)
+  # and carried as build/report/scenes/ct5n.particles.
+  step quality $build/bin/octoray_bench_quality --backend cuda --scenes build/report/scenes --json "$out/quality-cuda.json"
+  step bench-render $build/bin/octoray_bench_render --backend cuda --size 1920x1080 --parts modes --json "$out/bench-render-cuda.json"
+  step bench-thesis $build/bin/octoray_bench_thesis --backend cuda --json "$out/bench-thesis-cuda.json"
+  step bench-quantisation $build/bin/octoray_bench_quantisation --backend cuda --json "$out/bench-quantisation-cuda.json"
+fi
+if want orbit; then
+  mkdir -p "$out/orbit"
+  # shellcheck disable=SC2086
+  step orbit $build/bin/octoray_bench_orbit --json "$out/orbit.json" --images "$out/orbit" ${ORBIT_ARGS:-}
+fi
 
 {
 echo
-echo "== octoray CUDA check, $(date -u +%Y-%m-%d) =="
-grep -E "tests? (ran|from)|PASSED|FAILED" "$out/tests.log" | tail -3
-grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out"/memcheck.log "$out"/memcheck-refused.log "$out"/racecheck.log "$out"/initcheck.log "$out"/synccheck.log
-grep -E "^(device|build|update|render|thesis|  [0-9]+ points)" "$out/bench.log"
+echo "== octoray GPU check, $(date -u +%Y-%m-%d): $(cat "$out/gpu.txt") =="
+[ -f "$out/engine-tests.log" ] && grep -E "tests? (ran|from)|PASSED|FAILED" "$out/engine-tests.log" | tail -3
+[ -f "$out/mapper-tests.log" ] && grep -E "tests passed|tests failed|\(Failed\)|\(Skipped\)" "$out/mapper-tests.log" | tail -8
+for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper; do
+  [ -f "$out/$f.log" ] && echo "$f: $(grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out/$f.log" | sort | uniq -c | tr -s ' ' | paste -sd';')"
+done
+[ -f "$out/bench.log" ] && grep -E "^(device|build|update|render)" "$out/bench.log"
+[ -f "$out/orbit.log" ] && grep -E "^(clusters|  =>)" "$out/orbit.log" | cut -c1-200
 printf '%s\n' "${status[@]}"
 } | tee "$out/summary.txt"
 # What `make report` reads, in one archive (the device tool brings back only
-# a limited number of files): unpack it into Testing/Bench/gpu/.
-tar czf "$out/report-files.tgz" -C "$out" summary.txt gpu.txt engine-tests.xml bench-results-cuda.json \
-  quality-cuda.json bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json
+# a limited number of files).
+(cd "$out" && tar czf report-files.tgz $(ls summary.txt gpu.txt engine-tests.xml mapper-tests.xml \
+  bench-results-cuda.json quality-cuda.json bench-render-cuda.json bench-thesis-cuda.json \
+  bench-quantisation-cuda.json orbit.json orbit 2>/dev/null))

@@ -31,8 +31,9 @@ def read_png(path):
 def test_mappers_are_in_the_package():
     m = octoray.vtkOctreeVolumeMapper()
     assert isinstance(m, octoray.vtkOctreeVolumeMapper)
-    expected = octoray.vtkCudaOctreeVolumeMapper if m.IsCudaAvailable() else octoray.vtkCPUOctreeVolumeMapper
-    assert isinstance(m, expected)
+    assert m.GetRequestedBackend() == m.BACKEND_AUTO  # CUDA where usable, chosen at the first render
+    assert m.GetCudaDevice() == -1 and m.GetUseCudaGLInterop()
+    assert octoray.vtkCudaOctreeVolumeMapper().GetRequestedBackend() == m.BACKEND_CUDA
     cpu = octoray.vtkCPUOctreeVolumeMapper()
     assert cpu.GetRequestedBackend() == cpu.BACKEND_CPU
     cpu.SetLeafDepth(7)

@@ -449,21 +449,44 @@ OctreeView CudaEngine::DeviceState::View() const
   return v;
 }
 
-CudaEngine::CudaEngine()
+CudaEngine::CudaEngine(int device)
 {
-  int device = 0;
-  CudaCheck(cudaGetDevice(&device), "cudaGetDevice");
+  if (device < 0)
+  {
+    CudaCheck(cudaGetDevice(&device), "cudaGetDevice");
+  }
+  Device = device;
   cudaDeviceProp prop;
   CudaCheck(cudaGetDeviceProperties(&prop, device), "cudaGetDeviceProperties");
   DeviceName = prop.name;
   State = std::make_unique<DeviceState>();
 }
 
-CudaEngine::~CudaEngine() = default;
+CudaEngine::~CudaEngine()
+{
+  DestructionScope = std::make_unique<ScopedDevice>(Device);
+}
 
 std::string CudaEngine::Description() const
 {
-  return "CUDA (" + DeviceName + ")";
+  int count = 0;
+  cudaGetDeviceCount(&count);
+  return "CUDA (" + DeviceName + (count > 1 ? ", device " + std::to_string(Device) : std::string()) + ")";
+}
+
+DeviceImage CudaEngine::LastDeviceImage() const
+{
+  DeviceImage image;
+  if (ImageWidth > 0)
+  {
+    image.width = ImageWidth;
+    image.height = ImageHeight;
+    image.device = Device;
+    image.rgba = ImageIs8Bit ? nullptr : ImageRgba.Get();
+    image.rgba8 = ImageIs8Bit ? ImageRgba8.Get() : nullptr;
+    image.depth = ImageDepth.Get();
+  }
+  return image;
 }
 
 void* CudaEngine::CubTemp(std::size_t bytes)
@@ -474,6 +497,7 @@ void* CudaEngine::CubTemp(std::size_t bytes)
 
 BuildStats CudaEngine::Build(const PointCloudView& points, const BuildOptions& options)
 {
+  const ScopedDevice scope(Device);
   ValidateCloud(points);
   ValidateDepth(options.depth);
   const auto start = std::chrono::steady_clock::now();
@@ -739,6 +763,7 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
 
 UpdateStats CudaEngine::Update(const PositionsView& positions)
 {
+  const ScopedDevice scope(Device);
   if (State->count == 0 && DiscardedByUpdate)
   {
     throw Error("octoray: update after a failed update discarded the octree; build again");
@@ -852,6 +877,8 @@ UpdateStats CudaEngine::UpdateState(DeviceState& s, const PositionsView& positio
 
 RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
 {
+  const ScopedDevice scope(Device);
+  ImageWidth = ImageHeight = 0; // no picture until this one is complete
   const DeviceState& s = *State;
   if (s.count == 0)
   {
@@ -899,8 +926,9 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   CudaCheck(cudaMemcpy(&secondary, counter.Get(), sizeof(secondary), cudaMemcpyDeviceToHost), "RenderKernel");
   stats.secondaryRays = secondary;
   stats.seconds = SecondsSince(start);
-  image.width = settings.width;
-  image.height = settings.height;
+  image.width = ImageWidth = settings.width;
+  image.height = ImageHeight = settings.height;
+  ImageIs8Bit = settings.rgba8;
   if (settings.copyToHost)
   {
     const auto copy = std::chrono::steady_clock::now();
@@ -984,6 +1012,7 @@ bool CudaEngine::UpdateInPlace(DeviceState& s, const void* deviceMoves, std::siz
 
 void CudaEngine::CopyToHost(HostOctree& out) const
 {
+  const ScopedDevice scope(Device);
   const DeviceState& s = *State;
   out.depth = s.depth;
   out.cube = s.cube;
@@ -1043,8 +1072,19 @@ bool CudaDeviceUsable(std::string* why)
   return true;
 }
 
-std::unique_ptr<Engine> CreateCudaEngine()
+int CudaDevices()
 {
-  return std::make_unique<CudaEngine>();
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess)
+  {
+    cudaGetLastError();
+    return 0;
+  }
+  return count;
+}
+
+std::unique_ptr<Engine> CreateCudaEngine(int device)
+{
+  return std::make_unique<CudaEngine>(device);
 }
 }

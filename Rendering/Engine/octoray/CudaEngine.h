@@ -12,7 +12,8 @@ namespace octoray
 class CudaEngine final : public Engine
 {
 public:
-  CudaEngine();
+  // Works on `device` (-1: the caller's current device).
+  explicit CudaEngine(int device);
   ~CudaEngine() override;
 
   Backend Kind() const override { return Backend::CUDA; }
@@ -62,6 +63,7 @@ public:
   const float* DeviceImageRgba() const { return ImageRgba.Get(); }
   const std::uint8_t* DeviceImageRgba8() const { return ImageRgba8.Get(); }
   const float* DeviceImageDepth() const { return ImageDepth.Get(); }
+  DeviceImage LastDeviceImage() const override;
 
 private:
   void DataBounds(const DeviceState& s, double lo[3], double hi[3]);
@@ -74,7 +76,14 @@ private:
   // The update proper; sets `writing` before its first write to the state.
   UpdateStats UpdateState(DeviceState& s, const PositionsView& positions, bool& writing);
 
+  int Device = 0;
   std::string DeviceName;
+  int ImageWidth = 0, ImageHeight = 0;
+  bool ImageIs8Bit = false;
+  // Declared first so that it is destroyed last: the destructor makes the
+  // engine's device current and this restores the caller's once every
+  // buffer below is freed.
+  std::unique_ptr<ScopedDevice> DestructionScope;
   // Declared before the buffers so that it outlives them.
   DeviceMemoryPool Pool;
   std::unique_ptr<DeviceState> State;

@@ -46,6 +46,37 @@ inline dim3 LaunchGrid(const char* kernel, dim3 grid)
     ::octoray::CudaCheckLaunch(#kernel);                                                                               \
   } while (0)
 
+// Makes an engine's device current for the scope of one of its calls and
+// restores the caller's afterwards, so that engines on different devices
+// (one mapper per GPU) live in one process and never disturb a caller's own
+// CUDA work.
+class ScopedDevice
+{
+public:
+  explicit ScopedDevice(int device)
+  {
+    cudaGetDevice(&Previous);
+    if (device >= 0 && device != Previous)
+    {
+      CudaCheck(cudaSetDevice(device), "cudaSetDevice");
+      Changed = true;
+    }
+  }
+  ~ScopedDevice()
+  {
+    if (Changed)
+    {
+      cudaSetDevice(Previous);
+    }
+  }
+  ScopedDevice(const ScopedDevice&) = delete;
+  ScopedDevice& operator=(const ScopedDevice&) = delete;
+
+private:
+  int Previous = 0;
+  bool Changed = false;
+};
+
 // Every device allocation of one engine goes through this: it enforces a
 // budget (set to test and to live with out-of-memory) and reports what the
 // engine holds.

@@ -10,9 +10,19 @@ const char* ToString(Backend backend)
 }
 
 #if OCTORAY_HAVE_CUDA
-std::unique_ptr<Engine> CreateCudaEngine(); // CudaEngine.cu
+std::unique_ptr<Engine> CreateCudaEngine(int device); // CudaEngine.cu
 bool CudaDeviceUsable(std::string* why);
+int CudaDevices();
 #endif
+
+int CudaDeviceCount()
+{
+#if OCTORAY_HAVE_CUDA
+  return CudaDevices();
+#else
+  return 0;
+#endif
+}
 
 bool CudaAvailable(std::string* why)
 {
@@ -27,7 +37,7 @@ bool CudaAvailable(std::string* why)
 #endif
 }
 
-std::unique_ptr<Engine> CreateEngine(Backend backend)
+std::unique_ptr<Engine> CreateEngine(Backend backend, int cudaDevice)
 {
   if (backend == Backend::CPU)
   {
@@ -38,8 +48,13 @@ std::unique_ptr<Engine> CreateEngine(Backend backend)
   {
     throw Error("octoray: the CUDA backend is not available: " + why);
   }
+  if (cudaDevice >= CudaDeviceCount())
+  {
+    throw Error("octoray: CUDA device " + std::to_string(cudaDevice) + " does not exist (this process sees " +
+      std::to_string(CudaDeviceCount()) + ")");
+  }
 #if OCTORAY_HAVE_CUDA
-  return CreateCudaEngine();
+  return CreateCudaEngine(cudaDevice);
 #else
   return nullptr;
 #endif

@@ -55,6 +55,12 @@ public:
   // Error for settings that cannot make a picture or before any build.
   virtual RenderStats Render(const RenderSettings& settings, Image& image) = 0;
 
+  // The last picture where the backend keeps it: device memory for CUDA
+  // (valid until the next Render or Build), nothing for the CPU. A caller
+  // that draws with OpenGL copies it from there into its textures without
+  // a round trip through the host (RenderSettings::copyToHost off).
+  virtual DeviceImage LastDeviceImage() const { return {}; }
+
   virtual std::size_t PointCount() const = 0;
   virtual void CopyToHost(HostOctree& out) const = 0;
   virtual MemoryReport Memory() const = 0;
@@ -69,9 +75,14 @@ public:
 };
 
 // The backend's engine. Throws Error when the backend is not available here
-// (CUDA not compiled in, or no usable device), saying why.
-std::unique_ptr<Engine> CreateEngine(Backend backend);
+// (CUDA not compiled in, or no usable device), saying why. `cudaDevice`:
+// the CUDA device the engine works on (an index below CudaDeviceCount());
+// -1 keeps the calling thread's current device.
+std::unique_ptr<Engine> CreateEngine(Backend backend, int cudaDevice = -1);
 
 // Whether CreateEngine(Backend::CUDA) would succeed; if not, why.
 bool CudaAvailable(std::string* why = nullptr);
+
+// CUDA devices this process sees (0 without CUDA or without a device).
+int CudaDeviceCount();
 }

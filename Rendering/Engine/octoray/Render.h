@@ -82,6 +82,17 @@ struct Image
   std::vector<float> depth;
 };
 
+// A picture in device memory (Engine::LastDeviceImage): the same layout as
+// Image, colour as 4 floats a pixel or, after an rgba8 frame, 4 bytes.
+struct DeviceImage
+{
+  int width = 0, height = 0;
+  int device = -1; // the CUDA device that holds it; -1: none (CPU backend)
+  const float* rgba = nullptr;
+  const std::uint8_t* rgba8 = nullptr;
+  const float* depth = nullptr;
+};
+
 // A premultiplied channel in [0,1] as a byte, rounded to nearest.
 inline std::uint8_t ChannelToByte(float v)
 {

@@ -43,13 +43,13 @@
 #ifndef vtkParticleTextReader_h
 #define vtkParticleTextReader_h
 
-#include "octorayFiltersParticlesModule.h" // for export macro
+#include "octorayIOParticlesModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
 #include "vtkSmartPointer.h" // for vtkSmartPointer
 
 #include <string> // for std::string
 
-class OCTORAYFILTERSPARTICLES_EXPORT vtkParticleTextReader : public vtkPolyDataAlgorithm
+class OCTORAYIOPARTICLES_EXPORT vtkParticleTextReader : public vtkPolyDataAlgorithm
 {
 public:
   static vtkParticleTextReader* New();

@@ -13,10 +13,10 @@
 #ifndef vtkParticleTextWriter_h
 #define vtkParticleTextWriter_h
 
-#include "octorayFiltersParticlesModule.h" // for export macro
+#include "octorayIOParticlesModule.h" // for export macro
 #include "vtkWriter.h"
 
-class OCTORAYFILTERSPARTICLES_EXPORT vtkParticleTextWriter : public vtkWriter
+class OCTORAYIOPARTICLES_EXPORT vtkParticleTextWriter : public vtkWriter
 {
 public:
   static vtkParticleTextWriter* New();

@@ -17,12 +17,12 @@
 #ifndef vtkDepthMapReader_h
 #define vtkDepthMapReader_h
 
-#include "octorayFiltersParticlesModule.h" // for export macro
+#include "octorayIOImageStackModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
 
 #include <string> // for std::string
 
-class OCTORAYFILTERSPARTICLES_EXPORT vtkDepthMapReader : public vtkPolyDataAlgorithm
+class OCTORAYIOIMAGESTACK_EXPORT vtkDepthMapReader : public vtkPolyDataAlgorithm
 {
 public:
   static vtkDepthMapReader* New();

@@ -38,7 +38,7 @@
 #ifndef vtkSliceStackReader_h
 #define vtkSliceStackReader_h
 
-#include "octorayFiltersParticlesModule.h" // for export macro
+#include "octorayIOImageStackModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
 #include "vtkSmartPointer.h" // for vtkSmartPointer
 
@@ -48,7 +48,7 @@
 class vtkImageData;
 class vtkStringArray;
 
-class OCTORAYFILTERSPARTICLES_EXPORT vtkSliceStackReader : public vtkPolyDataAlgorithm
+class OCTORAYIOIMAGESTACK_EXPORT vtkSliceStackReader : public vtkPolyDataAlgorithm
 {
 public:
   static vtkSliceStackReader* New();

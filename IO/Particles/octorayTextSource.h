@@ -23,7 +23,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <zlib.h>
+#include "vtk_zlib.h" // VTK's zlib: the module needs no third-party library of its own
 
 namespace octoray
 {

@@ -16,10 +16,10 @@
 #ifndef vtkParticleNormals_h
 #define vtkParticleNormals_h
 
-#include "octorayFiltersParticlesModule.h" // for export macro
+#include "octorayFiltersPCLModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
 
-class OCTORAYFILTERSPARTICLES_EXPORT vtkParticleNormals : public vtkPolyDataAlgorithm
+class OCTORAYFILTERSPCL_EXPORT vtkParticleNormals : public vtkPolyDataAlgorithm
 {
 public:
   static vtkParticleNormals* New();

@@ -1,0 +1,592 @@
+// The octree mapper against VTK's own GPU mappers, on the same points, the
+// same camera orbit and the same offscreen window (issue 13). For each point
+// set and window size, each method draws an orbit of the camera around the
+// points and records:
+//   - time to the first picture: from points in memory to the first frame on
+//     screen (octree build, or resampling onto an image, plus the first
+//     render); reading or generating the points is reported apart;
+//   - median and 95th-percentile frame time over the orbit (each frame ends
+//     with glFinish, so it is the GPU's time too);
+//   - GPU memory the method added (cudaMemGetInfo: the device's whole use,
+//     OpenGL's buffers and textures included).
+// Methods:
+//   octoray          vtkOctreeVolumeMapper, CUDA, picture to OpenGL device to device
+//   octoray-host     the same with the picture through host memory
+//   pointgauss       vtkPointGaussianMapper (ParaView's "Sphere" splat shader)
+//   points           vtkPolyDataMapper drawing the vertices, 2-pixel points
+//   smart-G          vtkPointInterpolator (Gaussian kernel) onto G^3 voxels,
+//                    then vtkSmartVolumeMapper (GPU ray casting) of RGBA
+// A method whose first frame is slow draws fewer orbit frames (at least 3),
+// so that one run stays within the device's time; the count is recorded.
+//
+//   octoray_bench_orbit [--points 1e6,1e7,1e8] [--sizes 1920x1080,3840x2160]
+//     [--methods octoray,octoray-host,pointgauss,points,smart-256,smart-512]
+//     [--file particles.txt] [--frames 60] [--seconds 6] [--json out.json]
+//     [--images DIR]   (each method's first frame as a PNG)
+#include "BenchUtil.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkCellArray.h"
+#include "vtkFloatArray.h"
+#include "vtkGaussianKernel.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkOctreeVolumeMapper.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkParticleTextReader.h"
+#include "vtkPNGWriter.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkPointGaussianMapper.h"
+#include "vtkPointInterpolator.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
+#include "vtkSmartVolumeMapper.h"
+#include "vtkTypeInt32Array.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtkWindowToImageFilter.h"
+
+#include <cuda_runtime_api.h>
+
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <thread>
+
+using namespace octoray::bench;
+
+namespace
+{
+double Now()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Bytes in use on the current CUDA device (all of it: CUDA and OpenGL).
+double DeviceBytesUsed()
+{
+  std::size_t freeBytes = 0, total = 0;
+  return cudaMemGetInfo(&freeBytes, &total) == cudaSuccess ? static_cast<double>(total - freeBytes) : 0.0;
+}
+
+// ---------------------------------------------------------------- points
+
+// Clustered points with a colour from their position: `n` points in 64
+// Gaussian blobs (fixed seed), made on every core; deterministic for a given
+// n whatever the thread count.
+vtkSmartPointer<vtkPolyData> ClusteredPoints(std::size_t n)
+{
+  const int clusters = 64;
+  Random centres(kDefaultSeed);
+  std::vector<double> centre(3 * clusters), sigma(clusters);
+  for (int k = 0; k < clusters; ++k)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      centre[3 * k + a] = 0.1 + 0.8 * centres.Uniform();
+    }
+    sigma[k] = 0.01 + 0.05 * centres.Uniform();
+  }
+  vtkNew<vtkFloatArray> xyz;
+  xyz->SetNumberOfComponents(3);
+  xyz->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  vtkNew<vtkUnsignedCharArray> rgb;
+  rgb->SetName("Colors");
+  rgb->SetNumberOfComponents(3);
+  rgb->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  const std::size_t block = 1 << 20;
+  const std::size_t blocks = (n + block - 1) / block;
+  std::vector<std::thread> workers;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned t = 0; t < threads; ++t)
+  {
+    workers.emplace_back([&, t] {
+      for (std::size_t b = t; b < blocks; b += threads)
+      {
+        Random random(kDefaultSeed + 1 + b);
+        for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
+        {
+          const std::size_t k = random.Next() % clusters;
+          float* p = xyz->GetPointer(3 * static_cast<vtkIdType>(i));
+          unsigned char* c = rgb->GetPointer(3 * static_cast<vtkIdType>(i));
+          for (int a = 0; a < 3; ++a)
+          {
+            p[a] = static_cast<float>(centre[3 * k + a] + sigma[k] * random.Normal());
+            c[a] = static_cast<unsigned char>(40 + 215 * std::min(1.0, std::max(0.0, static_cast<double>(p[a]))));
+          }
+        }
+      }
+    });
+  }
+  for (std::thread& w : workers)
+  {
+    w.join();
+  }
+  auto cloud = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetData(xyz);
+  cloud->SetPoints(points);
+  cloud->GetPointData()->SetScalars(rgb);
+  return cloud;
+}
+
+// One vertex cell per point (vtkPolyDataMapper draws cells), 32-bit ids.
+void AddVertices(vtkPolyData* cloud)
+{
+  const vtkIdType n = cloud->GetNumberOfPoints();
+  vtkNew<vtkTypeInt32Array> offsets, connectivity;
+  offsets->SetNumberOfValues(n + 1);
+  connectivity->SetNumberOfValues(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    offsets->SetValue(i, static_cast<int>(i));
+    connectivity->SetValue(i, static_cast<int>(i));
+  }
+  offsets->SetValue(n, static_cast<int>(n));
+  vtkNew<vtkCellArray> verts;
+  verts->SetData(offsets, connectivity);
+  cloud->SetVerts(verts);
+}
+
+// ---------------------------------------------------------------- methods
+
+struct Scene
+{
+  std::string Name;
+  vtkSmartPointer<vtkPolyData> Cloud;
+  double Bounds[6];
+  double Radius; // splat radius: about the mean point spacing on the surface
+  double PrepareSeconds = 0.0; // reading or generating the points
+};
+
+struct Method
+{
+  vtkSmartPointer<vtkProp> Prop;
+  double PrepareSeconds = 0.0; // resampling onto an image, before the first render
+  vtkOctreeVolumeMapper* Octree = nullptr;
+  std::string Note;
+};
+
+Method Octree(const Scene& scene, bool interop)
+{
+  vtkNew<vtkOctreeVolumeMapper> mapper;
+  mapper->SetRequestedBackendToCuda();
+  mapper->SetUseCudaGLInterop(interop);
+  mapper->SetInputData(scene.Cloud);
+  mapper->SetLeafDepth(0); // chosen from the data, as a user gets it
+  auto volume = vtkSmartPointer<vtkVolume>::New();
+  volume->SetMapper(mapper);
+  vtkNew<vtkVolumeProperty> property;
+  property->IndependentComponentsOff();
+  property->ShadeOn();
+  volume->SetProperty(property);
+  Method m;
+  m.Prop = volume;
+  m.Octree = mapper;
+  return m;
+}
+
+// ParaView's "Sphere" preset of the Point Gaussian representation: a lit,
+// opaque disc shaded as a sphere (the default Gaussian blur is translucent).
+const char* const kSphereShader = "//VTK::Color::Impl\n"
+                                  "float dist = dot(offsetVCVSOutput.xy, offsetVCVSOutput.xy);\n"
+                                  "if (dist > 1.0) { discard; } else {\n"
+                                  "  float scale = (1.0 - dist);\n"
+                                  "  ambientColor *= scale;\n"
+                                  "  diffuseColor *= scale;\n"
+                                  "}\n";
+
+Method PointGaussian(const Scene& scene)
+{
+  vtkNew<vtkPointGaussianMapper> mapper;
+  mapper->SetInputData(scene.Cloud);
+  mapper->SetScaleFactor(scene.Radius);
+  mapper->EmissiveOff();
+  mapper->SetSplatShaderCode(kSphereShader);
+  mapper->SetColorModeToDirectScalars();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  Method m;
+  m.Prop = actor;
+  return m;
+}
+
+Method Points(const Scene& scene)
+{
+  if (!scene.Cloud->GetVerts() || scene.Cloud->GetVerts()->GetNumberOfCells() == 0)
+  {
+    AddVertices(scene.Cloud);
+  }
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(scene.Cloud);
+  mapper->SetColorModeToDirectScalars();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetPointSize(2);
+  Method m;
+  m.Prop = actor;
+  return m;
+}
+
+// The points resampled onto `grid`^3 voxels over their bounds by
+// vtkPointInterpolator with a Gaussian kernel (radius: the scene's splat
+// radius, at least a voxel), then vtkSmartVolumeMapper: RGBA voxels with the
+// interpolated colour and, as alpha, the interpolator's mask of voxels that
+// had points within the radius.
+Method SmartVolume(const Scene& scene, int grid)
+{
+  const double* b = scene.Bounds;
+  const double longest = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
+  const double h = longest / (grid - 1);
+  const double t0 = Now();
+  vtkNew<vtkImageData> image;
+  int dims[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    dims[a] = std::max(2, static_cast<int>(std::ceil((b[2 * a + 1] - b[2 * a]) / h)) + 1);
+  }
+  image->SetDimensions(dims);
+  image->SetOrigin(b[0], b[2], b[4]);
+  image->SetSpacing(h, h, h);
+  vtkNew<vtkGaussianKernel> kernel;
+  kernel->SetRadius(std::max(scene.Radius, h));
+  kernel->SetSharpness(2.0);
+  vtkNew<vtkPointInterpolator> interpolator;
+  interpolator->SetInputData(image);
+  interpolator->SetSourceData(scene.Cloud);
+  interpolator->SetKernel(kernel);
+  interpolator->SetNullPointsStrategyToMaskPoints();
+  interpolator->Update();
+  vtkDataSet* out = interpolator->GetOutput();
+  auto* colours = vtkDataArray::SafeDownCast(out->GetPointData()->GetArray("Colors"));
+  auto* valid = vtkDataArray::SafeDownCast(out->GetPointData()->GetArray(interpolator->GetValidPointsMaskArrayName()));
+  const vtkIdType voxels = out->GetNumberOfPoints();
+  vtkNew<vtkUnsignedCharArray> rgba;
+  rgba->SetName("RGBA");
+  rgba->SetNumberOfComponents(4);
+  rgba->SetNumberOfTuples(voxels);
+  for (vtkIdType i = 0; i < voxels; ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      rgba->SetTypedComponent(i, c, static_cast<unsigned char>(colours->GetComponent(i, c)));
+    }
+    rgba->SetTypedComponent(i, 3, valid->GetComponent(i, 0) != 0 ? 255 : 0);
+  }
+  // An empty voxel beside a filled one takes that voxel's colour: the ray
+  // caster interpolates colour and opacity apart (not premultiplied), so
+  // black empty voxels would otherwise darken every blob's rim.
+  const vtkIdType step[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  for (vtkIdType i = 0; i < voxels; ++i)
+  {
+    if (rgba->GetTypedComponent(i, 3) != 0)
+    {
+      continue;
+    }
+    for (int a = 0; a < 6; ++a)
+    {
+      const vtkIdType j = i + (a % 2 ? step[a / 2] : -step[a / 2]);
+      if (j >= 0 && j < voxels && valid->GetComponent(j, 0) != 0)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          rgba->SetTypedComponent(i, c, rgba->GetTypedComponent(j, c));
+        }
+        break;
+      }
+    }
+  }
+  auto volumeImage = vtkSmartPointer<vtkImageData>::New();
+  volumeImage->CopyStructure(out);
+  volumeImage->GetPointData()->SetScalars(rgba);
+  Method m;
+  m.PrepareSeconds = Now() - t0;
+  vtkNew<vtkSmartVolumeMapper> mapper;
+  mapper->SetInputData(volumeImage);
+  mapper->SetRequestedRenderModeToGPU();
+  auto volume = vtkSmartPointer<vtkVolume>::New();
+  volume->SetMapper(mapper);
+  // RGB drawn directly, A through the opacity function. Unshaded: with
+  // dependent RGBA components VTK 9.2's ray caster lights with the ambient
+  // term only, which would just darken the picture.
+  vtkNew<vtkVolumeProperty> property;
+  property->IndependentComponentsOff();
+  property->ShadeOff();
+  property->SetInterpolationTypeToLinear();
+  vtkNew<vtkPiecewiseFunction> opacity;
+  opacity->AddPoint(0, 0.0);
+  opacity->AddPoint(255, 1.0);
+  property->SetScalarOpacity(opacity);
+  volume->SetProperty(property);
+  m.Prop = volume;
+  m.Note = std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]);
+  return m;
+}
+
+// ---------------------------------------------------------------- the orbit
+
+struct Result
+{
+  std::string Scene, Method, Note;
+  std::size_t Points = 0;
+  int Width = 0, Height = 0;
+  double PrepareSeconds = 0.0, FirstPictureSeconds = 0.0, MedianFrame = 0.0, P95Frame = 0.0, GpuBytes = 0.0;
+  int Frames = 0;
+  // octoray's share of a frame: trace, depth read, picture transfer, draw.
+  double Trace = 0.0, Depth = 0.0, Transfer = 0.0, Draw = 0.0;
+  std::string Backend;
+};
+
+double Percentile(std::vector<double> v, double q)
+{
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+}
+
+// The window's picture as a PNG file.
+void WritePicture(vtkRenderWindow* window, const std::string& path)
+{
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->ReadFrontBufferOff();
+  vtkNew<vtkPNGWriter> png;
+  png->SetInputConnection(grab->GetOutputPort());
+  png->SetFileName(path.c_str());
+  png->Write();
+}
+
+Result Orbit(const Scene& scene, const std::string& name, int width, int height, int frames, double seconds,
+  const std::string& images)
+{
+  Result r;
+  r.Scene = scene.Name;
+  r.Method = name;
+  r.Points = static_cast<std::size_t>(scene.Cloud->GetNumberOfPoints());
+  r.Width = width;
+  r.Height = height;
+  const double before = DeviceBytesUsed();
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(width, height);
+  vtkNew<vtkRenderer> ren;
+  ren->SetBackground(0.1, 0.1, 0.12);
+  window->AddRenderer(ren);
+  auto* gl = vtkOpenGLRenderWindow::SafeDownCast(window);
+  window->Render(); // the context and an empty frame: not the method's cost
+  gl->WaitForCompletion();
+
+  const double t0 = Now();
+  Method m;
+  if (name == "octoray" || name == "octoray-host")
+  {
+    m = Octree(scene, name == "octoray");
+  }
+  else if (name == "pointgauss")
+  {
+    m = PointGaussian(scene);
+  }
+  else if (name == "points")
+  {
+    m = Points(scene);
+  }
+  else
+  {
+    m = SmartVolume(scene, std::stoi(name.substr(name.find('-') + 1)));
+  }
+  ren->AddViewProp(m.Prop);
+  ren->ResetCamera(scene.Bounds);
+  ren->GetActiveCamera()->Elevation(25);
+  ren->GetActiveCamera()->Zoom(1.3);
+  ren->ResetCameraClippingRange(scene.Bounds);
+  window->Render();
+  gl->WaitForCompletion();
+  r.FirstPictureSeconds = Now() - t0;
+  r.PrepareSeconds = m.PrepareSeconds;
+  r.Note = m.Note;
+  r.GpuBytes = DeviceBytesUsed() - before;
+  if (!images.empty())
+  {
+    WritePicture(window, images + "/" + scene.Name + "-" + std::to_string(r.Points) + "-" + std::to_string(width) +
+        "x" + std::to_string(height) + "-" + name + ".png");
+  }
+
+  // Fewer frames for a slow method (at least 3), so the run fits its time.
+  const double firstFrame = r.FirstPictureSeconds - m.PrepareSeconds;
+  r.Frames = std::max(3, std::min(frames, static_cast<int>(seconds / std::max(firstFrame, 1e-3))));
+  std::vector<double> times, trace, depth, transfer, draw;
+  for (int f = 0; f < r.Frames; ++f)
+  {
+    ren->GetActiveCamera()->Azimuth(360.0 / r.Frames);
+    ren->ResetCameraClippingRange(scene.Bounds);
+    const double f0 = Now();
+    window->Render();
+    gl->WaitForCompletion();
+    times.push_back(Now() - f0);
+    if (m.Octree)
+    {
+      trace.push_back(m.Octree->GetLastTraceSeconds());
+      depth.push_back(m.Octree->GetLastDepthReadSeconds());
+      transfer.push_back(m.Octree->GetLastUploadSeconds());
+      draw.push_back(m.Octree->GetLastDrawSeconds());
+    }
+  }
+  r.MedianFrame = Summarise(times).median;
+  r.P95Frame = Percentile(times, 0.95);
+  if (m.Octree)
+  {
+    r.Trace = Summarise(trace).median;
+    r.Depth = Summarise(depth).median;
+    r.Transfer = Summarise(transfer).median;
+    r.Draw = Summarise(draw).median;
+    r.Backend = std::string(m.Octree->GetLastUsedBackendName()) + ", " + m.Octree->GetLastPictureTransferName();
+  }
+  return r;
+}
+
+void Print(const Result& r)
+{
+  std::printf("%-10s %11zu %4dx%-4d %-13s first %9.1f ms (prepare %8.1f)  frame median %8.2f p95 %8.2f ms (%2d)  "
+              "GPU %8.1f MB %s%s\n",
+    r.Scene.c_str(), r.Points, r.Width, r.Height, r.Method.c_str(), 1e3 * r.FirstPictureSeconds,
+    1e3 * r.PrepareSeconds, 1e3 * r.MedianFrame, 1e3 * r.P95Frame, r.Frames, r.GpuBytes / 1e6, r.Note.c_str(),
+    r.Backend.empty() ? "" : (" [" + r.Backend + "]").c_str());
+  if (!r.Backend.empty())
+  {
+    std::printf("%59s trace %.2f, depth read %.2f, picture to OpenGL %.2f, draw %.2f ms\n", "", 1e3 * r.Trace,
+      1e3 * r.Depth, 1e3 * r.Transfer, 1e3 * r.Draw);
+  }
+  std::fflush(stdout);
+}
+
+Scene MakeScene(const std::string& name, vtkSmartPointer<vtkPolyData> cloud, double prepare)
+{
+  Scene s;
+  s.Name = name;
+  s.Cloud = cloud;
+  s.PrepareSeconds = prepare;
+  cloud->GetBounds(s.Bounds);
+  const double longest = std::max({ s.Bounds[1] - s.Bounds[0], s.Bounds[3] - s.Bounds[2], s.Bounds[5] - s.Bounds[4] });
+  // About the spacing of the points seen as a surface: longest / sqrt(n), a
+  // few pixels across at these window sizes.
+  s.Radius = 1.5 * longest / std::sqrt(static_cast<double>(cloud->GetNumberOfPoints()));
+  return s;
+}
+}
+
+int main(int argc, char* argv[])
+{
+  std::string points = "1e6,1e7,1e8", sizes = "1920x1080,3840x2160",
+              methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", file, json, images;
+  int frames = 60;
+  double seconds = 6.0;
+  CommandLine cli;
+  cli.Text("--points", points).Text("--sizes", sizes).Text("--methods", methods).Text("--file", file);
+  cli.Integer("--frames", frames, 3).Real("--seconds", seconds).Text("--json", json).Text("--images", images);
+  if (!cli.Parse(argc, argv))
+  {
+    std::fprintf(stderr, "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] "
+                         "[--file particles.txt] [--frames 60] [--seconds 6] [--json out.json] [--images DIR]\n",
+      argv[0]);
+    return 2;
+  }
+  if (!vtkOctreeVolumeMapper::IsCudaAvailable())
+  {
+    std::printf("no usable CUDA device: octoray falls back to the CPU and GPU memory reads 0\n");
+  }
+  cudaFree(nullptr); // the CUDA context first: its own memory is nobody's cost
+  std::vector<Scene> scenes;
+  for (const std::string& count : SplitList(points))
+  {
+    const auto n = static_cast<std::size_t>(std::strtod(count.c_str(), nullptr));
+    const double t0 = Now();
+    vtkSmartPointer<vtkPolyData> cloud = ClusteredPoints(n);
+    scenes.push_back(MakeScene("clusters", cloud, Now() - t0));
+  }
+  if (!file.empty())
+  {
+    const double t0 = Now();
+    vtkNew<vtkParticleTextReader> reader;
+    reader->SetFileName(file.c_str());
+    reader->Update();
+    auto cloud = vtkSmartPointer<vtkPolyData>::New();
+    cloud->ShallowCopy(reader->GetOutput());
+    cloud->SetVerts(nullptr);
+    scenes.push_back(MakeScene(file.substr(file.find_last_of('/') + 1), cloud, Now() - t0));
+  }
+  std::vector<Record> records;
+  for (const Scene& scene : scenes)
+  {
+    std::printf("\n%s, %lld points: generated or read in %.2f s\n", scene.Name.c_str(),
+      static_cast<long long>(scene.Cloud->GetNumberOfPoints()), scene.PrepareSeconds);
+    for (const std::string& size : SplitList(sizes))
+    {
+      int w = 0, h = 0;
+      std::sscanf(size.c_str(), "%dx%d", &w, &h);
+      std::map<std::string, Result> results;
+      for (const std::string& method : SplitList(methods))
+      {
+        const Result r = Orbit(scene, method, w, h, frames, seconds, images);
+        Print(r);
+        results[method] = r;
+        Record record;
+        record.name = "orbit " + scene.Name + " " + size + " " + method;
+        record.backend = method.rfind("octoray", 0) == 0 ? "cuda" : "vtk";
+        record.n = r.Points;
+        record.seconds = r.MedianFrame;
+        record.With("first_picture_s", r.FirstPictureSeconds)
+          .With("prepare_s", r.PrepareSeconds)
+          .With("p95_frame_s", r.P95Frame)
+          .With("frames", r.Frames)
+          .With("gpu_bytes", r.GpuBytes)
+          .With("width", w)
+          .With("height", h);
+        if (!r.Backend.empty())
+        {
+          record.With("trace_s", r.Trace).With("depth_read_s", r.Depth).With("transfer_s", r.Transfer).With("draw_s", r.Draw);
+        }
+        records.push_back(record);
+      }
+      // The issue's ratios: octoray against the fastest VTK frame, and its
+      // first picture against vtkSmartVolumeMapper's.
+      if (results.count("octoray"))
+      {
+        const Result& o = results["octoray"];
+        double fastest = 0.0, smartFirst = 0.0;
+        std::string fastestName, smartName;
+        for (const auto& [method, r] : results)
+        {
+          if (method.rfind("octoray", 0) == 0)
+          {
+            continue;
+          }
+          if (fastest == 0.0 || r.MedianFrame < fastest)
+          {
+            fastest = r.MedianFrame;
+            fastestName = method;
+          }
+          if (method.rfind("smart", 0) == 0 && (smartFirst == 0.0 || r.FirstPictureSeconds < smartFirst))
+          {
+            smartFirst = r.FirstPictureSeconds;
+            smartName = method;
+          }
+        }
+        std::printf("  => octoray frame %.2f ms: %.1fx faster than the fastest VTK path (%s, %.2f ms); first picture "
+                    "%.3f of %s's; interop %.2f ms vs host %.2f ms a frame\n",
+          1e3 * o.MedianFrame, fastest / o.MedianFrame, fastestName.c_str(), 1e3 * fastest,
+          smartFirst > 0 ? o.FirstPictureSeconds / smartFirst : 0.0, smartName.c_str(), 1e3 * o.MedianFrame,
+          results.count("octoray-host") ? 1e3 * results["octoray-host"].MedianFrame : 0.0);
+      }
+    }
+  }
+  SaveRecords(json, records);
+  return 0;
+}

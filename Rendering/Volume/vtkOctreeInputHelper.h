@@ -1,0 +1,141 @@
+/**
+ * @class   vtkOctreeInputHelper
+ * @brief   a vtkOctreeVolumeMapper's input as the octree engine's arrays,
+ *          and what changed since the octree was built
+ *
+ * A private helper of vtkOctreeVolumeMapper (not wrapped, not installed),
+ * in the role vtkVolumeInputHelper plays for VTK's GPU ray caster. It finds
+ * which arrays play which part (colours or scalars, reflectivity,
+ * refraction, normals), turns them into an octoray::PointCloudView (the
+ * caller's arrays where their layout allows, converted host copies
+ * otherwise; image voxels above the background become points), and
+ * compares the input with what the current octree was built from: nothing
+ * changed, only the point positions moved (an in-place update), or
+ * anything else (a build).
+ */
+#ifndef vtkOctreeInputHelper_h
+#define vtkOctreeInputHelper_h
+
+#include "vtkType.h" // for vtkIdType, vtkMTimeType
+
+#include <octoray/PointCloud.h> // for the views
+
+#include <array>      // for std::array
+#include <cstdint>    // for std::uint8_t
+#include <functional> // for std::function
+#include <string>     // for std::string
+#include <vector>     // for std::vector
+
+class vtkDataArray;
+class vtkDataSet;
+class vtkOctreeVolumeMapper;
+class vtkVolumeProperty;
+
+class vtkOctreeInputHelper
+{
+public:
+  enum class Change
+  {
+    None,      // the octree is up to date
+    Positions, // only the points' positions moved: Engine::Update
+    All        // anything else: Engine::Build
+  };
+
+  /**
+   * What the octree is made of this frame: the input, the arrays in their
+   * roles and the mapper settings that shape the octree.
+   */
+  struct Request
+  {
+    vtkDataSet* Input = nullptr;
+    vtkDataArray* Scalars = nullptr; // active scalars (point data only)
+    bool Colours = false;            // Scalars are RGB(A) colours, not through the transfer function
+    vtkDataArray* Reflectivity = nullptr;
+    vtkDataArray* Refraction = nullptr;
+    vtkDataArray* Normals = nullptr;
+    bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
+    double ImageBackground = 0.0;
+    int LeafDepth = 0;
+    std::array<double, 6> RootBounds{};
+    unsigned long EngineGeneration = 0; // a new engine holds no octree
+  };
+
+  /**
+   * The request for `input` as `mapper` and `property` select its arrays.
+   */
+  static Request MakeRequest(vtkDataSet* input, vtkOctreeVolumeMapper* mapper, vtkVolumeProperty* property,
+    unsigned long engineGeneration);
+
+  /**
+   * What changed since Remember() was last called.
+   */
+  Change Compare(const Request& request) const;
+
+  /**
+   * The engine's view of the points (valid until the next call). Empty
+   * (count 0) when an image has no voxel above the background.
+   */
+  octoray::PointCloudView PointCloud(const Request& request, const std::function<void(double)>& progress);
+
+  /**
+   * The moved positions for Engine::Update (Change::Positions).
+   */
+  octoray::PositionsView Positions(const Request& request);
+
+  /**
+   * The octree now reflects `request` (after a successful build or update).
+   */
+  void Remember(const Request& request);
+
+  /**
+   * The octree is gone (a failed build, a new engine).
+   */
+  void Forget() { this->Built = false; }
+
+  bool HasOctree() const { return this->Built; }
+  bool HasScalar() const { return this->ScalarPresent; }
+  const double* ScalarRange() const { return this->Range; }
+
+  /**
+   * The signature of an array as the octree used it: a change of contents
+   * (MTime) or of the array itself means a rebuild.
+   */
+  struct ArrayStamp
+  {
+    const void* Array = nullptr;
+    vtkMTimeType MTime = 0;
+    bool operator==(const ArrayStamp& o) const { return this->Array == o.Array && this->MTime == o.MTime; }
+  };
+
+private:
+  struct Signature
+  {
+    const void* Input = nullptr;
+    vtkIdType Count = 0;
+    std::string Layout; // which arrays play which role
+    std::array<ArrayStamp, 4> Arrays{};
+    ArrayStamp Points;
+    int LeafDepth = 0;
+    std::array<double, 6> RootBounds{};
+    unsigned long EngineGeneration = 0;
+    bool SameExceptPoints(const Signature& o) const;
+  };
+  static Signature Sign(const Request& request);
+
+  void PointSetView(const Request& request, octoray::PointCloudView& view);
+  void ImageView(const Request& request, octoray::PointCloudView& view, const std::function<void(double)>& progress);
+  void FindScalarRange(const octoray::PointCloudView& view);
+
+  bool Built = false;
+  Signature Current;
+  bool ScalarPresent = false;
+  double Range[2] = { 0.0, 1.0 };
+
+  // Host copies the engine reads during a build (converted types, image voxels).
+  std::vector<double> Xyz;
+  std::vector<float> Scalar, Reflectivity, Refraction, Normal, ColorFloat;
+  std::vector<std::uint8_t> Color8;
+};
+
+#endif
+// VTK-HeaderTest-Exclude: vtkOctreeInputHelper.h

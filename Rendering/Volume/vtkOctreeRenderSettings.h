@@ -1,0 +1,92 @@
+/**
+ * @class   vtkOctreeRenderSettings
+ * @brief   a frame's octoray::RenderSettings from VTK's camera, volume,
+ *          property and lights
+ *
+ * A private helper of vtkOctreeVolumeMapper (not wrapped, not installed).
+ * Pure functions of VTK state, with no OpenGL, so that each mapping (the
+ * ray matrix, blend and shade modes, lights in data coordinates, the
+ * transfer table) is tested on its own. TraceKey is what a picture was
+ * traced from: the mapper traces again only when it changes.
+ */
+#ifndef vtkOctreeRenderSettings_h
+#define vtkOctreeRenderSettings_h
+
+#include "vtkType.h" // for vtkMTimeType
+
+#include <octoray/Render.h> // for octoray::RenderSettings
+
+#include <vector> // for std::vector
+
+class vtkCamera;
+class vtkLightCollection;
+class vtkMatrix4x4;
+class vtkVolumeProperty;
+
+class vtkOctreeRenderSettings
+{
+public:
+  /**
+   * The engine's ray matrix: the inverse of VTK's composite projection
+   * (world -> NDC, row-major) times the volume's matrix (data -> world), so
+   * that perspective, parallel projection, clipping range and tiled or
+   * off-axis viewports agree with VTK by construction.
+   */
+  static void SetCamera(
+    vtkCamera* camera, double aspect, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings);
+
+  /**
+   * VTK's blend mode as the engine's: SURFACE_BLEND, and ISOSURFACE_BLEND as
+   * its nearest, are first hits.
+   */
+  static octoray::BlendMode Blend(int vtkBlendMode);
+
+  /**
+   * Shade mode and Phong coefficients of component 0 of `property`: Phong
+   * when it shades, else a depth cue when `depthCue` > 0, else flat.
+   */
+  static void SetShading(vtkVolumeProperty* property, double depthCue, octoray::RenderSettings& settings);
+
+  /**
+   * The switched-on lights in data coordinates (camera lights and the
+   * headlight carry the camera's transform). Every light off: one dark
+   * light, as VTK then leaves ambient light only. Returns how many lights
+   * past the engine's 8 were left out.
+   */
+  static int SetLights(
+    vtkLightCollection* lights, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings);
+
+  /**
+   * The colour (or grey) transfer function and scalar opacity of component
+   * 0, sampled over `range` (widened when empty).
+   */
+  static void SetTransfer(vtkVolumeProperty* property, const double range[2], octoray::RenderSettings& settings);
+
+  /**
+   * The window depth at the centre of each traced pixel, when one ray
+   * serves step x step pixels (ImageSampleDistance).
+   */
+  static std::vector<float> SampleDepth(
+    const std::vector<float>& depth, int width, int height, int step, int tracedWidth, int tracedHeight);
+
+  /**
+   * What a picture was traced from.
+   */
+  struct TraceKey
+  {
+    double InverseViewProjection[16] = {};
+    int Width = 0, Height = 0;
+    vtkMTimeType MapperMTime = 0, PropertyMTime = 0;
+    unsigned long OctreeVersion = 0; // bumped by every build and update
+    std::vector<octoray::Light> Lights;
+    std::vector<float> Depth;
+
+    static TraceKey Of(const octoray::RenderSettings& settings, vtkMTimeType mapperMTime,
+      vtkMTimeType propertyMTime, unsigned long octreeVersion);
+    bool operator==(const TraceKey& o) const;
+    bool operator!=(const TraceKey& o) const { return !(*this == o); }
+  };
+};
+
+#endif
+// VTK-HeaderTest-Exclude: vtkOctreeRenderSettings.h
