@@ -64,7 +64,7 @@ test-asan: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
 	  ctest --output-on-failure -j $(JOBS) \
-	  -R '^(engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|reliability\.|fuzz\.|python\.(particle_reader|slice_stack_reader|depth_and_normals)$$)'
+	  -R '^(deps\.|engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|reliability\.|fuzz\.|python\.(particle_reader|slice_stack_reader|depth_and_normals)$$)'
 
 # The LiDAR tile's reflectivity column is the scanner's intensity (0.3-0.6):
 # taken as mirror weight it would blend every voxel with the empty sky, so

@@ -15,15 +15,17 @@
 #
 #   Testing/Bench/gpu-check.sh OUTDIR [PARTS]
 # PARTS, comma-separated (default all): tests (engine and mapper tests, both
-# backends), sanitize (compute-sanitizer on the engine's and the mapper's CUDA
-# tests), bench (engine benchmarks), report (the report's engine programs),
-# orbit (the mapper against VTK's GPU mappers; ORBIT_ARGS adds arguments).
+# backends), sanitize (compute-sanitizer memcheck, initcheck and synccheck on
+# the engine's CUDA tests, memcheck on the mapper's), racecheck (on the
+# engine's CUDA tests: the slowest, about 3 minutes), bench (engine
+# benchmarks), report (the report's engine programs), orbit (the mapper
+# against VTK's GPU mappers; ORBIT_ARGS adds arguments).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Testing/Bench/gpu/).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 out=$(realpath -m "${1:-build-gpu/logs}")
-parts=",${2:-tests,sanitize,bench,report,orbit},"
+parts=",${2:-tests,sanitize,racecheck,bench,report,orbit},"
 mkdir -p "$out"
 status=()
 step() { # name, command...
@@ -76,12 +78,15 @@ if want sanitize; then
   engine=$build/bin/octoray_engine_tests
   step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 $engine --gtest_filter="$tests:-CudaFaultsLaunch*"
   step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 1 $engine --gtest_filter='CudaFaultsLaunch*'
-  step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
   step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
   step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
   # Every CUDA mapper test under memcheck, with the command CTest runs.
   (cd $build && ctest -L gpu -R "$mapper_tests" -N -V) | sed -n 's/^[0-9]*: Test command: //p' > "$out/mapper-commands.txt"
   step memcheck-mapper bash -c "set -e; while read -r cmd; do eval compute-sanitizer --tool memcheck --error-exitcode 1 \$cmd; done < '$out/mapper-commands.txt'"
+fi
+if want racecheck; then
+  step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 $build/bin/octoray_engine_tests \
+    --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*:CudaFaultsLaunch*'
 fi
 
 if want bench; then
