@@ -45,11 +45,10 @@ if [ "$prebuilt" = 1 ] && [ ! -f "$dir/vtk-egl.tar.xz" ]; then
   # Built outside the carried folder (build-vtk-egl/, ignored; the build
   # tree and the unpacked install would not fit a device call's 64 MiB).
   VTK_EGL_WORK=$PWD/build-vtk-egl-work scripts/gpu/build-vtk-egl.sh "$dir" "$PWD/build-vtk-egl"
-  # Headers, CMake package, libraries: what configuring and running against it
-  # needs, as vtk-egl/. The prefix is relocatable (VTK's CMake files use
-  # paths relative to themselves).
-  tar -C "$PWD" --transform 's,^build-vtk-egl,vtk-egl,' -cf - build-vtk-egl/include build-vtk-egl/lib |
-    xz -T0 -9 > "$dir/vtk-egl.tar.xz"
+  # The whole install (headers, CMake package, libraries, and the wrapping
+  # tools VTK's CMake package names) as vtk-egl/. The prefix is relocatable
+  # (VTK's CMake files use paths relative to themselves).
+  tar -C "$PWD" --transform 's,^build-vtk-egl,vtk-egl,' -cf - build-vtk-egl | xz -T0 -6 > "$dir/vtk-egl.tar.xz"
   rm -rf build-vtk-egl-work
 fi
 du -sh "$dir"/*.tar.xz "$dir/gl" "$dir/googletest"
