@@ -190,6 +190,24 @@ bool vtkOctreeCompositor::SetPictureFromDevice(
 }
 
 //------------------------------------------------------------------------------
+// 2^bits - 1 for the red channel of the framebuffer drawn into when it has
+// fixed-point colour (8, 10, 16 bits), 0 for floating point.
+static float ColorLevels()
+{
+  GLint framebuffer = 0, bits = 0, type = GL_UNSIGNED_NORMALIZED;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+  const GLenum attachment = framebuffer == 0 ? GL_BACK_LEFT : GL_COLOR_ATTACHMENT0;
+  glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, attachment, GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, &bits);
+  glGetFramebufferAttachmentParameteriv(
+    GL_DRAW_FRAMEBUFFER, attachment, GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
+  if (glGetError() != GL_NO_ERROR || type == GL_FLOAT || bits <= 0 || bits > 16)
+  {
+    return 0.0f;
+  }
+  return static_cast<float>((1 << bits) - 1);
+}
+
+//------------------------------------------------------------------------------
 bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
 {
   this->UseWindow(window);
@@ -202,11 +220,16 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
     std::string fs = vtkOpenGLRenderUtilities::GetFullScreenQuadFragmentShaderTemplate();
     vtkShaderProgram::Substitute(fs, "//VTK::FSQ::Decl",
       "uniform sampler2D octorayColor;\n"
-      "uniform sampler2D octorayDepth;\n");
-    // Pixels no ray coloured leave colour and depth as they were.
+      "uniform sampler2D octorayDepth;\n"
+      "uniform float octorayLevels;\n");
+    // Pixels no ray coloured leave colour and depth as they were. The colour
+    // is rounded to the framebuffer's levels here, to nearest: drivers
+    // convert float to 8 bits differently (NVIDIA's and Mesa's differ by
+    // one in the last bit), and a picture must not depend on the driver.
     vtkShaderProgram::Substitute(fs, "//VTK::FSQ::Impl",
       "  vec4 c = texture(octorayColor, texCoord);\n"
       "  if (c.a <= 0.0) { discard; }\n"
+      "  if (octorayLevels > 0.0) { c = floor(clamp(c, 0.0, 1.0) * octorayLevels + 0.5) / octorayLevels; }\n"
       "  gl_FragData[0] = c;\n"
       "  gl_FragDepth = texture(octorayDepth, texCoord).r;\n");
     this->Quad.reset(new vtkOpenGLQuadHelper(window, nullptr, fs.c_str(), nullptr));
@@ -236,6 +259,7 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
   this->DepthTexture->Activate();
   this->Quad->Program->SetUniformi("octorayColor", this->ColorTexture->GetTextureUnit());
   this->Quad->Program->SetUniformi("octorayDepth", this->DepthTexture->GetTextureUnit());
+  this->Quad->Program->SetUniformf("octorayLevels", ColorLevels());
   this->Quad->Render();
   this->DepthTexture->Deactivate();
   this->ColorTexture->Deactivate();

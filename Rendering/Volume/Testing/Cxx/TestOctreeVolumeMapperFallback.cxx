@@ -17,7 +17,7 @@ namespace
 struct Messages
 {
   int warnings = 0, errors = 0;
-  std::string last;
+  std::string last, all;
   vtkNew<vtkCallbackCommand> callback;
   explicit Messages(vtkObject* o)
   {
@@ -26,6 +26,7 @@ struct Messages
       auto* m = static_cast<Messages*>(self);
       (event == vtkCommand::WarningEvent ? m->warnings : m->errors)++;
       m->last = text ? static_cast<const char*>(text) : "";
+      m->all += m->last + "\n";
     });
     o->AddObserver(vtkCommand::WarningEvent, callback);
     o->AddObserver(vtkCommand::ErrorEvent, callback);
@@ -84,6 +85,10 @@ int TestOctreeVolumeMapperFallback(int, char*[])
             << "\n";
   CHECK(std::string(cuda.Mapper->GetLastUsedBackendName()) == "CPU");
   CHECK(messages.warnings == 1 && messages.errors == 0);
+  if (messages.warnings != 1 || messages.errors != 0)
+  {
+    std::cerr << "messages:\n" << messages.all;
+  }
   Scene cpu(vtkOctreeVolumeMapper::BACKEND_CPU, cloud, 240, 200);
   const Picture reference = Capture(cpu.RenderWindow);
   const int differing = Differing(fallen, reference);

@@ -96,7 +96,13 @@ int TestOctreeVolumeMapperMixed(int argc, char* argv[])
       const bool sphereWins = winner[i] == 2;
       sphereFront += sphereWins && zc < 1.0f;
       cloudFront += !sphereWins && zs < 1.0f;
-      wrong += !Same(both.At(x, y), (sphereWins ? sphereOnly : cloudOnly).At(x, y));
+      const unsigned char *got = both.At(x, y), *want = (sphereWins ? sphereOnly : cloudOnly).At(x, y);
+      if (!Same(got, want) && wrong++ < 3)
+      {
+        std::cerr << "pixel " << x << "," << y << " (" << (sphereWins ? "sphere" : "cloud") << " in front): "
+                  << int(got[0]) << " " << int(got[1]) << " " << int(got[2]) << ", expected " << int(want[0]) << " "
+                  << int(want[1]) << " " << int(want[2]) << "\n";
+      }
       depthWrong += std::fabs(both.Depth(x, y) - std::min(zc, zs)) > 1e-5;
     }
   }

@@ -54,12 +54,14 @@ inline int Result()
 struct Backend
 {
   int Requested = vtkOctreeVolumeMapper::BACKEND_CPU;
+  bool Interop = true; // CUDA: the picture to OpenGL device to device (else through the host)
   const char* Name() const { return Requested == vtkOctreeVolumeMapper::BACKEND_CUDA ? "CUDA" : "CPU"; }
   bool Cuda() const { return Requested == vtkOctreeVolumeMapper::BACKEND_CUDA; }
 };
 
-// `--backend cpu|cuda` among the arguments (default cpu). False when CUDA is
-// asked for and no device is usable: the test then skips.
+// `--backend cpu|cuda` among the arguments (default cpu), and for CUDA
+// `--transfer device|host` (default device). False when CUDA is asked for
+// and no device is usable: the test then skips.
 inline bool ParseBackend(int argc, char* argv[], Backend& backend)
 {
   for (int i = 1; i + 1 < argc; ++i)
@@ -68,13 +70,19 @@ inline bool ParseBackend(int argc, char* argv[], Backend& backend)
     {
       backend.Requested = vtkOctreeVolumeMapper::BACKEND_CUDA;
     }
+    if (std::strcmp(argv[i], "--transfer") == 0 && std::strcmp(argv[i + 1], "host") == 0)
+    {
+      backend.Interop = false;
+    }
   }
   if (backend.Cuda() && !vtkOctreeVolumeMapper::IsCudaAvailable())
   {
     std::cout << "CUDA backend not usable here: skipped" << std::endl;
     return false;
   }
-  std::cout << "backend: " << backend.Name() << std::endl;
+  std::cout << "backend: " << backend.Name()
+            << (backend.Cuda() ? (backend.Interop ? ", picture device to device" : ", picture through the host") : "")
+            << std::endl;
   return true;
 }
 #define OCTORAY_TEST_BACKEND(backend)                                                              \
@@ -101,16 +109,19 @@ inline vtkSmartPointer<vtkOctreeVolumeMapper> NewMapper(const Backend& backend)
 {
   auto mapper = vtkSmartPointer<vtkOctreeVolumeMapper>::New();
   mapper->SetRequestedBackend(backend.Requested);
+  mapper->SetUseCudaGLInterop(backend.Interop);
   return mapper;
 }
 
-// After a render: the backend under test drew it, and on CUDA the picture
-// went to OpenGL device to device (the GPU machine's EGL runs on the GPU
-// that CUDA uses).
+// After a render: the backend under test drew it, and the picture took the
+// way asked for (CUDA with interop: device to device; the GPU machine's EGL
+// runs on the GPU that CUDA uses).
 inline bool DrewWith(vtkOctreeVolumeMapper* mapper, const Backend& backend)
 {
   const bool backendOk = std::string(mapper->GetLastUsedBackendName()) == backend.Name();
-  const bool transferOk = !backend.Cuda() || mapper->GetLastPictureTransfer() == vtkOctreeVolumeMapper::TRANSFER_DEVICE;
+  const int transfer = backend.Cuda() && backend.Interop ? vtkOctreeVolumeMapper::TRANSFER_DEVICE
+                                                         : vtkOctreeVolumeMapper::TRANSFER_HOST;
+  const bool transferOk = mapper->GetLastPictureTransfer() == transfer;
   if (!backendOk || !transferOk)
   {
     std::cerr << "drawn by " << mapper->GetLastUsedBackendName() << " through "
