@@ -17,7 +17,9 @@
 //   smart-G          vtkPointInterpolator (Gaussian kernel) onto G^3 voxels,
 //                    then vtkSmartVolumeMapper (GPU ray casting) of RGBA
 // A method whose first frame is slow draws fewer orbit frames (at least 3),
-// so that one run stays within the device's time; the count is recorded.
+// so that one run stays within the device's time; the count is recorded. A
+// resampling whose time, extrapolated from the smaller grid's in the same
+// run (voxels x), would pass --max-prepare seconds is skipped and says so.
 //
 //   octoray_bench_orbit [--points 1e6,1e7,1e8] [--sizes 1920x1080,3840x2160]
 //     [--methods octoray,octoray-host,pointgauss,points,smart-256,smart-512]
@@ -487,10 +489,11 @@ int main(int argc, char* argv[])
   std::string points = "1e6,1e7,1e8", sizes = "1920x1080,3840x2160",
               methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", file, json, images;
   int frames = 60;
-  double seconds = 6.0;
+  double seconds = 6.0, maxPrepare = 90.0;
   CommandLine cli;
   cli.Text("--points", points).Text("--sizes", sizes).Text("--methods", methods).Text("--file", file);
   cli.Integer("--frames", frames, 3).Real("--seconds", seconds).Text("--json", json).Text("--images", images);
+  cli.Real("--max-prepare", maxPrepare);
   if (!cli.Parse(argc, argv))
   {
     std::fprintf(stderr, "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] "
@@ -532,9 +535,27 @@ int main(int argc, char* argv[])
       int w = 0, h = 0;
       std::sscanf(size.c_str(), "%dx%d", &w, &h);
       std::map<std::string, Result> results;
+      double resampleSeconds = 0.0; // the last resampling: seconds per voxel
       for (const std::string& method : SplitList(methods))
       {
+        if (method.rfind("smart-", 0) == 0 && resampleSeconds > 0.0)
+        {
+          const double grid = std::stod(method.substr(6));
+          const double estimate = resampleSeconds * grid * grid * grid;
+          if (estimate > maxPrepare)
+          {
+            std::printf("%-10s %11lld %4dx%-4d %-13s skipped: resampling estimated at %.0f s (over --max-prepare %.0f)\n",
+              scene.Name.c_str(), static_cast<long long>(scene.Cloud->GetNumberOfPoints()), w, h, method.c_str(),
+              estimate, maxPrepare);
+            continue;
+          }
+        }
         const Result r = Orbit(scene, method, w, h, frames, seconds, images);
+        if (method.rfind("smart-", 0) == 0)
+        {
+          const double grid = std::stod(method.substr(6));
+          resampleSeconds = r.PrepareSeconds / (grid * grid * grid);
+        }
         Print(r);
         results[method] = r;
         Record record;

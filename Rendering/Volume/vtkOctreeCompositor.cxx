@@ -93,12 +93,14 @@ unsigned int vtkOctreeCompositor::ResolveDepth(
 }
 
 //------------------------------------------------------------------------------
-bool vtkOctreeCompositor::ReadDepth(
-  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, std::vector<float>& depth)
+// glReadPixels of the viewport's depth (as floats) from the framebuffer VTK
+// draws into, resolved first when it is multisampled, into `pixels`: host
+// memory, or an offset in the bound pixel-pack buffer.
+bool vtkOctreeCompositor::ReadDepthInto(
+  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, void* pixels)
 {
   this->UseWindow(window);
   vtkOpenGLState* state = window->GetState();
-  depth.assign(static_cast<std::size_t>(width) * height, 1.0f);
   GLint drawFramebuffer = 0, samples = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
   glGetIntegerv(GL_SAMPLES, &samples);
@@ -117,14 +119,54 @@ bool vtkOctreeCompositor::ReadDepth(
     x0 = y0 = 0;
   }
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, pixels);
   state->PopReadFramebufferBinding();
-  if (glGetError() != GL_NO_ERROR)
+  return glGetError() == GL_NO_ERROR;
+}
+
+//------------------------------------------------------------------------------
+bool vtkOctreeCompositor::ReadDepth(
+  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, std::vector<float>& depth)
+{
+  depth.assign(static_cast<std::size_t>(width) * height, 1.0f);
+  if (!this->ReadDepthInto(window, x0, y0, width, height, depth.data()))
   {
     std::fill(depth.begin(), depth.end(), 1.0f);
     return false;
   }
   return true;
+}
+
+//------------------------------------------------------------------------------
+const float* vtkOctreeCompositor::ReadDepthToDevice(
+  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, int device, std::string& error)
+{
+  this->UseWindow(window);
+  const std::size_t bytes = sizeof(float) * static_cast<std::size_t>(width) * height;
+  if (!this->DepthPixelBuffer)
+  {
+    glGenBuffers(1, &this->DepthPixelBuffer);
+  }
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, this->DepthPixelBuffer);
+  if (this->DepthPixelBufferBytes != bytes)
+  {
+    this->Interop->Release(); // a registration does not survive new storage
+    glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_COPY);
+    this->DepthPixelBufferBytes = bytes;
+  }
+  const bool read = this->ReadDepthInto(window, x0, y0, width, height, nullptr);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  if (!read)
+  {
+    error = "glReadPixels of the depth into a pixel buffer failed";
+    return nullptr;
+  }
+  return static_cast<const float*>(this->Interop->MapBuffer(this->DepthPixelBuffer, bytes, device, error));
+}
+
+void vtkOctreeCompositor::ReleaseDeviceDepth()
+{
+  this->Interop->UnmapBuffer();
 }
 
 //------------------------------------------------------------------------------
@@ -270,7 +312,7 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
 void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
 {
   auto* glWindow = vtkOpenGLRenderWindow::SafeDownCast(window);
-  if (glWindow && (this->ColorTexture || this->ResolveFramebuffer))
+  if (glWindow && (this->ColorTexture || this->ResolveFramebuffer || this->DepthPixelBuffer))
   {
     glWindow->MakeCurrent();
   }
@@ -292,6 +334,12 @@ void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
     glDeleteFramebuffers(1, &this->ResolveFramebuffer);
     glDeleteRenderbuffers(1, &this->ResolveRenderbuffer);
   }
+  if (this->DepthPixelBuffer && glWindow)
+  {
+    glDeleteBuffers(1, &this->DepthPixelBuffer);
+  }
+  this->DepthPixelBuffer = 0;
+  this->DepthPixelBufferBytes = 0;
   this->ResolveFramebuffer = this->ResolveRenderbuffer = 0;
   this->ResolveSize[0] = this->ResolveSize[1] = 0;
   this->PictureReady = false;

@@ -19,7 +19,8 @@
 
 #include "vtkSmartPointer.h" // for the textures
 
-#include <memory> // for std::unique_ptr
+#include <cstddef> // for std::size_t
+#include <memory>  // for std::unique_ptr
 #include <string> // for std::string
 #include <vector> // for std::vector
 
@@ -48,6 +49,16 @@ public:
    * (depth all 1: nothing in front) when OpenGL could not read it.
    */
   bool ReadDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, std::vector<float>& depth);
+
+  /**
+   * The same depth left on the GPU for the CUDA engine on `device`: read
+   * into an OpenGL pixel buffer and mapped by CUDA-OpenGL interop, so it
+   * never crosses to the host. Null, with `error`, where interop cannot
+   * serve this window. Valid until ReleaseDeviceDepth().
+   */
+  const float* ReadDepthToDevice(
+    vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, int device, std::string& error);
+  void ReleaseDeviceDepth();
 
   /**
    * The picture, uploaded from host memory.
@@ -79,6 +90,7 @@ private:
   void UseWindow(vtkOpenGLRenderWindow* window);
   void AllocateTextures(int width, int height);
   unsigned int ResolveDepth(vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int width, int height);
+  bool ReadDepthInto(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, void* pixels);
 
   vtkOpenGLRenderWindow* Window = nullptr;
   vtkSmartPointer<vtkTextureObject> ColorTexture;
@@ -91,6 +103,9 @@ private:
   unsigned int ResolveRenderbuffer = 0;
   int ResolveSize[2] = { 0, 0 };
   unsigned int ResolveFormat = 0;
+  // The window depth for CUDA: a pixel-pack buffer and its size in bytes.
+  unsigned int DepthPixelBuffer = 0;
+  std::size_t DepthPixelBufferBytes = 0;
 };
 
 #endif

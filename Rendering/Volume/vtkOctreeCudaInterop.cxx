@@ -13,14 +13,16 @@
 class vtkOctreeCudaInterop::vtkInternals
 {
 public:
-  // One registered texture: which OpenGL name, at which size, on which device.
+  // One registered texture or buffer: which OpenGL name, at which size, on
+  // which device.
   struct Registration
   {
     cudaGraphicsResource_t Resource = nullptr;
-    unsigned int Texture = 0;
+    unsigned int Name = 0; // the OpenGL texture or buffer
     int Width = 0, Height = 0, Device = -1;
+    bool Mapped = false;
   };
-  Registration Color, Depth;
+  Registration Color, Depth, Buffer;
 
   static bool Check(cudaError_t status, const char* what, std::string& error)
   {
@@ -35,6 +37,10 @@ public:
 
   static void Unregister(Registration& r)
   {
+    if (r.Mapped)
+    {
+      cudaGraphicsUnmapResources(1, &r.Resource);
+    }
     if (r.Resource)
     {
       cudaGraphicsUnregisterResource(r.Resource);
@@ -43,10 +49,23 @@ public:
     r = Registration{};
   }
 
+  // Makes `device` current for a scope, restoring the caller's.
+  struct DeviceScope
+  {
+    int Previous = 0;
+    bool Ok = false;
+    DeviceScope(int device, std::string& error)
+    {
+      cudaGetDevice(&this->Previous);
+      this->Ok = Check(cudaSetDevice(device), "cudaSetDevice", error);
+    }
+    ~DeviceScope() { cudaSetDevice(this->Previous); }
+  };
+
   // Registers `texture` unless it already is, at this size on this device.
   static bool Register(Registration& r, unsigned int texture, const octoray::DeviceImage& image, std::string& error)
   {
-    if (r.Resource && r.Texture == texture && r.Width == image.width && r.Height == image.height &&
+    if (r.Resource && r.Name == texture && r.Width == image.width && r.Height == image.height &&
       r.Device == image.device)
     {
       return true;
@@ -59,7 +78,7 @@ public:
       r.Resource = nullptr;
       return false;
     }
-    r.Texture = texture;
+    r.Name = texture;
     r.Width = image.width;
     r.Height = image.height;
     r.Device = image.device;
@@ -82,6 +101,60 @@ void vtkOctreeCudaInterop::Release()
 {
   vtkInternals::Unregister(this->Internals->Color);
   vtkInternals::Unregister(this->Internals->Depth);
+  vtkInternals::Unregister(this->Internals->Buffer);
+}
+
+const void* vtkOctreeCudaInterop::MapBuffer(unsigned int buffer, std::size_t bytes, int device, std::string& error)
+{
+  vtkInternals::DeviceScope scope(device, error);
+  vtkInternals::Registration& r = this->Internals->Buffer;
+  if (!scope.Ok)
+  {
+    return nullptr;
+  }
+  if (!(r.Resource && r.Name == buffer && r.Width == static_cast<int>(bytes) && r.Device == device))
+  {
+    vtkInternals::Unregister(r);
+    if (!vtkInternals::Check(cudaGraphicsGLRegisterBuffer(&r.Resource, buffer, cudaGraphicsRegisterFlagsReadOnly),
+          "cudaGraphicsGLRegisterBuffer", error))
+    {
+      r = vtkInternals::Registration{};
+      return nullptr;
+    }
+    r.Name = buffer;
+    r.Width = static_cast<int>(bytes); // a buffer's size: its bytes, one row
+    r.Device = device;
+  }
+  void* address = nullptr;
+  std::size_t size = 0;
+  if (!vtkInternals::Check(cudaGraphicsMapResources(1, &r.Resource), "cudaGraphicsMapResources", error))
+  {
+    return nullptr;
+  }
+  r.Mapped = true;
+  if (!vtkInternals::Check(cudaGraphicsResourceGetMappedPointer(&address, &size, r.Resource),
+        "cudaGraphicsResourceGetMappedPointer", error) ||
+    size < bytes)
+  {
+    this->UnmapBuffer();
+    return nullptr;
+  }
+  return address;
+}
+
+void vtkOctreeCudaInterop::UnmapBuffer()
+{
+  vtkInternals::Registration& r = this->Internals->Buffer;
+  if (r.Mapped)
+  {
+    int previous = 0;
+    cudaGetDevice(&previous);
+    cudaSetDevice(r.Device);
+    cudaGraphicsUnmapResources(1, &r.Resource);
+    cudaGetLastError();
+    cudaSetDevice(previous);
+    r.Mapped = false;
+  }
 }
 
 bool vtkOctreeCudaInterop::Copy(unsigned int colorTexture, unsigned int depthTexture,
@@ -92,9 +165,8 @@ bool vtkOctreeCudaInterop::Copy(unsigned int colorTexture, unsigned int depthTex
     error = "no float picture in device memory";
     return false;
   }
-  int previous = 0;
-  cudaGetDevice(&previous);
-  if (!vtkInternals::Check(cudaSetDevice(image.device), "cudaSetDevice", error))
+  vtkInternals::DeviceScope scope(image.device, error);
+  if (!scope.Ok)
   {
     return false;
   }
@@ -125,7 +197,6 @@ bool vtkOctreeCudaInterop::Copy(unsigned int colorTexture, unsigned int depthTex
     }
     ok = vtkInternals::Check(cudaGraphicsUnmapResources(2, resources), "cudaGraphicsUnmapResources", error) && ok;
   }
-  cudaSetDevice(previous);
   if (!ok)
   {
     this->Release();
@@ -150,6 +221,14 @@ vtkOctreeCudaInterop::~vtkOctreeCudaInterop()
 }
 
 void vtkOctreeCudaInterop::Release() {}
+
+const void* vtkOctreeCudaInterop::MapBuffer(unsigned int, std::size_t, int, std::string& error)
+{
+  error = "octoray was built without CUDA";
+  return nullptr;
+}
+
+void vtkOctreeCudaInterop::UnmapBuffer() {}
 
 bool vtkOctreeCudaInterop::Copy(unsigned int, unsigned int, const octoray::DeviceImage&, std::string& error)
 {

@@ -15,7 +15,8 @@
 #ifndef vtkOctreeCudaInterop_h
 #define vtkOctreeCudaInterop_h
 
-#include <string> // for std::string
+#include <cstddef> // for std::size_t
+#include <string>  // for std::string
 
 namespace octoray
 {
@@ -39,8 +40,17 @@ public:
     std::string& error);
 
   /**
-   * Forgets the registrations (before the textures are resized or deleted;
-   * their context current).
+   * Maps the OpenGL buffer named `buffer` (`bytes` long, its context
+   * current) for reading by CUDA on `device`: the device address of its
+   * contents, or null with `error` set. UnmapBuffer() before OpenGL uses the
+   * buffer again.
+   */
+  const void* MapBuffer(unsigned int buffer, std::size_t bytes, int device, std::string& error);
+  void UnmapBuffer();
+
+  /**
+   * Forgets the registrations (before the textures or the buffer are
+   * resized or deleted; their context current).
    */
   void Release();
 

@@ -168,7 +168,7 @@ std::vector<float> vtkOctreeRenderSettings::SampleDepth(
 
 //------------------------------------------------------------------------------
 vtkOctreeRenderSettings::TraceKey vtkOctreeRenderSettings::TraceKey::Of(const octoray::RenderSettings& s,
-  vtkMTimeType mapperMTime, vtkMTimeType propertyMTime, unsigned long octreeVersion)
+  vtkMTimeType mapperMTime, vtkMTimeType propertyMTime, unsigned long octreeVersion, std::uint64_t depthSignature)
 {
   TraceKey k;
   std::copy(s.inverseViewProjection, s.inverseViewProjection + 16, k.InverseViewProjection);
@@ -178,7 +178,7 @@ vtkOctreeRenderSettings::TraceKey vtkOctreeRenderSettings::TraceKey::Of(const oc
   k.PropertyMTime = propertyMTime;
   k.OctreeVersion = octreeVersion;
   k.Lights = s.lights;
-  k.Depth = s.depthBuffer;
+  k.DepthSignature = depthSignature;
   return k;
 }
 
@@ -192,5 +192,5 @@ bool vtkOctreeRenderSettings::TraceKey::operator==(const TraceKey& o) const
     this->Width == o.Width && this->Height == o.Height && this->MapperMTime == o.MapperMTime &&
     this->PropertyMTime == o.PropertyMTime && this->OctreeVersion == o.OctreeVersion &&
     std::equal(this->Lights.begin(), this->Lights.end(), o.Lights.begin(), o.Lights.end(), sameLight) &&
-    this->Depth == o.Depth;
+    this->DepthSignature == o.DepthSignature;
 }

@@ -16,7 +16,8 @@
 
 #include <octoray/Render.h> // for octoray::RenderSettings
 
-#include <vector> // for std::vector
+#include <cstdint> // for std::uint64_t
+#include <vector>  // for std::vector
 
 class vtkCamera;
 class vtkLightCollection;
@@ -79,10 +80,10 @@ public:
     vtkMTimeType MapperMTime = 0, PropertyMTime = 0;
     unsigned long OctreeVersion = 0; // bumped by every build and update
     std::vector<octoray::Light> Lights;
-    std::vector<float> Depth;
+    std::uint64_t DepthSignature = 0; // of the opaque depth (octoray/DepthSignature.h)
 
     static TraceKey Of(const octoray::RenderSettings& settings, vtkMTimeType mapperMTime,
-      vtkMTimeType propertyMTime, unsigned long octreeVersion);
+      vtkMTimeType propertyMTime, unsigned long octreeVersion, std::uint64_t depthSignature);
     bool operator==(const TraceKey& o) const;
     bool operator!=(const TraceKey& o) const { return !(*this == o); }
   };

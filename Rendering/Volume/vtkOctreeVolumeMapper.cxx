@@ -22,6 +22,7 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
+#include <octoray/DepthSignature.h>
 #include <octoray/Engine.h>
 
 #include <algorithm>
@@ -63,6 +64,10 @@ public:
   Step Build(const vtkOctreeInputHelper::Request& request);
   Step Trace(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window);
   octoray::RenderSettings FrameSettings(vtkRenderer* ren, vtkVolume* vol, int width, int height);
+  Step OpaqueDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
+    octoray::RenderSettings& settings, std::uint64_t& signature);
+  bool UsesInterop() const;
+  void InteropFailed(const std::string& why);
   Step Deliver(vtkOpenGLRenderWindow* window, octoray::RenderSettings& settings);
   template <typename Call>
   Step Run(const char* what, Call&& call);
@@ -281,18 +286,20 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
     return Step::Stop;
   }
   octoray::RenderSettings s = this->FrameSettings(ren, vol, width, height);
-  const double t0 = Now();
-  std::vector<float> depth;
-  if (!this->Compositor.ReadDepth(window, x0, y0, width, height, depth))
+  // The depth mapped for CUDA goes back to OpenGL when the trace is done.
+  struct UnmapDepth
   {
-    vtkWarningWithObjectMacro(self, "Could not read the depth of the opaque geometry; the octree is drawn without it.");
+    vtkOctreeCompositor& Compositor;
+    ~UnmapDepth() { this->Compositor.ReleaseDeviceDepth(); }
+  } unmapDepth{ this->Compositor };
+  std::uint64_t depthSignature = 0;
+  const Step step = this->OpaqueDepth(window, x0, y0, width, height, s, depthSignature);
+  if (step != Step::Done)
+  {
+    return step;
   }
-  const int step = std::max(1, static_cast<int>(std::lround(self->ImageSampleDistance)));
-  s.depthBuffer = vtkOctreeRenderSettings::SampleDepth(depth, width, height, step, s.width, s.height);
-  self->LastDepthReadSeconds = Now() - t0;
-
-  vtkOctreeRenderSettings::TraceKey key =
-    vtkOctreeRenderSettings::TraceKey::Of(s, self->GetMTime(), vol->GetProperty()->GetMTime(), this->OctreeVersion);
+  const vtkOctreeRenderSettings::TraceKey key = vtkOctreeRenderSettings::TraceKey::Of(
+    s, self->GetMTime(), vol->GetProperty()->GetMTime(), this->OctreeVersion, depthSignature);
   if (key == this->LastTrace && this->Compositor.HasPicture())
   {
     return Step::Done;
@@ -301,9 +308,65 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
   if (traced == Step::Done)
   {
     ++self->NumberOfTraces;
-    this->LastTrace = std::move(key);
+    this->LastTrace = key;
   }
   return traced;
+}
+
+//------------------------------------------------------------------------------
+// The depth of what VTK drew in the viewport, where rays must stop, and its
+// signature (what the last trace is compared by). On CUDA with interop it
+// stays on the GPU: read into an OpenGL buffer that CUDA maps, which the
+// trace then reads in place; otherwise it is read back to the host (and
+// sampled at the traced pixels when one ray serves several).
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::OpaqueDepth(
+  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, octoray::RenderSettings& s,
+  std::uint64_t& signature)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  const double t0 = Now();
+  const int step = std::max(1, static_cast<int>(std::lround(self->ImageSampleDistance)));
+  if (step == 1 && this->UsesInterop())
+  {
+    std::string why;
+    s.deviceDepthBuffer =
+      this->Compositor.ReadDepthToDevice(window, x0, y0, width, height, this->Backend.CudaDevice(), why);
+    if (!s.deviceDepthBuffer)
+    {
+      this->InteropFailed(why);
+    }
+    else
+    {
+      const Step summed = this->Run("depth signature", [&] {
+        signature = this->Backend.Engine()->DeviceDepthSignature(
+          s.deviceDepthBuffer, static_cast<std::size_t>(width) * height);
+      });
+      self->LastDepthReadSeconds = Now() - t0;
+      return summed;
+    }
+  }
+  std::vector<float> depth;
+  if (!this->Compositor.ReadDepth(window, x0, y0, width, height, depth))
+  {
+    vtkWarningWithObjectMacro(self, "Could not read the depth of the opaque geometry; the octree is drawn without it.");
+  }
+  s.depthBuffer = vtkOctreeRenderSettings::SampleDepth(depth, width, height, step, s.width, s.height);
+  signature = octoray::DepthSignature(s.depthBuffer.data(), s.depthBuffer.size());
+  self->LastDepthReadSeconds = Now() - t0;
+  return Step::Done;
+}
+
+//------------------------------------------------------------------------------
+bool vtkOctreeVolumeMapper::vtkInternals::UsesInterop() const
+{
+  return this->Backend.Kind() == BACKEND_CUDA && this->Self->UseCudaGLInterop && !this->InteropUnusable;
+}
+
+void vtkOctreeVolumeMapper::vtkInternals::InteropFailed(const std::string& why)
+{
+  vtkWarningWithObjectMacro(
+    this->Self, "CUDA-OpenGL interop cannot serve this window (" << why << "); the picture goes through host memory");
+  this->InteropUnusable = true;
 }
 
 //------------------------------------------------------------------------------
@@ -315,8 +378,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::D
 {
   vtkOctreeVolumeMapper* self = this->Self;
   octoray::Engine* engine = this->Backend.Engine();
-  s.copyToHost =
-    !(this->Backend.Kind() == BACKEND_CUDA && self->UseCudaGLInterop && !this->InteropUnusable);
+  s.copyToHost = !this->UsesInterop();
   octoray::RenderStats stats;
   Step step = this->Run("render", [&] { stats = engine->Render(s, this->Image); });
   if (step != Step::Done)
@@ -327,9 +389,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::D
   std::string why;
   if (!s.copyToHost && !this->Compositor.SetPictureFromDevice(window, engine->LastDeviceImage(), why))
   {
-    vtkWarningWithObjectMacro(self, "CUDA-OpenGL interop cannot serve this window (" << why
-        << "); the picture goes through host memory");
-    this->InteropUnusable = true;
+    this->InteropFailed(why);
     s.copyToHost = true;
     step = this->Run("render", [&] { stats = engine->Render(s, this->Image); });
     if (step != Step::Done)

@@ -2,6 +2,8 @@
 // in double precision, on every backend.
 #include "TestRenderSupport.h"
 
+#include <octoray/DepthSignature.h>
+
 using namespace octoray;
 using namespace octoray::test;
 
@@ -240,7 +242,88 @@ TEST_P(RenderTest, EightBitOutputIsTheRoundedFloatPicture)
   }
 }
 
+// A depth buffer in device memory (what the VTK layer maps from OpenGL)
+// stops rays exactly where the same depth from the host does, and its
+// signature on the device is the host's. The CPU backend refuses one.
+TEST_P(RenderTest, DepthBufferInDeviceMemory)
+{
+  const Cloud c = GaussianClusters(3000, 48);
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(c.View(), options);
+  const int w = 48, h = 36;
+  const double eye[3] = { 20, -25, 15 }, target[3] = { 2, 1, 1 };
+  const Matrix vp = ViewProjection(eye, target, kUp, 40, double(w) / h, 1, 100);
+  RenderSettings s = Settings(vp, w, h);
+  s.maxBounces = 0;
+  Image first;
+  engine->Render(s, first);
+  if (GetParam() == Backend::CPU)
+  {
+    s.deviceDepthBuffer = first.depth.data();
+    EXPECT_THROW(engine->Render(s, first), Error);
+    EXPECT_THROW(engine->DeviceDepthSignature(first.depth.data(), first.depth.size()), Error);
+    return;
+  }
+  // The opaque geometry: a second engine's picture of a cluster between the
+  // camera and the cloud, whose depth stays in device memory.
+  Cloud front = GaussianClusters(500, 49);
+  for (std::size_t i = 0; i < front.xyz.size(); i += 3)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      front.xyz[i + a] = 0.3 * front.xyz[i + a] + 0.5 * (eye[a] + target[a]) * 0.6;
+    }
+  }
+  auto occluder = CreateEngine(Backend::CUDA);
+  occluder->Build(front.View(), options);
+  Image opaque;
+  occluder->Render(s, opaque);
+  const DeviceImage device = occluder->LastDeviceImage();
+  ASSERT_NE(device.depth, nullptr);
+  EXPECT_EQ(occluder->DeviceDepthSignature(device.depth, opaque.depth.size()),
+    DepthSignature(opaque.depth.data(), opaque.depth.size()));
+  // The cloud behind it, with that depth read on the device and from the host.
+  RenderSettings d = s;
+  d.deviceDepthBuffer = device.depth;
+  Image fromDevice, fromHost;
+  engine->Render(d, fromDevice);
+  d.deviceDepthBuffer = nullptr;
+  d.depthBuffer = opaque.depth;
+  engine->Render(d, fromHost);
+  EXPECT_EQ(fromDevice.rgba, fromHost.rgba);
+  EXPECT_EQ(fromDevice.depth, fromHost.depth);
+  int blocked = 0;
+  for (std::size_t i = 0; i < first.depth.size(); ++i)
+  {
+    blocked += first.rgba[4 * i + 3] > 0 && fromHost.rgba[4 * i + 3] == 0;
+  }
+  EXPECT_GT(blocked, 20) << "the opaque depth must hide part of the cloud";
+  d.deviceDepthBuffer = device.depth;
+  EXPECT_THROW(engine->Render(d, fromDevice), Error) << "host and device depth at once";
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, RenderTest, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
+
+TEST(DepthSignature, ChangesWithAnyPixel)
+{
+  std::vector<float> depth(640 * 480);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (float& z : depth)
+  {
+    z = u(rng);
+  }
+  const std::uint64_t base = DepthSignature(depth.data(), depth.size());
+  EXPECT_EQ(base, DepthSignature(depth.data(), depth.size()));
+  std::vector<float> moved(depth);
+  moved[12345] = std::nextafter(moved[12345], 2.0f); // one ulp
+  EXPECT_NE(base, DepthSignature(moved.data(), moved.size()));
+  std::swap(moved[1], moved[2]);
+  moved[12345] = depth[12345];
+  EXPECT_NE(base, DepthSignature(moved.data(), moved.size())) << "two pixels swapped";
+  EXPECT_NE(base, DepthSignature(depth.data(), depth.size() - 1));
+}
 
 // The CUDA picture against the CPU one (the reference), per mode.
 TEST(RenderCUDA, ImagesEqualTheCpuBackend)

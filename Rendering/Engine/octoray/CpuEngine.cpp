@@ -542,6 +542,10 @@ UpdateStats CpuEngine::Update(const PositionsView& positions)
 
 RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
 {
+  if (settings.deviceDepthBuffer)
+  {
+    throw Error("octoray: the CPU backend cannot read a depth buffer in device memory");
+  }
   if (Count == 0)
   {
     throw Error("octoray: render before any build");

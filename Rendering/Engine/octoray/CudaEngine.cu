@@ -6,6 +6,7 @@
 #include "CudaEngine.h"
 
 #include "DepthChoice.h"
+#include "DepthSignature.h"
 #include "Frame.h"
 #include "OctreeKernels.h"
 
@@ -474,6 +475,27 @@ std::string CudaEngine::Description() const
   return "CUDA (" + DeviceName + (count > 1 ? ", device " + std::to_string(Device) : std::string()) + ")";
 }
 
+// DepthSignatureTerm of pixel i, for the reduction below.
+struct DepthTerm
+{
+  const float* depth;
+  __device__ std::uint64_t operator()(std::size_t i) const { return DepthSignatureTerm(depth[i], i); }
+};
+
+std::uint64_t CudaEngine::DeviceDepthSignature(const float* deviceDepth, std::size_t count)
+{
+  const ScopedDevice scope(Device);
+  auto in = thrust::make_transform_iterator(thrust::counting_iterator<std::size_t>(0), DepthTerm{ deviceDepth });
+  DeviceBuffer<std::uint64_t> sum;
+  sum.Reserve(Pool, 1, "counters");
+  std::size_t bytes = 0;
+  CudaCheck(cub::DeviceReduce::Sum(nullptr, bytes, in, sum.Get(), count), "cub::DeviceReduce (depth signature)");
+  CudaCheck(cub::DeviceReduce::Sum(CubTemp(bytes), bytes, in, sum.Get(), count), "cub::DeviceReduce (depth signature)");
+  std::uint64_t result = 0;
+  CudaCheck(cudaMemcpy(&result, sum.Get(), sizeof result, cudaMemcpyDeviceToHost), "depth signature");
+  return result + count;
+}
+
 DeviceImage CudaEngine::LastDeviceImage() const
 {
   DeviceImage image;
@@ -894,7 +916,15 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
     Upload(Pool, Transfer, settings.transfer.table.data(), settings.transfer.table.size(), "transfer function");
     frame.transfer = Transfer.Get();
   }
-  if (frame.depthBuffer)
+  if (settings.deviceDepthBuffer)
+  {
+    if (frame.depthBuffer)
+    {
+      throw Error("octoray: a depth buffer in host and in device memory at once");
+    }
+    frame.depthBuffer = settings.deviceDepthBuffer;
+  }
+  else if (frame.depthBuffer)
   {
     Upload(Pool, DepthIn, settings.depthBuffer.data(), pixels, "depth buffer");
     frame.depthBuffer = DepthIn.Get();

@@ -64,6 +64,7 @@ public:
   const std::uint8_t* DeviceImageRgba8() const { return ImageRgba8.Get(); }
   const float* DeviceImageDepth() const { return ImageDepth.Get(); }
   DeviceImage LastDeviceImage() const override;
+  std::uint64_t DeviceDepthSignature(const float* deviceDepth, std::size_t count) override;
 
 private:
   void DataBounds(const DeviceState& s, double lo[3], double hi[3]);

@@ -9,6 +9,11 @@ const char* ToString(Backend backend)
   return backend == Backend::CUDA ? "CUDA" : "CPU";
 }
 
+std::uint64_t Engine::DeviceDepthSignature(const float*, std::size_t)
+{
+  throw Error(std::string("octoray: the ") + ToString(Kind()) + " backend holds no device memory");
+}
+
 #if OCTORAY_HAVE_CUDA
 std::unique_ptr<Engine> CreateCudaEngine(int device); // CudaEngine.cu
 bool CudaDeviceUsable(std::string* why);

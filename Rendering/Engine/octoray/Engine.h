@@ -61,6 +61,11 @@ public:
   // a round trip through the host (RenderSettings::copyToHost off).
   virtual DeviceImage LastDeviceImage() const { return {}; }
 
+  // DepthSignature (DepthSignature.h) of `count` depths in this engine's
+  // device memory (CUDA; the CPU backend throws Error): the VTK layer keeps
+  // it to know whether the opaque depth changed without reading it back.
+  virtual std::uint64_t DeviceDepthSignature(const float* deviceDepth, std::size_t count);
+
   virtual std::size_t PointCount() const = 0;
   virtual void CopyToHost(HostOctree& out) const = 0;
   virtual MemoryReport Memory() const = 0;

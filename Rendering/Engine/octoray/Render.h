@@ -63,6 +63,10 @@ struct RenderSettings
   // Window depth ([0,1], OpenGL convention, row-major from the bottom row) of
   // opaque geometry already drawn; rays stop there. Empty = none.
   std::vector<float> depthBuffer;
+  // CUDA: the same window depth already in the engine's device memory (an
+  // OpenGL buffer mapped by CUDA-OpenGL interop), width x height values,
+  // read in place instead of depthBuffer. Not for the CPU backend.
+  const float* deviceDepthBuffer = nullptr;
   // CUDA: copy the picture to the host Image. Off, it stays in device memory
   // (CudaEngine::DeviceImageRgba/DeviceImageDepth) for a caller that draws it
   // from there.

@@ -1,14 +1,17 @@
 // Work only when needed: the octree is built when the input or the arrays it
 // uses change, updated in place when only point positions move, and the
-// picture is traced again only when the camera, lights, properties or
-// settings change. Also: the default backend choice, TimeToDraw and the
+// picture is traced again only when the camera, lights, properties,
+// settings or the opaque geometry's depth change. Also: the default backend choice, TimeToDraw and the
 // render events, and image input. --backend cpu|cuda.
 #include "octorayMapperTesting.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkCommand.h"
+#include "vtkActor.h"
 #include "vtkLight.h"
+#include "vtkPolyDataMapper.h"
 #include "vtkRenderer.h"
+#include "vtkSphereSource.h"
 
 using namespace octoray_test;
 
@@ -101,6 +104,23 @@ int TestOctreeVolumeMapperWork(int argc, char* argv[])
   volume->GetProperty()->SetAmbient(0.3);
   window->Render();
   CHECK(Made(mapper, 1, 0, 5));
+  // Opaque geometry appeared in front (the window depth changed): trace;
+  // then nothing changed again: no trace.
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(0.5, 0.3, 0.8);
+  sphere->SetRadius(0.3);
+  vtkNew<vtkPolyDataMapper> sphereMapper;
+  sphereMapper->SetInputConnection(sphere->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(sphereMapper);
+  ren->AddActor(actor);
+  window->Render();
+  CHECK(Made(mapper, 1, 0, 6));
+  window->Render();
+  CHECK(Made(mapper, 1, 0, 6));
+  ren->RemoveActor(actor);
+  window->Render();
+  CHECK(Made(mapper, 1, 0, 7));
   // Only the positions changed (same array, modified in place): update.
   double p[3];
   cloud->GetPoints()->GetPoint(0, p);
@@ -108,21 +128,21 @@ int TestOctreeVolumeMapperWork(int argc, char* argv[])
   cloud->GetPoints()->SetPoint(0, p);
   cloud->GetPoints()->Modified();
   window->Render();
-  CHECK(Made(mapper, 1, 1, 6));
+  CHECK(Made(mapper, 1, 1, 8));
   // The colours changed: rebuild.
   cloud->GetPointData()->GetScalars()->Modified();
   window->Render();
-  CHECK(Made(mapper, 2, 1, 7));
+  CHECK(Made(mapper, 2, 1, 9));
   // A mapper setting that shapes the octree: rebuild.
   mapper->SetLeafDepth(3);
   window->Render();
-  CHECK(Made(mapper, 3, 1, 8));
+  CHECK(Made(mapper, 3, 1, 10));
   // Depth 3: a leaf is an eighth of the root cube, which is about 2 wide.
   CHECK(mapper->GetLeafSize() * 8 > 1.8 && mapper->GetLeafSize() * 8 < 2.01);
   // A setting of the picture only: trace, no build.
   mapper->SetBlendModeToMaximumIntensity();
   window->Render();
-  CHECK(Made(mapper, 3, 1, 9));
+  CHECK(Made(mapper, 3, 1, 11));
   CHECK(DrewWith(mapper, backend));
 
   // vtkImageData: voxels above the background become points.
