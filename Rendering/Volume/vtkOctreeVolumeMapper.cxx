@@ -17,6 +17,7 @@
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
@@ -274,6 +275,31 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
 }
 
 //------------------------------------------------------------------------------
+// Whether anything may have written depth in the viewport before the
+// volumes are drawn: another visible 3D prop with opaque geometry (actors,
+// and other volumes, which this mapper draws with depth), or a depth buffer
+// the renderer keeps from the layer below. When nothing can, the depth read
+// (a round trip through OpenGL) is skipped and rays run to the far plane.
+static bool MayHaveOpaqueDepth(vtkRenderer* ren, vtkVolume* vol)
+{
+  if (ren->GetPreserveDepthBuffer())
+  {
+    return true;
+  }
+  vtkCollectionSimpleIterator it;
+  vtkPropCollection* props = ren->GetViewProps();
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    if (prop != vol && prop->GetVisibility() && vtkProp3D::SafeDownCast(prop) && prop->HasOpaqueGeometry())
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+//------------------------------------------------------------------------------
 // Traces the picture when anything that shapes it changed since the last one.
 vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Trace(
   vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window)
@@ -293,10 +319,14 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
     ~UnmapDepth() { this->Compositor.ReleaseDeviceDepth(); }
   } unmapDepth{ this->Compositor };
   std::uint64_t depthSignature = 0;
-  const Step step = this->OpaqueDepth(window, x0, y0, width, height, s, depthSignature);
-  if (step != Step::Done)
+  self->LastDepthReadSeconds = 0.0;
+  if (MayHaveOpaqueDepth(ren, vol))
   {
-    return step;
+    const Step step = this->OpaqueDepth(window, x0, y0, width, height, s, depthSignature);
+    if (step != Step::Done)
+    {
+      return step;
+    }
   }
   const vtkOctreeRenderSettings::TraceKey key = vtkOctreeRenderSettings::TraceKey::Of(
     s, self->GetMTime(), vol->GetProperty()->GetMTime(), this->OctreeVersion, depthSignature);
