@@ -1,6 +1,6 @@
 # The two commands of the README, on a fresh Debian 12 machine:
-#   make demo   install what is missing, build, run the main job on bundled data
-#   make test   install what is missing, build, run every test
+#   make demo   install what is missing, fetch the data, build, run the main job on bundled data
+#   make test   install what is missing, fetch the data, build, run every test
 # and `make bench` for the benchmarks (JSON into build/bench-results.json),
 # `make report` for Testing/Bench/RESULTS.md with its CSV files and plots.
 
@@ -8,12 +8,19 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-asan demo bench report clean
+.PHONY: all deps data configure build test test-asan demo bench report clean
 
 all: build
 
 deps:
 	./scripts/install-deps.sh
+
+# Real third-party data by Debian package name (head CT, laser scans, range
+# scans; Data/README.md) into Data/External/, which is not committed: the
+# packages are downloaded and unpacked, never installed. A second run checks
+# Data/External/MANIFEST.tsv and stops.
+data: deps
+	./scripts/fetch-data.sh
 
 configure: deps
 	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
@@ -27,7 +34,7 @@ build: configure
 # reset fails with "bad X server connection".
 XVFB = $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1280x1024x24 -noreset")
 
-test: build
+test: build data
 	cd $(BUILD) && $(XVFB) ctest --output-on-failure -j $(JOBS) -LE bench
 	$(MAKE) test-asan
 
@@ -70,7 +77,7 @@ test-asan: deps
 # taken as mirror weight it would blend every voxel with the empty sky, so
 # the demo pictures draw first hits only (--bounces 0).
 DEMO_DATA = Data/Particles/lidar_simple.particles
-demo: build
+demo: build data
 	$(BUILD)/bin/octoray stats $(DEMO_DATA)
 	$(BUILD)/bin/octoray render $(DEMO_DATA) -o $(BUILD)/demo-phong.png --mode phong --shadows --bounces 0 --zoom 1.3
 	$(BUILD)/bin/octoray render $(DEMO_DATA) -o $(BUILD)/demo-surface.png --mode surface --bounces 0 --zoom 1.3
