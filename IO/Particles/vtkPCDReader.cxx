@@ -250,8 +250,8 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
         std::to_string(n) + " of " + std::to_string(h.ValuesPerPoint) + " value(s) each");
       return false;
     }
-    // Padding and values of the ascii body are written by the parse; the
-    // bytes of padding fields are never read.
+    // The parse writes every value but those of padding fields, which
+    // nothing reads.
     buffer.reset(new unsigned char[std::max<size_t>(n * h.PointStep, 1)]);
     const bool parsed = ParseAscii(data + h.DataOffset, data + size, h.DataLine + 1, h, file,
       buffer.get(), error, warnings, [&](uint64_t done) {

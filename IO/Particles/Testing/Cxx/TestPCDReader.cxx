@@ -705,6 +705,28 @@ void TestHeaders()
         std::string::npos);
     }
   }
+  // Bytes after the body: zeros (PCL's writer leaves some after a
+  // compressed block) pass quietly; anything else is read, with a warning.
+  {
+    const std::vector<FieldSpec> fields = { { "x", 'F', 4, 1 }, { "y", 'F', 4, 1 },
+      { "z", 'F', 4, 1 } };
+    const Values v = { { 1, 2, 3 }, { 4, 5, 6 } };
+    for (const char* form : { "binary", "binary_compressed" })
+    {
+      const std::string good = Encode(fields, 2, 1, v, form);
+      const std::string path = Path(std::string("trailing_") + form + ".pcd");
+      WriteFile(path, good + std::string(3900, '\0'));
+      Run run;
+      CHECK(run.Read(path)->GetNumberOfPoints() == 2 && run.Warnings.empty());
+      WriteFile(path, good + "junk");
+      CHECK(run.Read(path)->GetNumberOfPoints() == 2 && run.Warnings.size() == 1);
+      if (run.Warnings.size() == 1)
+      {
+        CHECK(run.Warnings[0].find(path + ": 4 bytes (not all zero) after the ") !=
+          std::string::npos);
+      }
+    }
+  }
   // GenerateVertices off: no cells.
   {
     Run run;
