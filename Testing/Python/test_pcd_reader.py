@@ -258,3 +258,17 @@ def test_independent_lzf_decoder_is_itself_right():
     """The reference decoder on a hand-made stream with an overlapping copy."""
     stream = bytes([0x02]) + b"abc" + bytes([0xE0, 0x03, 0x02])  # 'abc' + 12 bytes from 3 back
     assert lzf_decompress(stream, 15) == b"abc" * 5
+
+
+def test_gzip_compressed_file(tmp_path):
+    """A gzip-compressed PCD (x.pcd.gz) is read as the file it holds, like a
+    gzip-compressed particle file (the module's file source inflates it)."""
+    import gzip
+    text = ("VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\n"
+            "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA binary\n").encode()
+    body = struct.pack("<fffIfffI", 1, 2, 3, 0x00FF8000, 4, 5, 6, 0x000000FF)
+    path = tmp_path / "cloud.pcd.gz"
+    path.write_bytes(gzip.compress(text + body))
+    _, out, _ = read(str(path))
+    assert points(out).tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert array(out, "Colors").tolist() == [[255, 128, 0], [0, 0, 255]]
