@@ -44,11 +44,12 @@ test: build data
 # CUDA, readers, and the mappers where they exist); ParaView's libraries are
 # not instrumented. It runs the C++ tests of the engine, the readers and the
 # reliability tests, and each libFuzzer target for FUZZ_SECONDS; and the
-# Python reader suites (python.particle_reader, .slice_stack_reader,
-# .depth_and_normals) with the instrumented `octoray` modules: python3 and
-# ParaView's libraries are not instrumented, so the ASan runtime is preloaded
-# into python3 (LD_PRELOAD, set per test by Testing/Python/CMakeLists.txt),
-# with LeakSanitizer off there (the interpreter leaks by design).
+# Python reader suites (python.particle_reader, .pcd_reader,
+# .slice_stack_reader, .depth_and_normals) with the instrumented `octoray`
+# modules: python3 and ParaView's libraries are not instrumented, so the ASan
+# runtime is preloaded into python3 (LD_PRELOAD, set per test by
+# Testing/Python/CMakeLists.txt), with LeakSanitizer off there (the
+# interpreter leaks by design).
 ASAN_BUILD ?= build-asan
 FUZZ_SECONDS ?= 30
 ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
@@ -56,8 +57,9 @@ ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fr
 # call), not only in the targets themselves.
 ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
 ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader TestDicomCheck \
-  TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader octoray_fuzz_ParticleText \
-  octoray_fuzz_SliceStackMetadata octorayIOParticlesPython octorayIOImageStackPython octorayFiltersPCLPython \
+  TestReaderRobustness TestSceneLeaks octorayIOParticlesCxxTests octoray_fuzz_ParticleHeader \
+  octoray_fuzz_ParticleText octoray_fuzz_PCD octoray_fuzz_SliceStackMetadata \
+  octorayIOParticlesPython octorayIOImageStackPython octorayFiltersPCLPython \
   octorayRenderingVolumePython
 test-asan: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -71,7 +73,7 @@ test-asan: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
 	  ctest --output-on-failure -j $(JOBS) \
-	  -R '^(deps\.|engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|reliability\.|fuzz\.|python\.(particle_reader|slice_stack_reader|depth_and_normals)$$)'
+	  -R '^(deps\.|engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|octoray::IOParticlesCxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
 
 # The LiDAR tile's reflectivity column is the scanner's intensity (0.3-0.6):
 # taken as mirror weight it would blend every voxel with the empty sky, so

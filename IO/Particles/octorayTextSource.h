@@ -27,6 +27,21 @@
 
 namespace octoray
 {
+// "device:inode:size:mtime" of a file, empty when it cannot be stat'ed: the
+// readers' GetMTime() compare it with the last one seen, so that Update()
+// reads a file again once it changed on disk.
+inline std::string FileSignature(const char* name)
+{
+  struct stat st;
+  if (!name || ::stat(name, &st) != 0)
+  {
+    return std::string();
+  }
+  return std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino) + ":" +
+    std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
+    std::to_string(st.st_mtim.tv_nsec);
+}
+
 class TextSource
 {
 public:

@@ -33,8 +33,6 @@
 #include <thread>
 #include <vector>
 
-#include <sys/stat.h>
-
 vtkStandardNewMacro(vtkParticleTextReader);
 
 namespace
@@ -216,14 +214,7 @@ int vtkParticleTextReader::RequestData(
 vtkMTimeType vtkParticleTextReader::GetMTime()
 {
   const vtkMTimeType own = this->Superclass::GetMTime();
-  std::string signature;
-  struct stat st;
-  if (this->FileName && ::stat(this->FileName, &st) == 0)
-  {
-    signature = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino) + ":" +
-      std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
-      std::to_string(st.st_mtim.tv_nsec);
-  }
+  const std::string signature = octoray::FileSignature(this->FileName);
   if (signature != this->FileSignature)
   {
     this->FileSignature = signature;

@@ -41,6 +41,22 @@ check("particles: File > Open offers the reader",
 o = OpenDataFile(particles)
 check("OpenDataFile(.particles)", o.GetXMLName(), "OctorayParticleReader")
 
+# A PCD file (written here: the real scans come with `make data`) through
+# the reader factory: OpenDataFile picks the PCD reader.
+import tempfile  # noqa: E402
+
+pcd = os.path.join(tempfile.mkdtemp(), "cloud.pcd")
+with open(pcd, "w") as f:
+    f.write("VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+            "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
+            "0 0 0 1\n1 0 0 2\n0 1 0 3\n")
+check("PCD: File > Open offers the reader", "OctorayPCDReader" in readers_for(pcd), True)
+p = OpenDataFile(pcd)
+check("OpenDataFile(.pcd)", p.GetXMLName(), "OctorayPCDReader")
+p.UpdatePipeline()
+check("PCD: points", p.GetDataInformation().GetNumberOfPoints(), 3)
+check("PCD: Intensity array", "Intensity" in p.PointData.keys(), True)
+
 # A DICOM folder: the folder reader, then the same files as a series.
 folder = os.path.join(data, "DICOM", "CT5N")
 d = OctoraySliceFolderReader(DirectoryName=folder)

@@ -81,3 +81,25 @@ def test_missing_input_is_an_error(tmp_path):
     assert r.returncode != 0
     assert "no such file" in r.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_render_pcd(tmp_path):
+    """A .pcd file goes to vtkPCDReader: a binary PCD of a coloured 20 x 20
+    grid written here."""
+    import struct
+    pcd = tmp_path / "grid.pcd"
+    n = 400
+    body = b"".join(struct.pack("<fffI", i % 20, i // 20, 0.0, 0xFF0000 | (i % 256) << 8)
+                    for i in range(n))
+    pcd.write_bytes(("VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+                     "WIDTH %d\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA binary\n"
+                     % (n, n)).encode() + body)
+    out = tmp_path / "grid.png"
+    r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96")
+    assert r.returncode == 0, r.stderr
+    assert "points: 400" in r.stdout
+    w, h, rgb = read_png(str(out))
+    # The grid's colours are red with some green, never blue.
+    drawn = rgb[:, :3].max(axis=1) > 0
+    assert drawn.sum() > 0.2 * w * h
+    assert rgb[drawn, 0].mean() > 100 and rgb[drawn, 2].max() < 40

@@ -4,7 +4,8 @@
         [--size 1920x1080] [--mode surface|phong|depthcue|composite|mip|minip|average|additive]
         [--azimuth DEG] [--elevation DEG] [--zoom F] [--depth N] [--background LO HI]
 
-INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a folder of
+INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
+cloud (.pcd: ascii, binary or binary_compressed), a folder of
 image slices or DICOM files, or a printf pattern of slice names
 ("ct_%03d.png", with --range FIRST LAST). Reading and building show a
 progress bar on stderr; the backend and the load, build and render times are
@@ -63,7 +64,10 @@ def make_reader(path, args):
         if args.background is not None:
             reader.SetBackgroundRange(*args.background)
         return reader
-    reader = octoray.vtkParticleReader()
+    if path.lower().endswith((".pcd", ".pcd.gz")):
+        reader = octoray.vtkPCDReader()  # PCL's point cloud files
+    else:
+        reader = octoray.vtkParticleReader()
     reader.SetFileName(path)
     reader.SetOutputPointsPrecision(vtk.vtkAlgorithm.DOUBLE_PRECISION)
     return reader

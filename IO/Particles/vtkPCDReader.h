@@ -1,0 +1,122 @@
+/**
+ * @class   vtkPCDReader
+ * @brief   Reads PCL's PCD point cloud files (ascii, binary, binary_compressed) into vtkPolyData.
+ *
+ * PCD v0.7 headers, and the v0.5 / v0.6 headers PCL still accepts (COLUMNS
+ * for FIELDS, no WIDTH / HEIGHT / VIEWPOINT / COUNT); the keywords in any
+ * order, `#` comment lines anywhere in the header. Value types I, U
+ * (sizes 1, 2, 4, 8) and F (4, 8), fields of COUNT > 1, padding fields
+ * named `_`. All three bodies: `ascii`, `binary` (interleaved), and
+ * `binary_compressed` (LZF, one array per field), decoded by the module
+ * itself: no PCL, no third-party library.
+ *
+ * Output (each only where the file has it):
+ * - points from x y z (float, or double with SetOutputPointsPrecision);
+ *   one vertex cell per point (GenerateVertices);
+ * - `Colors`: unsigned char RGB from a packed `rgb` field, RGBA from
+ *   `rgba` (4 bytes, float or uint32, 0xAARRGGBB), the active scalars;
+ * - `Normals`: from `normal_x normal_y normal_z`, the active normals;
+ * - `Intensity`: from `intensity` (float), the active scalars when there
+ *   are no colours;
+ * - every other field (`curvature`, `label`, a descriptor such as `fpfh`
+ *   with COUNT 33, ...) as a float array of its own name with COUNT
+ *   components; padding fields `_` are skipped;
+ * - field data: `SkippedPointCount`, `PCDWidth`, `PCDHeight` and
+ *   `PCDViewpoint` (tx ty tz qw qx qy qz).
+ *
+ * Points whose x, y or z is NaN or infinite (the empty cells of an
+ * organised cloud) are left out and counted: one warning names the file and
+ * the count, and the field data keep it (`SkippedPointCount`). Non-finite
+ * values of other fields are kept as they are.
+ *
+ * Errors name the file, and the line for the header and the ascii body
+ * (`scan.pcd:5: TYPE lists 3 value(s), FIELDS (line 3) lists 4 field(s)`,
+ * `scan.pcd:14:7: expected a number for value 2 (y), found 'abc'`); a body
+ * shorter than the header promises says how much was expected and found; a
+ * damaged compressed block says where. A failed update leaves the output of
+ * the last successful one in place (empty when there was none).
+ *
+ * The file is memory-mapped (gzip-compressed files are inflated); progress
+ * events and SetAbortExecute are honoured while decoding.
+ */
+#ifndef vtkPCDReader_h
+#define vtkPCDReader_h
+
+#include "octorayIOParticlesModule.h" // for export macro
+#include "vtkPolyDataAlgorithm.h"
+#include "vtkSmartPointer.h" // for vtkSmartPointer
+
+#include <string> // for std::string
+
+class OCTORAYIOPARTICLES_EXPORT vtkPCDReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkPCDReader* New();
+  vtkTypeMacro(vtkPCDReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The PCD file to read.
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /// vtkAlgorithm::SINGLE_PRECISION (default) or DOUBLE_PRECISION for the
+  /// points. The other arrays are float whatever the file stores.
+  vtkSetClampMacro(OutputPointsPrecision, int, SINGLE_PRECISION, DOUBLE_PRECISION);
+  vtkGetMacro(OutputPointsPrecision, int);
+  ///@}
+
+  ///@{
+  /// Make one VTK_VERTEX cell per point (default on), so that ordinary VTK
+  /// mappers draw the points.
+  vtkSetMacro(GenerateVertices, bool);
+  vtkGetMacro(GenerateVertices, bool);
+  vtkBooleanMacro(GenerateVertices, bool);
+  ///@}
+
+  /// Points left out by the last update because a coordinate was NaN or
+  /// infinite.
+  vtkGetMacro(NumberOfSkippedPoints, vtkIdType);
+
+  /// The message of the last error; empty when the last update succeeded.
+  const char* GetErrorMessage() { return this->ErrorMessage.c_str(); }
+
+  /// The fields of the file read last, as its FIELDS line lists them, and
+  /// its DATA form ("ascii", "binary", "binary_compressed").
+  const char* GetFieldNames() { return this->FieldNames.c_str(); }
+  const char* GetDataEncoding() { return this->DataEncoding.c_str(); }
+
+  /// Includes the file's modification time, size and inode: when the file
+  /// changes on disk, the next Update() reads it again.
+  vtkMTimeType GetMTime() override;
+
+protected:
+  vtkPCDReader();
+  ~vtkPCDReader() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* FileName = nullptr;
+  int OutputPointsPrecision = SINGLE_PRECISION;
+  bool GenerateVertices = true;
+  vtkIdType NumberOfSkippedPoints = 0;
+  std::string ErrorMessage;
+  std::string FieldNames;
+  std::string DataEncoding;
+  std::string FileSignature;
+  vtkTimeStamp FileChangeTime;
+  // The output of the last successful update, which a failed update leaves
+  // in place.
+  vtkSmartPointer<vtkPolyData> LastOutput;
+
+private:
+  vtkPCDReader(const vtkPCDReader&) = delete;
+  void operator=(const vtkPCDReader&) = delete;
+
+  bool Read(const char* data, size_t size, vtkPolyData* output);
+  void Fail(const std::string& message);
+};
+
+#endif
