@@ -62,74 +62,100 @@ static unsigned int DepthFormat(unsigned int drawFramebuffer)
 }
 
 //------------------------------------------------------------------------------
-// A multisampled framebuffer cannot be read: its depth is blitted into a
-// single-sampled one of the same format, whose name this returns (bound for
-// reading, the viewport at its origin).
-unsigned int vtkOctreeCompositor::ResolveDepth(
-  vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int width, int height)
+// The base format and pixel type that go with a depth internal format, for
+// allocating a texture of it.
+static void DepthTextureFormat(unsigned int format, GLenum& base, GLenum& type)
 {
-  vtkOpenGLState* state = window->GetState();
-  const unsigned int format = DepthFormat(drawFramebuffer);
-  if (!this->ResolveFramebuffer || this->ResolveSize[0] != width || this->ResolveSize[1] != height ||
-    this->ResolveFormat != format)
+  switch (format)
   {
-    if (!this->ResolveFramebuffer)
-    {
-      glGenFramebuffers(1, &this->ResolveFramebuffer);
-      glGenRenderbuffers(1, &this->ResolveRenderbuffer);
-    }
-    glBindRenderbuffer(GL_RENDERBUFFER, this->ResolveRenderbuffer);
-    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, 0);
-    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, this->ResolveFramebuffer);
-    const bool withStencil = format == GL_DEPTH24_STENCIL8 || format == GL_DEPTH32F_STENCIL8;
-    glFramebufferRenderbuffer(GL_READ_FRAMEBUFFER, withStencil ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
-      GL_RENDERBUFFER, this->ResolveRenderbuffer);
-    this->ResolveSize[0] = width;
-    this->ResolveSize[1] = height;
-    this->ResolveFormat = format;
+    case GL_DEPTH24_STENCIL8:
+      base = GL_DEPTH_STENCIL;
+      type = GL_UNSIGNED_INT_24_8;
+      return;
+    case GL_DEPTH32F_STENCIL8:
+      base = GL_DEPTH_STENCIL;
+      type = GL_FLOAT_32_UNSIGNED_INT_24_8_REV;
+      return;
+    case GL_DEPTH_COMPONENT32F:
+      base = GL_DEPTH_COMPONENT;
+      type = GL_FLOAT;
+      return;
+    default:
+      base = GL_DEPTH_COMPONENT;
+      type = GL_UNSIGNED_INT;
   }
-  return this->ResolveFramebuffer;
 }
 
 //------------------------------------------------------------------------------
-// glReadPixels of the viewport's depth (as floats) from the framebuffer VTK
-// draws into, resolved first when it is multisampled, into `pixels`: host
-// memory, or an offset in the bound pixel-pack buffer.
-bool vtkOctreeCompositor::ReadDepthInto(
-  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, void* pixels)
+// Copies the viewport's depth from the framebuffer VTK draws into (a blit,
+// which also resolves a multisampled one) into a single-sampled depth
+// texture of the same format (a blit needs one), at the origin. Returns the
+// framebuffer that holds it; the draw and read bindings are as they were.
+unsigned int vtkOctreeCompositor::CopyDepth(
+  vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int x0, int y0, int width, int height)
 {
-  this->UseWindow(window);
   vtkOpenGLState* state = window->GetState();
-  GLint drawFramebuffer = 0, samples = 0;
-  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
-  glGetIntegerv(GL_SAMPLES, &samples);
-
+  const unsigned int format = DepthFormat(drawFramebuffer);
+  state->PushDrawFramebufferBinding();
   state->PushReadFramebufferBinding();
-  state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(drawFramebuffer));
-  if (samples > 0)
+  if (!this->CopyFramebuffer || this->CopySize[0] != width || this->CopySize[1] != height ||
+    this->CopyFormat != format)
   {
-    const unsigned int resolved = this->ResolveDepth(window, drawFramebuffer, width, height);
-    state->PushDrawFramebufferBinding();
-    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(drawFramebuffer));
-    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved);
-    glBlitFramebuffer(x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-    state->PopDrawFramebufferBinding();
-    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, resolved);
-    x0 = y0 = 0;
+    if (!this->CopyFramebuffer)
+    {
+      glGenFramebuffers(1, &this->CopyFramebuffer);
+      glGenTextures(1, &this->CopyTexture);
+    }
+    GLenum base = GL_DEPTH_COMPONENT, type = GL_UNSIGNED_INT;
+    DepthTextureFormat(format, base, type);
+    glBindTexture(GL_TEXTURE_2D, this->CopyTexture);
+    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(format), width, height, 0, base, type, nullptr);
+    // Sampled texel for texel: no filtering, no mipmaps (without which the
+    // texture would be incomplete), no comparison.
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CopyFramebuffer);
+    const bool withStencil = base == GL_DEPTH_STENCIL;
+    glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, withStencil ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+      GL_TEXTURE_2D, this->CopyTexture, 0);
+    this->CopySize[0] = width;
+    this->CopySize[1] = height;
+    this->CopyFormat = format;
   }
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, pixels);
+  state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
+  state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CopyFramebuffer);
+  glBlitFramebuffer(x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
   state->PopReadFramebufferBinding();
-  return glGetError() == GL_NO_ERROR;
+  state->PopDrawFramebufferBinding();
+  return this->CopyFramebuffer;
 }
 
 //------------------------------------------------------------------------------
 bool vtkOctreeCompositor::ReadDepth(
   vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, std::vector<float>& depth)
 {
+  this->UseWindow(window);
+  vtkOpenGLState* state = window->GetState();
   depth.assign(static_cast<std::size_t>(width) * height, 1.0f);
-  if (!this->ReadDepthInto(window, x0, y0, width, height, depth.data()))
+  GLint drawFramebuffer = 0, samples = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
+  glGetIntegerv(GL_SAMPLES, &samples);
+  // A multisampled framebuffer cannot be read: its depth is resolved into
+  // a single-sampled copy first.
+  unsigned int source = static_cast<unsigned int>(drawFramebuffer);
+  if (samples > 0)
+  {
+    source = this->CopyDepth(window, source, x0, y0, width, height);
+    x0 = y0 = 0;
+  }
+  state->PushReadFramebufferBinding();
+  state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, source);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+  state->PopReadFramebufferBinding();
+  if (glGetError() != GL_NO_ERROR)
   {
     std::fill(depth.begin(), depth.end(), 1.0f);
     return false;
@@ -138,35 +164,82 @@ bool vtkOctreeCompositor::ReadDepth(
 }
 
 //------------------------------------------------------------------------------
+// On the GPU throughout: the depth is copied into a depth texture (a blit),
+// drawn as floats into a single-channel float texture (a depth format
+// cannot be shared with CUDA; a read of depth as floats is a slow path in
+// some drivers), which CUDA copies into linear device memory.
 const float* vtkOctreeCompositor::ReadDepthToDevice(
   vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, int device, std::string& error)
 {
   this->UseWindow(window);
-  const std::size_t bytes = sizeof(float) * static_cast<std::size_t>(width) * height;
-  if (!this->DepthPixelBuffer)
+  vtkOpenGLState* state = window->GetState();
+  GLint drawFramebuffer = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
+  this->CopyDepth(window, static_cast<unsigned int>(drawFramebuffer), x0, y0, width, height);
+
+  if (!this->FloatDepth)
   {
-    glGenBuffers(1, &this->DepthPixelBuffer);
+    this->FloatDepth = vtkSmartPointer<vtkTextureObject>::New();
+    this->FloatDepth->SetContext(window);
+    this->WindowDepth = vtkSmartPointer<vtkTextureObject>::New();
+    this->WindowDepth->SetContext(window);
   }
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, this->DepthPixelBuffer);
-  if (this->DepthPixelBufferBytes != bytes)
+  if (!this->FloatDepthFramebuffer || static_cast<int>(this->FloatDepth->GetWidth()) != width ||
+    static_cast<int>(this->FloatDepth->GetHeight()) != height)
   {
     this->Interop->Release(); // a registration does not survive new storage
-    glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_COPY);
-    this->DepthPixelBufferBytes = bytes;
+    this->FloatDepth->Allocate2D(width, height, 1, VTK_FLOAT);
+    this->FloatDepth->SetMinificationFilter(vtkTextureObject::Nearest);
+    this->FloatDepth->SetMagnificationFilter(vtkTextureObject::Nearest);
+    if (!this->FloatDepthFramebuffer)
+    {
+      glGenFramebuffers(1, &this->FloatDepthFramebuffer);
+    }
+    state->PushDrawFramebufferBinding();
+    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->FloatDepthFramebuffer);
+    glFramebufferTexture2D(
+      GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, this->FloatDepth->GetHandle(), 0);
+    state->PopDrawFramebufferBinding();
   }
-  const bool read = this->ReadDepthInto(window, x0, y0, width, height, nullptr);
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  if (!read)
+  if (!this->DepthQuad)
   {
-    error = "glReadPixels of the depth into a pixel buffer failed";
+    std::string fs = vtkOpenGLRenderUtilities::GetFullScreenQuadFragmentShaderTemplate();
+    vtkShaderProgram::Substitute(fs, "//VTK::FSQ::Decl", "uniform sampler2D octorayWindowDepth;\n");
+    vtkShaderProgram::Substitute(
+      fs, "//VTK::FSQ::Impl", "  gl_FragData[0] = vec4(texture(octorayWindowDepth, texCoord).r, 0.0, 0.0, 1.0);\n");
+    this->DepthQuad.reset(new vtkOpenGLQuadHelper(window, nullptr, fs.c_str(), nullptr));
+  }
+  else
+  {
+    window->GetShaderCache()->ReadyShaderProgram(this->DepthQuad->Program);
+  }
+  if (!this->DepthQuad->Program)
+  {
+    error = "the depth shader did not compile";
     return nullptr;
   }
-  return static_cast<const float*>(this->Interop->MapBuffer(this->DepthPixelBuffer, bytes, device, error));
-}
-
-void vtkOctreeCompositor::ReleaseDeviceDepth()
-{
-  this->Interop->UnmapBuffer();
+  this->WindowDepth->AssignToExistingTexture(this->CopyTexture, GL_TEXTURE_2D);
+  {
+    vtkOpenGLState::ScopedglViewport viewport(state);
+    vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
+    vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
+    state->PushDrawFramebufferBinding();
+    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->FloatDepthFramebuffer);
+    state->vtkglViewport(0, 0, width, height);
+    state->vtkglDisable(GL_DEPTH_TEST);
+    state->vtkglDisable(GL_BLEND);
+    this->WindowDepth->Activate();
+    this->DepthQuad->Program->SetUniformi("octorayWindowDepth", this->WindowDepth->GetTextureUnit());
+    this->DepthQuad->Render();
+    this->WindowDepth->Deactivate();
+    state->PopDrawFramebufferBinding();
+  }
+  if (glGetError() != GL_NO_ERROR)
+  {
+    error = "OpenGL could not copy the depth into a float texture";
+    return nullptr;
+  }
+  return this->Interop->CopyToDevice(this->FloatDepth->GetHandle(), width, height, device, error);
 }
 
 //------------------------------------------------------------------------------
@@ -312,7 +385,7 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
 void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
 {
   auto* glWindow = vtkOpenGLRenderWindow::SafeDownCast(window);
-  if (glWindow && (this->ColorTexture || this->ResolveFramebuffer || this->DepthPixelBuffer))
+  if (glWindow && (this->ColorTexture || this->CopyFramebuffer || this->FloatDepth))
   {
     glWindow->MakeCurrent();
   }
@@ -329,19 +402,36 @@ void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
     this->Quad->ReleaseGraphicsResources(window);
     this->Quad.reset();
   }
-  if (this->ResolveFramebuffer && glWindow)
+  if (this->DepthQuad)
   {
-    glDeleteFramebuffers(1, &this->ResolveFramebuffer);
-    glDeleteRenderbuffers(1, &this->ResolveRenderbuffer);
+    this->DepthQuad->ReleaseGraphicsResources(window);
+    this->DepthQuad.reset();
   }
-  if (this->DepthPixelBuffer && glWindow)
+  if (this->FloatDepth)
   {
-    glDeleteBuffers(1, &this->DepthPixelBuffer);
+    this->FloatDepth->ReleaseGraphicsResources(window);
+    this->WindowDepth->ReleaseGraphicsResources(window);
   }
-  this->DepthPixelBuffer = 0;
-  this->DepthPixelBufferBytes = 0;
-  this->ResolveFramebuffer = this->ResolveRenderbuffer = 0;
-  this->ResolveSize[0] = this->ResolveSize[1] = 0;
+  this->FloatDepth = nullptr;
+  this->WindowDepth = nullptr;
+  if (glWindow)
+  {
+    const unsigned int framebuffers[2] = { this->CopyFramebuffer, this->FloatDepthFramebuffer };
+    for (unsigned int f : framebuffers)
+    {
+      if (f)
+      {
+        glDeleteFramebuffers(1, &f);
+      }
+    }
+    if (this->CopyTexture)
+    {
+      glDeleteTextures(1, &this->CopyTexture);
+    }
+  }
+  this->CopyFramebuffer = this->FloatDepthFramebuffer = this->CopyTexture = 0;
+  this->CopySize[0] = this->CopySize[1] = 0;
+  this->CopyFormat = 0;
   this->PictureReady = false;
   this->Window = nullptr;
 }

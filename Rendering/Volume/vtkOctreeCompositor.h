@@ -5,7 +5,9 @@
  *
  * A private helper of vtkOctreeVolumeMapper (not wrapped, not installed).
  * ReadDepth() reads the window depth of the viewport (resolving a
- * multisampled framebuffer first), so that rays stop at opaque geometry.
+ * multisampled framebuffer first), so that rays stop at opaque geometry;
+ * ReadDepthToDevice() gives the CUDA engine the same depth without leaving
+ * the GPU.
  * The picture reaches two textures (premultiplied RGBA32F, R32F window
  * depth) either from the host (SetPictureFromHost, a texture upload) or
  * straight from CUDA device memory (SetPictureFromDevice,
@@ -19,8 +21,7 @@
 
 #include "vtkSmartPointer.h" // for the textures
 
-#include <cstddef> // for std::size_t
-#include <memory>  // for std::unique_ptr
+#include <memory> // for std::unique_ptr
 #include <string> // for std::string
 #include <vector> // for std::vector
 
@@ -51,14 +52,13 @@ public:
   bool ReadDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, std::vector<float>& depth);
 
   /**
-   * The same depth left on the GPU for the CUDA engine on `device`: read
-   * into an OpenGL pixel buffer and mapped by CUDA-OpenGL interop, so it
-   * never crosses to the host. Null, with `error`, where interop cannot
-   * serve this window. Valid until ReleaseDeviceDepth().
+   * The same depth left on the GPU for the CUDA engine on `device`, in its
+   * device memory (through CUDA-OpenGL interop), so it never crosses to the
+   * host. Null, with `error`, where interop cannot serve this window. Valid
+   * until the next call.
    */
   const float* ReadDepthToDevice(
     vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, int device, std::string& error);
-  void ReleaseDeviceDepth();
 
   /**
    * The picture, uploaded from host memory.
@@ -89,8 +89,8 @@ public:
 private:
   void UseWindow(vtkOpenGLRenderWindow* window);
   void AllocateTextures(int width, int height);
-  unsigned int ResolveDepth(vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int width, int height);
-  bool ReadDepthInto(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, void* pixels);
+  unsigned int CopyDepth(
+    vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int x0, int y0, int width, int height);
 
   vtkOpenGLRenderWindow* Window = nullptr;
   vtkSmartPointer<vtkTextureObject> ColorTexture;
@@ -98,14 +98,20 @@ private:
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
   std::unique_ptr<vtkOctreeCudaInterop> Interop;
   bool PictureReady = false;
-  // A single-sampled copy of a multisampled depth buffer, for reading.
-  unsigned int ResolveFramebuffer = 0;
-  unsigned int ResolveRenderbuffer = 0;
-  int ResolveSize[2] = { 0, 0 };
-  unsigned int ResolveFormat = 0;
-  // The window depth for CUDA: a pixel-pack buffer and its size in bytes.
-  unsigned int DepthPixelBuffer = 0;
-  std::size_t DepthPixelBufferBytes = 0;
+  // A single-sampled copy of the window's depth (a depth texture of its
+  // format, in its own framebuffer): for reading a multisampled window, and
+  // as the source of the float copy for CUDA.
+  unsigned int CopyFramebuffer = 0;
+  unsigned int CopyTexture = 0;
+  int CopySize[2] = { 0, 0 };
+  unsigned int CopyFormat = 0;
+  // The window depth as a single-channel float texture, drawn from the copy,
+  // which CUDA-OpenGL interop can read; WindowDepth wraps the copy's texture
+  // for sampling.
+  vtkSmartPointer<vtkTextureObject> FloatDepth;
+  vtkSmartPointer<vtkTextureObject> WindowDepth;
+  unsigned int FloatDepthFramebuffer = 0;
+  std::unique_ptr<vtkOpenGLQuadHelper> DepthQuad;
 };
 
 #endif

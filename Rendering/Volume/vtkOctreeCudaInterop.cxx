@@ -20,9 +20,27 @@ public:
     cudaGraphicsResource_t Resource = nullptr;
     unsigned int Name = 0; // the OpenGL texture or buffer
     int Width = 0, Height = 0, Device = -1;
-    bool Mapped = false;
   };
-  Registration Color, Depth, Buffer;
+  Registration Color, Depth, Source;
+  // The window depth in linear device memory, for the engine to read.
+  void* Linear = nullptr;
+  std::size_t LinearBytes = 0;
+  int LinearDevice = -1;
+
+  void FreeLinear()
+  {
+    if (this->Linear)
+    {
+      int previous = 0;
+      cudaGetDevice(&previous);
+      cudaSetDevice(this->LinearDevice);
+      cudaFree(this->Linear);
+      cudaSetDevice(previous);
+    }
+    this->Linear = nullptr;
+    this->LinearBytes = 0;
+    this->LinearDevice = -1;
+  }
 
   static bool Check(cudaError_t status, const char* what, std::string& error)
   {
@@ -37,10 +55,6 @@ public:
 
   static void Unregister(Registration& r)
   {
-    if (r.Mapped)
-    {
-      cudaGraphicsUnmapResources(1, &r.Resource);
-    }
     if (r.Resource)
     {
       cudaGraphicsUnregisterResource(r.Resource);
@@ -62,8 +76,10 @@ public:
     ~DeviceScope() { cudaSetDevice(this->Previous); }
   };
 
-  // Registers `texture` unless it already is, at this size on this device.
-  static bool Register(Registration& r, unsigned int texture, const octoray::DeviceImage& image, std::string& error)
+  // Registers `texture` unless it already is, at this size on this device:
+  // write-discard for the picture's textures, read-only for the depth.
+  static bool Register(Registration& r, unsigned int texture, const octoray::DeviceImage& image, std::string& error,
+    unsigned int flags = cudaGraphicsRegisterFlagsWriteDiscard)
   {
     if (r.Resource && r.Name == texture && r.Width == image.width && r.Height == image.height &&
       r.Device == image.device)
@@ -71,9 +87,8 @@ public:
       return true;
     }
     Unregister(r);
-    if (!Check(cudaGraphicsGLRegisterImage(
-                 &r.Resource, texture, GL_TEXTURE_2D, cudaGraphicsRegisterFlagsWriteDiscard),
-          "cudaGraphicsGLRegisterImage", error))
+    if (!Check(cudaGraphicsGLRegisterImage(&r.Resource, texture, GL_TEXTURE_2D, flags), "cudaGraphicsGLRegisterImage",
+          error))
     {
       r.Resource = nullptr;
       return false;
@@ -101,60 +116,47 @@ void vtkOctreeCudaInterop::Release()
 {
   vtkInternals::Unregister(this->Internals->Color);
   vtkInternals::Unregister(this->Internals->Depth);
-  vtkInternals::Unregister(this->Internals->Buffer);
+  vtkInternals::Unregister(this->Internals->Source);
+  this->Internals->FreeLinear();
 }
 
-const void* vtkOctreeCudaInterop::MapBuffer(unsigned int buffer, std::size_t bytes, int device, std::string& error)
+const float* vtkOctreeCudaInterop::CopyToDevice(
+  unsigned int texture, int width, int height, int device, std::string& error)
 {
   vtkInternals::DeviceScope scope(device, error);
-  vtkInternals::Registration& r = this->Internals->Buffer;
-  if (!scope.Ok)
+  vtkInternals& in = *this->Internals;
+  octoray::DeviceImage size; // the registration's key: name, size and device
+  size.width = width;
+  size.height = height;
+  size.device = device;
+  if (!scope.Ok || !vtkInternals::Register(in.Source, texture, size, error, cudaGraphicsRegisterFlagsReadOnly))
   {
     return nullptr;
   }
-  if (!(r.Resource && r.Name == buffer && r.Width == static_cast<int>(bytes) && r.Device == device))
+  const std::size_t bytes = sizeof(float) * static_cast<std::size_t>(width) * height;
+  if (in.LinearBytes != bytes || in.LinearDevice != device)
   {
-    vtkInternals::Unregister(r);
-    if (!vtkInternals::Check(cudaGraphicsGLRegisterBuffer(&r.Resource, buffer, cudaGraphicsRegisterFlagsReadOnly),
-          "cudaGraphicsGLRegisterBuffer", error))
+    in.FreeLinear();
+    if (!vtkInternals::Check(cudaMalloc(&in.Linear, bytes), "cudaMalloc (window depth)", error))
     {
-      r = vtkInternals::Registration{};
+      in.Linear = nullptr;
       return nullptr;
     }
-    r.Name = buffer;
-    r.Width = static_cast<int>(bytes); // a buffer's size: its bytes, one row
-    r.Device = device;
+    in.LinearBytes = bytes;
+    in.LinearDevice = device;
   }
-  void* address = nullptr;
-  std::size_t size = 0;
-  if (!vtkInternals::Check(cudaGraphicsMapResources(1, &r.Resource), "cudaGraphicsMapResources", error))
+  cudaArray_t array = nullptr;
+  const std::size_t row = sizeof(float) * width;
+  bool ok = vtkInternals::Check(cudaGraphicsMapResources(1, &in.Source.Resource), "cudaGraphicsMapResources", error);
+  if (ok)
   {
-    return nullptr;
+    ok = vtkInternals::Check(cudaGraphicsSubResourceGetMappedArray(&array, in.Source.Resource, 0, 0),
+           "cudaGraphicsSubResourceGetMappedArray", error) &&
+      vtkInternals::Check(cudaMemcpy2DFromArray(in.Linear, row, array, 0, 0, row, height, cudaMemcpyDeviceToDevice),
+        "cudaMemcpy2DFromArray", error);
+    ok = vtkInternals::Check(cudaGraphicsUnmapResources(1, &in.Source.Resource), "cudaGraphicsUnmapResources", error) && ok;
   }
-  r.Mapped = true;
-  if (!vtkInternals::Check(cudaGraphicsResourceGetMappedPointer(&address, &size, r.Resource),
-        "cudaGraphicsResourceGetMappedPointer", error) ||
-    size < bytes)
-  {
-    this->UnmapBuffer();
-    return nullptr;
-  }
-  return address;
-}
-
-void vtkOctreeCudaInterop::UnmapBuffer()
-{
-  vtkInternals::Registration& r = this->Internals->Buffer;
-  if (r.Mapped)
-  {
-    int previous = 0;
-    cudaGetDevice(&previous);
-    cudaSetDevice(r.Device);
-    cudaGraphicsUnmapResources(1, &r.Resource);
-    cudaGetLastError();
-    cudaSetDevice(previous);
-    r.Mapped = false;
-  }
+  return ok ? static_cast<const float*>(in.Linear) : nullptr;
 }
 
 bool vtkOctreeCudaInterop::Copy(unsigned int colorTexture, unsigned int depthTexture,
@@ -222,13 +224,11 @@ vtkOctreeCudaInterop::~vtkOctreeCudaInterop()
 
 void vtkOctreeCudaInterop::Release() {}
 
-const void* vtkOctreeCudaInterop::MapBuffer(unsigned int, std::size_t, int, std::string& error)
+const float* vtkOctreeCudaInterop::CopyToDevice(unsigned int, int, int, int, std::string& error)
 {
   error = "octoray was built without CUDA";
   return nullptr;
 }
-
-void vtkOctreeCudaInterop::UnmapBuffer() {}
 
 bool vtkOctreeCudaInterop::Copy(unsigned int, unsigned int, const octoray::DeviceImage&, std::string& error)
 {

@@ -15,8 +15,7 @@
 #ifndef vtkOctreeCudaInterop_h
 #define vtkOctreeCudaInterop_h
 
-#include <cstddef> // for std::size_t
-#include <string>  // for std::string
+#include <string> // for std::string
 
 namespace octoray
 {
@@ -40,17 +39,16 @@ public:
     std::string& error);
 
   /**
-   * Maps the OpenGL buffer named `buffer` (`bytes` long, its context
-   * current) for reading by CUDA on `device`: the device address of its
-   * contents, or null with `error` set. UnmapBuffer() before OpenGL uses the
-   * buffer again.
+   * Copies the single-channel float texture named `texture` (width x height,
+   * its context current) into linear device memory on `device`, which this
+   * object keeps: its address (valid until the next call or Release()), or
+   * null with `error` set.
    */
-  const void* MapBuffer(unsigned int buffer, std::size_t bytes, int device, std::string& error);
-  void UnmapBuffer();
+  const float* CopyToDevice(unsigned int texture, int width, int height, int device, std::string& error);
 
   /**
-   * Forgets the registrations (before the textures or the buffer are
-   * resized or deleted; their context current).
+   * Forgets the registrations and frees the device memory (before the
+   * textures are resized or deleted; their context current).
    */
   void Release();
 

@@ -312,12 +312,6 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
     return Step::Stop;
   }
   octoray::RenderSettings s = this->FrameSettings(ren, vol, width, height);
-  // The depth mapped for CUDA goes back to OpenGL when the trace is done.
-  struct UnmapDepth
-  {
-    vtkOctreeCompositor& Compositor;
-    ~UnmapDepth() { this->Compositor.ReleaseDeviceDepth(); }
-  } unmapDepth{ this->Compositor };
   std::uint64_t depthSignature = 0;
   self->LastDepthReadSeconds = 0.0;
   if (MayHaveOpaqueDepth(ren, vol))
@@ -346,9 +340,9 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
 //------------------------------------------------------------------------------
 // The depth of what VTK drew in the viewport, where rays must stop, and its
 // signature (what the last trace is compared by). On CUDA with interop it
-// stays on the GPU: read into an OpenGL buffer that CUDA maps, which the
-// trace then reads in place; otherwise it is read back to the host (and
-// sampled at the traced pixels when one ray serves several).
+// stays on the GPU (vtkOctreeCompositor::ReadDepthToDevice), where the trace
+// reads it; otherwise it is read back to the host (and sampled at the traced
+// pixels when one ray serves several).
 vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::OpaqueDepth(
   vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, octoray::RenderSettings& s,
   std::uint64_t& signature)
