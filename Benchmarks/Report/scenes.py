@@ -3,7 +3,7 @@
 the project's own VTK readers and writers (so the engine-only benchmarks,
 which cannot link VTK, read them as particle files).
 
-    Testing/Report/scenes.py ct5n OUT.particles   # needs the build's octoray package on PYTHONPATH
+    Benchmarks/Report/scenes.py ct5n OUT.particles   # needs the build's octoray package on PYTHONPATH
 
 From a section: `ct_particles(ctx)` writes build/report/scenes/ct5n.particles
 once per report run and returns its path.

@@ -1,7 +1,7 @@
 """The GPU run's checks: engine tests on both backends and compute-sanitizer.
 
-Nothing is measured here: the files come from Testing/Bench/gpu-check.sh on a
-GPU machine (copied into Testing/Bench/gpu/ with COMMAND.md)."""
+Nothing is measured here: the files come from scripts/gpu/gpu-check.sh on a
+GPU machine (copied into Benchmarks/gpu/ with COMMAND.md)."""
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -44,7 +44,7 @@ def test_counts(xml_path):
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
     if not summary_path:
-        return Section("Not run on a GPU yet: `Testing/Bench/gpu-check.sh OUTDIR` on a GPU machine writes the "
+        return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
     with open(summary_path) as f:
         summary = f.read()
@@ -71,7 +71,7 @@ def render(ctx):
 
     text = [
         f"Device: {device or 'see gpu/gpu.txt'}; run of {date.group(1) if date else 'unknown date'}. Command: "
-        f"`{ctx.gpu_command() or 'Testing/Bench/gpu-check.sh OUTDIR'}`.",
+        f"`{ctx.gpu_command() or 'scripts/gpu/gpu-check.sh OUTDIR'}`.",
         "",
         "gpu-check.sh configures `Rendering/Engine` on its own (the GPU machine has only CUDA, CMake and a",
         "compiler), builds for sm_90, runs every engine test on both backends (the CPU backend is the",
