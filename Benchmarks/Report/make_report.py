@@ -50,6 +50,8 @@ SECTIONS = [
     "readers",      # readers vs VTK's own and pandas
     "thesis",       # the thesis's table 2 and two-sphere timings, ours beside them
     "gpu",          # the GPU run's checks: tests and compute-sanitizer
+    "mapper",       # the CUDA mapper in VTK windows on the GPU: its tests, memcheck, the orbit
+                    # against VTK's GPU mappers
 ]
 
 README_BEGIN = "<!-- report:summary begin (written by make report) -->"

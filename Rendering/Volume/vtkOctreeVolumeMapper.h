@@ -173,7 +173,11 @@ public:
   ///@{
   /**
    * Level of detail: rays stop descending at voxels smaller than this many
-   * pixels. 0 (the default) always descends to the leaves.
+   * pixels and draw the node there (its averaged attributes). 1 (the
+   * default): leaves smaller than a pixel, which a ray would mostly miss
+   * (a see-through, speckled picture of a dense cloud), are drawn by their
+   * ancestor of about a pixel, and the trace does not pay for descending
+   * below what the screen shows. 0 always descends to the leaves.
    */
   vtkSetClampMacro(LODPixelThreshold, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(LODPixelThreshold, double);
@@ -313,7 +317,7 @@ protected:
   int CudaDevice = -1;
   bool UseCudaGLInterop = true;
   int LeafDepth = 0;
-  double LODPixelThreshold = 0.0;
+  double LODPixelThreshold = 1.0;
   double RootBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   bool Shadows = false;
   int MaximumBounces = 2;
