@@ -84,6 +84,7 @@ def ct_points(threshold):
     r = octoray.vtkSliceStackReader()
     r.SetDirectoryName(os.path.join(DATA, "DICOM", "CT5N"))
     r.SetBackgroundRange(-1e30, threshold)  # air and below: background
+    r.SetFillBetweenSlices(False)  # the scene is the voxels as points, as RESULTS.md has it
     r.Update()
     return r.GetOutput(), r.GetOutputDataObject(1)
 

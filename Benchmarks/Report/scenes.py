@@ -54,6 +54,10 @@ def write_ct5n(out):
     reader = octoray.vtkSliceStackReader()
     reader.SetDirectoryName(CT5N)
     reader.SetBackgroundRange(-1e9, CT_AIR_BELOW_HU)  # intensity in this range: no particle
+    # The scene is the voxels themselves (as RESULTS.md and the GPU run's
+    # copy of this file have it), not the planes the reader fills between
+    # slices by default.
+    reader.SetFillBetweenSlices(False)
     reader.Update()
     if reader.GetErrorCode() or reader.GetOutput().GetNumberOfPoints() == 0:
         raise RuntimeError(f"{CT5N}: {reader.GetErrorMessage() or 'no points'}")

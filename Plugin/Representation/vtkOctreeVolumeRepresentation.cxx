@@ -335,6 +335,10 @@ void vtkOctreeVolumeRepresentation::SetImageBackground(double val)
 {
   this->Mapper->SetImageBackground(val);
 }
+void vtkOctreeVolumeRepresentation::SetFillBetweenSlices(bool val)
+{
+  this->Mapper->SetFillBetweenSlices(val);
+}
 
 //----------------------------------------------------------------------------
 void vtkOctreeVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)

@@ -81,6 +81,7 @@ public:
   void SetDepthCue(double);
   void SetImageSampleDistance(double);
   void SetImageBackground(double);
+  void SetFillBetweenSlices(bool);
   ///@}
 
   /**

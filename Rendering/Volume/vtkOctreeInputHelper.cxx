@@ -3,16 +3,21 @@
 #include "vtkAbstractMapper.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkSMPTools.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 
 namespace
 {
@@ -71,6 +76,101 @@ void PositionArrays(vtkDataArray* xyz, const float*& f, const double*& d, std::v
   }
   d = storage.data();
 }
+
+// The points of an image: every sample of `axes` (the voxels and, with
+// filling, the planes between slices; octorayLattice.h) whose value (the
+// largest component) is above the background, with its component 0 as
+// scalar or its components as RGBA colour. Two passes over the planes
+// (count, then fill at each plane's offset), each in parallel.
+struct ImageOutput
+{
+  std::vector<double>& Xyz;
+  std::vector<float>& Scalar;
+  std::vector<std::uint8_t>& Color8;
+  std::vector<float>& ColorFloat;
+};
+
+template <typename T>
+void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
+  const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, bool scalar,
+  ImageOutput out, const std::function<void(double)>& progress)
+{
+  const vtkIdType planes = static_cast<vtkIdType>(axes[2].Samples());
+  auto above = [&](const double* v) {
+    double value = comps > 0 ? v[0] : 1.0; // no scalars: the whole grid
+    for (int c = 1; c < comps; ++c)
+    {
+      value = std::max(value, v[c]);
+    }
+    return value > background;
+  };
+  // Planes in blocks, so that progress is reported from this thread.
+  const vtkIdType block = std::max<vtkIdType>(1, planes / 20);
+  auto blocks = [&](double from, double to, const std::function<void(vtkIdType, vtkIdType)>& work) {
+    for (vtkIdType b = 0; b < planes; b += block)
+    {
+      vtkSMPTools::For(b, std::min(planes, b + block), work);
+      progress(from + (to - from) * static_cast<double>(std::min(planes, b + block)) / planes);
+    }
+  };
+  std::vector<vtkIdType> counts(planes + 1, 0);
+  blocks(0.0, 0.2, [&](vtkIdType b, vtkIdType e) {
+    std::vector<double> values(std::max(comps, 1));
+    for (vtkIdType k = b; k < e; ++k)
+    {
+      vtkIdType n = 0;
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, k, values.data(),
+        [&](long long, long long, const double* v) { n += above(v); });
+      counts[k + 1] = n;
+    }
+  });
+  std::partial_sum(counts.begin(), counts.end(), counts.begin());
+  const std::size_t total = static_cast<std::size_t>(counts[planes]);
+  out.Xyz.resize(3 * total);
+  if (colours)
+  {
+    (bytes ? out.Color8.resize(4 * total) : out.ColorFloat.resize(4 * total));
+  }
+  else if (scalar)
+  {
+    out.Scalar.resize(total);
+  }
+  blocks(0.2, 0.5, [&](vtkIdType b, vtkIdType e) {
+    std::vector<double> values(std::max(comps, 1));
+    for (vtkIdType k = b; k < e; ++k)
+    {
+      std::size_t n = static_cast<std::size_t>(counts[k]);
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, k, values.data(),
+        [&](long long r0, long long r1, const double* v) {
+          if (!above(v))
+          {
+            return;
+          }
+          lattice.Position(r0, r1, k, &out.Xyz[3 * n]);
+          if (colours)
+          {
+            for (int c = 0; c < 4; ++c)
+            {
+              const double x = c < comps ? v[c] : (bytes ? 255.0 : 1.0);
+              if (bytes)
+              {
+                out.Color8[4 * n + c] = static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0, 255.0)));
+              }
+              else
+              {
+                out.ColorFloat[4 * n + c] = static_cast<float>(x);
+              }
+            }
+          }
+          else if (scalar)
+          {
+            out.Scalar[n] = static_cast<float>(v[0]);
+          }
+          ++n;
+        });
+    }
+  });
+}
 }
 
 //------------------------------------------------------------------------------
@@ -106,6 +206,16 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
     }
   }
   r.ImageBackground = mapper->GetImageBackground();
+  r.FillBetweenSlices = mapper->GetFillBetweenSlices();
+  if (vtkPointSet::SafeDownCast(input))
+  {
+    vtkDataArray* lattice = input->GetFieldData()->GetArray(octoray::lattice::kFieldArrayName);
+    if (lattice && lattice->GetNumberOfComponents() == octoray::lattice::kFieldArrayComponents &&
+      lattice->GetNumberOfTuples() >= 1)
+    {
+      r.Lattice = lattice;
+    }
+  }
   r.LeafDepth = mapper->GetLeafDepth();
   std::copy(mapper->GetRootBounds(), mapper->GetRootBounds() + 6, r.RootBounds.begin());
   r.EngineGeneration = engineGeneration;
@@ -123,9 +233,9 @@ vtkOctreeInputHelper::Signature vtkOctreeInputHelper::Sign(const Request& r)
   auto* pointSet = vtkPointSet::SafeDownCast(r.Input);
   if (!pointSet)
   {
-    s.Layout += "+image:" + std::to_string(r.ImageBackground);
+    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.FillBetweenSlices ? "+fill" : "");
   }
-  s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals) };
+  s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals), Stamp(r.Lattice) };
   // An image's points are its grid: any change of the image is a rebuild.
   s.Points = pointSet ? Stamp(pointSet->GetPoints() ? pointSet->GetPoints()->GetData() : nullptr)
                       : ArrayStamp{ r.Input, r.Input->GetMTime() };
@@ -181,6 +291,7 @@ octoray::PointCloudView vtkOctreeInputHelper::PointCloud(
   const Request& request, const std::function<void(double)>& progress)
 {
   octoray::PointCloudView view;
+  this->HasLattice = false;
   this->Xyz.clear();
   this->Scalar.clear();
   this->Color8.clear();
@@ -228,50 +339,100 @@ void vtkOctreeInputHelper::PointSetView(const Request& r, octoray::PointCloudVie
   view.reflectivity = r.Reflectivity ? FloatComponents(r.Reflectivity, 1, this->Reflectivity) : nullptr;
   view.refraction = r.Refraction ? FloatComponents(r.Refraction, 1, this->Refraction) : nullptr;
   view.normal = r.Normals ? FloatComponents(r.Normals, 3, this->Normal) : nullptr;
+
+  // The lattice the field data names (the slice-stack reader's particles),
+  // as long as the points still lie on it: a filter that moved them (a
+  // transform) passes the array on unchanged. Up to 1000 points checked.
+  if (r.Lattice && view.count > 0)
+  {
+    double tuple[octoray::lattice::kFieldArrayComponents];
+    r.Lattice->GetTuple(0, tuple);
+    const octoray::lattice::Lattice lattice = octoray::lattice::FromTuple(tuple);
+    const vtkIdType n = pointSet->GetNumberOfPoints();
+    const vtkIdType step = std::max<vtkIdType>(1, n / 1000);
+    bool on = true;
+    for (vtkIdType i = 0; on && i < n; i += step)
+    {
+      double p[3];
+      pointSet->GetPoint(i, p);
+      on = octoray::lattice::OnLattice(lattice, p);
+    }
+    if (on)
+    {
+      this->HasLattice = true;
+      this->Lattice = lattice;
+      pointSet->GetBounds(this->LatticeBounds);
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkOctreeInputHelper::PointLattice(octoray::lattice::Lattice& lattice, double bounds[6]) const
+{
+  if (!this->HasLattice)
+  {
+    return false;
+  }
+  lattice = this->Lattice;
+  std::copy(this->LatticeBounds, this->LatticeBounds + 6, bounds);
+  return true;
 }
 
 //------------------------------------------------------------------------------
 // Every voxel above the background is a point at the voxel's position, with
-// its value as scalar (or its components as colour).
+// its value as scalar (or its components as colour); with FillBetweenSlices,
+// so are the samples interpolated between slices (octorayLattice.h: along
+// the coarsest axis, down to the second-coarsest spacing).
 void vtkOctreeInputHelper::ImageView(
   const Request& r, octoray::PointCloudView& view, const std::function<void(double)>& progress)
 {
   auto* image = vtkImageData::SafeDownCast(r.Input);
   vtkDataArray* scalars = r.Scalars;
+  int dims[3];
+  image->GetDimensions(dims);
+  const long long size[3] = { dims[0], dims[1], dims[2] };
+  octoray::lattice::Axis axes[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    axes[a].Count = size[a];
+  }
+  const double* spacing = image->GetSpacing();
+  if (r.FillBetweenSlices)
+  {
+    int fill[3];
+    octoray::lattice::FillFactors(spacing, size, fill);
+    for (int a = 0; a < 3; ++a)
+    {
+      axes[a].Fill = fill[a];
+    }
+  }
+  const octoray::lattice::Lattice lattice =
+    octoray::lattice::LatticeOf(axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
   const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
   const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
-  const vtkIdType n = image->GetNumberOfPoints();
-  for (vtkIdType i = 0; i < n; ++i)
+  const ImageOutput out{ this->Xyz, this->Scalar, this->Color8, this->ColorFloat };
+  if (!scalars)
   {
-    double value = scalars ? scalars->GetComponent(i, 0) : 1.0; // no scalars: the whole grid
-    for (int c = 1; c < comps; ++c)
+    const double* none = nullptr;
+    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, false, out, progress);
+  }
+  else if (scalars->HasStandardMemoryLayout())
+  {
+    switch (scalars->GetDataType())
     {
-      value = std::max(value, scalars->GetComponent(i, c));
+      vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
+        lattice, r.ImageBackground, r.Colours, bytes, true, out, progress));
     }
-    if (!(value > r.ImageBackground))
+  }
+  else
+  {
+    // Another memory layout (e.g. struct of arrays): the values as doubles.
+    std::vector<double> values(static_cast<std::size_t>(scalars->GetNumberOfTuples()) * comps);
+    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
     {
-      continue;
+      scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
     }
-    double p[3];
-    image->GetPoint(i, p);
-    this->Xyz.insert(this->Xyz.end(), p, p + 3);
-    if (r.Colours)
-    {
-      for (int c = 0; c < 4; ++c)
-      {
-        const double v = c < comps ? scalars->GetComponent(i, c) : (bytes ? 255.0 : 1.0);
-        bytes ? this->Color8.push_back(static_cast<std::uint8_t>(v))
-              : this->ColorFloat.push_back(static_cast<float>(v));
-      }
-    }
-    else if (scalars)
-    {
-      this->Scalar.push_back(static_cast<float>(scalars->GetComponent(i, 0)));
-    }
-    if (i % 65536 == 0)
-    {
-      progress(0.5 * static_cast<double>(i) / n);
-    }
+    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, true, out, progress);
   }
   view.count = this->Xyz.size() / 3;
   view.xyzDouble = this->Xyz.data();
@@ -279,6 +440,26 @@ void vtkOctreeInputHelper::ImageView(
   view.colorFloat = this->ColorFloat.empty() ? nullptr : this->ColorFloat.data();
   view.colorComponents = r.Colours ? 4 : 0;
   view.scalar = this->Scalar.empty() ? nullptr : this->Scalar.data();
+
+  // The points' lattice and bounds, for the leaf grid.
+  if (view.count > 0)
+  {
+    double* b = this->LatticeBounds;
+    for (int a = 0; a < 3; ++a)
+    {
+      b[2 * a] = b[2 * a + 1] = this->Xyz[a];
+    }
+    for (std::size_t i = 0; i < view.count; ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        b[2 * a] = std::min(b[2 * a], this->Xyz[3 * i + a]);
+        b[2 * a + 1] = std::max(b[2 * a + 1], this->Xyz[3 * i + a]);
+      }
+    }
+    this->Lattice = lattice;
+    this->HasLattice = true;
+  }
 }
 
 //------------------------------------------------------------------------------

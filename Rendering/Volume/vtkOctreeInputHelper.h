@@ -8,10 +8,12 @@
  * which arrays play which part (colours or scalars, reflectivity,
  * refraction, normals), turns them into an octoray::PointCloudView (the
  * caller's arrays where their layout allows, converted host copies
- * otherwise; image voxels above the background become points), and
- * compares the input with what the current octree was built from: nothing
- * changed, only the point positions moved (an in-place update), or
- * anything else (a build).
+ * otherwise; image voxels above the background become points, with the
+ * planes between slices filled as octorayLattice.h says), knows the lattice
+ * the points lie on where there is one (an image; a point set whose field
+ * data names it and whose points lie on it), and compares the input with
+ * what the current octree was built from: nothing changed, only the point
+ * positions moved (an in-place update), or anything else (a build).
  */
 #ifndef vtkOctreeInputHelper_h
 #define vtkOctreeInputHelper_h
@@ -19,6 +21,7 @@
 #include "vtkType.h" // for vtkIdType, vtkMTimeType
 
 #include <octoray/PointCloud.h> // for the views
+#include <octorayLattice.h>      // for octoray::lattice::Lattice
 
 #include <array>      // for std::array
 #include <cstdint>    // for std::uint8_t
@@ -55,6 +58,8 @@ public:
     vtkDataArray* Normals = nullptr;
     bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
     double ImageBackground = 0.0;
+    bool FillBetweenSlices = true; // image input: fill between slices (octorayLattice.h)
+    vtkDataArray* Lattice = nullptr; // point set input: the field-data array naming its lattice
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
     unsigned long EngineGeneration = 0; // a new engine holds no octree
@@ -92,6 +97,13 @@ public:
    */
   void Forget() { this->Built = false; }
 
+  /**
+   * The lattice the points of the last PointCloud() lie on, and their
+   * bounds: false when they lie on none (scattered points, a point set
+   * without the field-data array, or one whose points left the lattice).
+   */
+  bool PointLattice(octoray::lattice::Lattice& lattice, double bounds[6]) const;
+
   bool HasOctree() const { return this->Built; }
   bool HasScalar() const { return this->ScalarPresent; }
   const double* ScalarRange() const { return this->Range; }
@@ -113,7 +125,7 @@ private:
     const void* Input = nullptr;
     vtkIdType Count = 0;
     std::string Layout; // which arrays play which role
-    std::array<ArrayStamp, 4> Arrays{};
+    std::array<ArrayStamp, 5> Arrays{}; // scalars, reflectivity, refraction, normals, lattice
     ArrayStamp Points;
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
@@ -128,6 +140,9 @@ private:
 
   bool Built = false;
   Signature Current;
+  bool HasLattice = false;
+  octoray::lattice::Lattice Lattice;
+  double LatticeBounds[6] = { 0, 0, 0, 0, 0, 0 };
   bool ScalarPresent = false;
   double Range[2] = { 0.0, 1.0 };
 

@@ -223,7 +223,8 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
   self->UpdateProgress(0.5);
   octoray::BuildOptions options;
   options.depth = request.LeafDepth;
-  if (vtkMath::AreBoundsInitialized(request.RootBounds.data()))
+  const bool rootBounds = vtkMath::AreBoundsInitialized(request.RootBounds.data());
+  if (rootBounds)
   {
     // The caller's cube (e.g. global bounds over parallel ranks): the same
     // voxel grid on every rank.
@@ -231,6 +232,28 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     const double lo[3] = { b[0], b[2], b[4] }, hi[3] = { b[1], b[3], b[5] };
     options.fixedCube = true;
     options.cube = octoray::RootCube::FromBounds(lo, hi);
+  }
+  // Points on a lattice (an image, the slice-stack reader's particles) with
+  // the depth left automatic: leaves as large as the lattice's largest step
+  // and aligned with it, so that the volume has no gap (octorayLattice.h),
+  // in a cube around the caller's bounds where there are some (then the
+  // same on every rank).
+  octoray::lattice::Lattice lattice;
+  double bounds[6];
+  if (request.LeafDepth == 0 && this->Input.PointLattice(lattice, bounds))
+  {
+    if (rootBounds)
+    {
+      std::copy(request.RootBounds.begin(), request.RootBounds.end(), bounds);
+    }
+    const octoray::lattice::LeafGrid grid = octoray::lattice::ChooseLeafGrid(lattice, bounds, octoray::kMaxLevel);
+    if (grid.Valid)
+    {
+      options.depth = grid.Depth;
+      options.fixedCube = true;
+      std::copy(grid.Origin, grid.Origin + 3, options.cube.origin);
+      options.cube.size = grid.Size;
+    }
   }
   const Step step = this->Run("build", [&] { this->Backend.Engine()->Build(view, options); });
   if (step == Step::Done)
@@ -674,6 +697,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DepthCue: " << this->DepthCue << "\n";
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "ImageBackground: " << this->ImageBackground << "\n";
+  os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
   os << indent << "ReflectivityArrayName: "
      << (this->ReflectivityArrayName ? this->ReflectivityArrayName : "(none)") << "\n";
   os << indent << "RefractionArrayName: "

@@ -4,7 +4,9 @@
  *
  * vtkOctreeVolumeMapper renders point data (a vtkPointSet: points with
  * optional colours, scalars, reflectivity, refraction and normals) or a
- * vtkImageData (every voxel above ImageBackground becomes a point) by
+ * vtkImageData (every voxel above ImageBackground becomes a point, and
+ * between slices farther apart than the pixels, interpolated points fill
+ * the gaps: FillBetweenSlices) by
  * building the octree engine's sparse voxel octree of the points and
  * ray-tracing it. It holds the VTK plumbing shared by both backends:
  *
@@ -151,7 +153,12 @@ public:
 
   ///@{
   /**
-   * Octree leaf level, 1..21, or 0 (the default) to choose it from the data.
+   * Octree leaf level, 1..21, or 0 (the default) to choose it from the data:
+   * for points on a lattice (a vtkImageData; a point set whose field data
+   * names its lattice, as vtkSliceStackReader's particles do) the leaves are
+   * as large as the lattice's largest step and aligned with it, so the
+   * volume has no gap (octorayLattice.h); for other points, the engine's
+   * choice (the median leaf holds one point).
    */
   vtkSetClampMacro(LeafDepth, int, 0, 21);
   vtkGetMacro(LeafDepth, int);
@@ -226,6 +233,24 @@ public:
    */
   vtkSetMacro(ImageBackground, double);
   vtkGetMacro(ImageBackground, double);
+  ///@}
+
+  ///@{
+  /**
+   * vtkImageData input whose spacing differs between axes (a slice stack:
+   * slices farther apart than pixels): fill the space between slices with
+   * points interpolated linearly from the two neighbouring slices, so that
+   * the points are no farther apart along the coarsest axis than along the
+   * next (for a stack, the pixel spacing); ImageBackground applies to
+   * the interpolated values. With LeafDepth 0 the leaves are then the pixel
+   * size and the volume is closed. Off, the voxels alone become points and
+   * the leaves are as large as the slice spacing (closed too, coarser).
+   * The same rule as vtkSliceStackReader's FillBetweenSlices
+   * (octorayLattice.h). Default on.
+   */
+  vtkSetMacro(FillBetweenSlices, bool);
+  vtkGetMacro(FillBetweenSlices, bool);
+  vtkBooleanMacro(FillBetweenSlices, bool);
   ///@}
 
   ///@{
@@ -324,6 +349,7 @@ protected:
   double DepthCue = 0.0;
   double ImageSampleDistance = 1.0;
   double ImageBackground = 0.0;
+  bool FillBetweenSlices = true;
   char* ReflectivityArrayName = nullptr;
   char* RefractionArrayName = nullptr;
   vtkIdType CudaMemoryBudget = 0;

@@ -2,14 +2,19 @@
 
     python3 -m octoray.render INPUT -o out.png [--backend auto|cuda|cpu]
         [--size 1920x1080] [--mode surface|phong|depthcue|composite|mip|minip|average|additive]
-        [--azimuth DEG] [--elevation DEG] [--zoom F] [--depth N] [--background LO HI]
+        [--azimuth DEG] [--elevation DEG] [--zoom F] [--parallel] [--depth N]
+        [--background LO HI] [--image] [--no-fill]
 
 INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
 cloud (.pcd: ascii, binary or binary_compressed), a folder of
 image slices or DICOM files, or a printf pattern of slice names
-("ct_%03d.png", with --range FIRST LAST). Reading and building show a
-progress bar on stderr; the backend and the load, build and render times are
-printed on stdout.
+("ct_%03d.png", with --range FIRST LAST). A slice stack is drawn as the
+reader's particles, or with --image as the stack's volume (the reader's
+output 1, a vtkImageData; voxels above --background's HI are points); either
+way the space between slices is filled with interpolated points (--no-fill:
+not), so the stack draws as a closed volume. Reading and building show a
+progress bar on stderr; the backend, the number of points, the leaf size and
+the load, build and render times are printed on stdout.
 """
 import argparse
 import os
@@ -63,6 +68,7 @@ def make_reader(path, args):
             reader.SetFileNameRange(*args.range)
         if args.background is not None:
             reader.SetBackgroundRange(*args.background)
+        reader.SetFillBetweenSlices(not args.no_fill)
         return reader
     if path.lower().endswith((".pcd", ".pcd.gz")):
         reader = octoray.vtkPCDReader()  # PCL's point cloud files
@@ -97,6 +103,11 @@ def main(argv=None):
     p.add_argument("--range", type=int, nargs=2, default=(0, 0), metavar=("FIRST", "LAST"))
     p.add_argument("--background", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                    help="slice intensities that are background")
+    p.add_argument("--parallel", action="store_true", help="parallel projection")
+    p.add_argument("--image", action="store_true",
+                   help="slice stacks: draw the stack's volume (a vtkImageData) instead of its particles")
+    p.add_argument("--no-fill", action="store_true",
+                   help="slice stacks: no points between slices (leaves as large as the slice spacing)")
     args = p.parse_args(argv)
 
     if not (os.path.exists(args.input) or "%" in args.input):
@@ -112,13 +123,19 @@ def main(argv=None):
     if cloud is None or cloud.GetNumberOfPoints() == 0:
         print("error: no points read from %s" % args.input, file=sys.stderr)
         return 1
+    if args.image and not isinstance(reader, octoray.vtkSliceStackReader):
+        p.error("--image needs a slice stack (a folder or a pattern of slices)")
+    data = reader.GetImageOutput() if args.image else cloud
 
     # ---- Mapper and scene.
     mapper = {"auto": octoray.vtkOctreeVolumeMapper,
               "cuda": octoray.vtkCudaOctreeVolumeMapper,
               "cpu": octoray.vtkCPUOctreeVolumeMapper}[args.backend]()
-    mapper.SetInputData(cloud)
+    mapper.SetInputData(data)
     mapper.SetLeafDepth(args.depth)
+    mapper.SetFillBetweenSlices(not args.no_fill)
+    if args.image and args.background is not None:
+        mapper.SetImageBackground(args.background[1])
     mapper.AddObserver("ProgressEvent", ProgressBar("building"))
     blend, shade = MODES[args.mode]
     {"surface": mapper.SetBlendModeToSurface,
@@ -131,11 +148,13 @@ def main(argv=None):
         mapper.SetDepthCue(0.7)
     prop = vtk.vtkVolumeProperty()
     prop.SetShade(shade)
-    scalars = cloud.GetPointData().GetScalars()
+    scalars = data.GetPointData().GetScalars()
     if scalars is not None and scalars.GetNumberOfComponents() in (3, 4):
         prop.IndependentComponentsOff()  # RGB(A) point colours
     elif scalars is not None:
         lo, hi = scalars.GetRange()
+        if args.image and args.background is not None:
+            lo = max(lo, args.background[1])  # the transfer function over the points' values
         ctf = vtk.vtkColorTransferFunction()
         ctf.AddRGBPoint(lo, 0.2, 0.2, 0.9)
         ctf.AddRGBPoint(0.5 * (lo + hi), 0.9, 0.8, 0.3)
@@ -159,6 +178,7 @@ def main(argv=None):
     cam.Azimuth(args.azimuth)
     cam.Elevation(args.elevation)
     cam.OrthogonalizeViewUp()
+    cam.SetParallelProjection(args.parallel)
     cam.Zoom(args.zoom)
     ren.ResetCameraClippingRange()
 
@@ -179,7 +199,8 @@ def main(argv=None):
     writer.Write()
 
     print("backend: %s (%s)" % (mapper.GetLastUsedBackendName(), mapper.GetBackendDescription()))
-    print("points: %d" % cloud.GetNumberOfPoints())
+    print("points: %d%s" % (mapper.GetNumberOfOctreePoints(), " (of the image)" if args.image else ""))
+    print("leaf: %.6g" % mapper.GetLeafSize())
     print("load: %.3f s" % load)
     print("build: %.3f s" % build)
     print("render: %.3f s (trace %.3f s, first frame with build %.3f s) at %dx%d"
