@@ -60,7 +60,7 @@ args = parser.parse_args()
 
 if not os.path.isfile(args.data):
     print(f"FAILED: the test data {args.data} is missing; `make data` fetches it "
-          "(Data/README.md says where it comes from)")
+          "(Data/External: from Debian packages, not committed)")
     sys.exit(1)
 ranks = servermanager.ActiveConnection.GetNumberOfDataPartitions()
 print(f"ranks: {ranks} (expected {args.ranks})")
