@@ -25,6 +25,7 @@
 
 #include <octoray/DepthSignature.h>
 #include <octoray/Engine.h>
+#include <octoray/RootCube.h>
 
 #include <algorithm>
 #include <chrono>
@@ -79,6 +80,12 @@ public:
   vtkOctreeInputHelper Input;
   vtkOctreeCompositor Compositor;
   unsigned long OctreeVersion = 0; // bumped by every build and update
+  // The leaf size of the last build and the input it was built for
+  // (GetVoxelBounds).
+  octoray::RootCube BuiltCube;
+  int BuiltDepth = 0;
+  vtkDataSet* BuiltFor = nullptr;
+  vtkMTimeType BuiltMTime = 0;
   bool CellScalarsWarned = false;
   bool InteropUnusable = false; // said once; the host path from then on
 
@@ -255,9 +262,15 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
       options.cube.size = grid.Size;
     }
   }
-  const Step step = this->Run("build", [&] { this->Backend.Engine()->Build(view, options); });
+  octoray::BuildStats stats;
+  const Step step = this->Run("build", [&] { stats = this->Backend.Engine()->Build(view, options); });
   if (step == Step::Done)
   {
+    // The leaf grid, for GetVoxelBounds.
+    this->BuiltCube = stats.cube;
+    this->BuiltDepth = stats.depth;
+    this->BuiltFor = request.Input;
+    this->BuiltMTime = request.Input->GetMTime();
     this->Input.Remember(request);
     ++this->OctreeVersion;
     ++self->NumberOfBuilds;
@@ -667,6 +680,67 @@ double vtkOctreeVolumeMapper::GetLeafSize()
   octoray::HostOctree tree;
   engine->CopyToHost(tree);
   return tree.cube.size / static_cast<double>(1u << tree.depth);
+}
+
+//------------------------------------------------------------------------------
+void vtkOctreeVolumeMapper::GetVoxelBounds(double bounds[6])
+{
+  vtkMath::UninitializeBounds(bounds);
+  vtkDataSet* input = this->GetInput();
+  const vtkIdType n = input ? input->GetNumberOfPoints() : 0;
+  if (n == 0)
+  {
+    return;
+  }
+  double box[6];
+  input->GetBounds(box);
+  const bool image = vtkImageData::SafeDownCast(input) != nullptr;
+  const vtkInternals& in = *this->Internals;
+  octoray::RootCube cube;
+  int depth = 0;
+  if (in.Input.HasOctree() && in.BuiltFor == input && in.BuiltMTime == input->GetMTime())
+  {
+    cube = in.BuiltCube;
+    depth = in.BuiltDepth;
+  }
+  else
+  {
+    // Not built yet: the cube the build will use and a depth not above the
+    // one it will choose. Leaves of a shallower level of the same cube hold
+    // the deeper ones, so the bounds below still hold the voxels.
+    const bool fixed = vtkMath::AreBoundsInitialized(this->RootBounds);
+    if (image && !fixed)
+    {
+      // The cube is fitted to the voxels above the background, unknown
+      // until the build: the image's bounds widened by half their largest
+      // extent hold any such cube.
+      const double half = 0.5 * std::max({ box[1] - box[0], box[3] - box[2], box[5] - box[4] });
+      for (int a = 0; a < 3; ++a)
+      {
+        bounds[2 * a] = box[2 * a] - half;
+        bounds[2 * a + 1] = box[2 * a + 1] + half;
+      }
+      return;
+    }
+    const double* c = fixed ? this->RootBounds : box;
+    const double lo[3] = { c[0], c[2], c[4] }, hi[3] = { c[1], c[3], c[5] };
+    cube = octoray::RootCube::FromBounds(lo, hi);
+    depth = this->LeafDepth;
+    if (depth == 0)
+    {
+      depth = image
+        ? 1
+        : std::max(1, static_cast<int>(std::floor(std::log(std::max(0.5 * n, 1.0)) / std::log(8.0))));
+    }
+  }
+  // The input's bounds out to the boundaries of the leaves that hold them.
+  const double leaf = std::ldexp(cube.size, -depth);
+  for (int a = 0; a < 3; ++a)
+  {
+    const double o = cube.origin[a];
+    bounds[2 * a] = o + std::floor((box[2 * a] - o) / leaf) * leaf;
+    bounds[2 * a + 1] = o + (std::floor((box[2 * a + 1] - o) / leaf) + 1.0) * leaf;
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -177,6 +177,24 @@ public:
   vtkGetVector6Macro(RootBounds, double);
   ///@}
 
+  /**
+   * Bounds that hold the voxels the mapper draws: the input's bounds out to
+   * the boundaries of the leaves around the outermost points, which reach
+   * past the points by up to a leaf (GetBounds() gives the points' bounds,
+   * as vtkVolumeMapper does). Exact once the octree is built for the current
+   * input; before that (the first frame) from the cube the build will use
+   * and LeafDepth, or, with the automatic depth, a depth of log8(n / 2) for
+   * n points, which the automatic choice (half the leaves hold one point)
+   * does not go below: leaves of that shallower level hold the deeper ones.
+   * (Image input without RootBounds, whose cube is fitted to the voxels
+   * above ImageBackground: the image's bounds widened by half their largest
+   * extent until the build.) A compositor that crops each process's picture
+   * to the screen rectangle of its props' bounds (IceT in ParaView) must be
+   * given these, or the outer parts of the edge voxels are cut off.
+   * Uninitialized (min > max) without input points.
+   */
+  void GetVoxelBounds(double bounds[6]);
+
   ///@{
   /**
    * Level of detail: rays stop descending at voxels smaller than this many
