@@ -1,6 +1,9 @@
 #include "vtkPCDReader.h"
 
-#include "octorayPCDFormat.h"
+#include "octorayLZF.h"
+#include "octorayPCDAscii.h"
+#include "octorayPCDHeader.h"
+#include "octorayPCDValues.h"
 #include "octorayTextSource.h"
 
 #include "vtkCellArray.h"
@@ -229,21 +232,7 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
       (!CheckedMultiply(n, 2 * static_cast<uint64_t>(h.ValuesPerPoint), least) ||
         available + 1 < least))
     {
-      size_t lines = 0;
-      const char* p = data + h.DataOffset;
-      const char* const e = data + size;
-      while (p < e)
-      {
-        const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(e - p)));
-        const char* le = nl ? nl : e;
-        const char* q = p;
-        while (q < le && IsBlank(*q))
-        {
-          ++q;
-        }
-        lines += q < le;
-        p = nl ? nl + 1 : e;
-      }
+      const size_t lines = CountNonBlankLines(data + h.DataOffset, data + size).Count;
       this->Fail(file + ": the ascii data after the DATA line (line " +
         std::to_string(h.DataLine) + ") has " + Plural(lines, "line", "lines") + " in " +
         Plural(available, "byte", "bytes") + "; the header promises POINTS " +

@@ -38,6 +38,7 @@ vtkStandardNewMacro(vtkParticleTextReader);
 namespace
 {
 using namespace octoray::ptext;
+using octoray::IsBlank;
 
 template <typename Real>
 struct Sinks
