@@ -4,9 +4,7 @@
 #include "octorayPCDAscii.h"
 #include "octorayPCDHeader.h"
 #include "octorayPCDValues.h"
-#include "octorayTextSource.h"
 
-#include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -81,112 +79,23 @@ std::string Plural(uint64_t n, const char* one, const char* many)
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkPCDReader::vtkPCDReader()
-{
-  this->SetNumberOfInputPorts(0);
-}
+vtkPCDReader::vtkPCDReader() = default;
 
 //------------------------------------------------------------------------------
-vtkPCDReader::~vtkPCDReader()
-{
-  this->SetFileName(nullptr);
-}
-
-//------------------------------------------------------------------------------
-void vtkPCDReader::Fail(const std::string& message)
-{
-  this->ErrorMessage = message;
-  vtkErrorMacro(<< message);
-}
+vtkPCDReader::~vtkPCDReader() = default;
 
 //------------------------------------------------------------------------------
 int vtkPCDReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  this->ErrorMessage.clear();
   this->FieldNames.clear();
   this->DataEncoding.clear();
   this->NumberOfSkippedPoints = 0;
-  // A failed update leaves the output of the last successful one (or an
-  // empty one) in place: the pipeline has already emptied the output, so the
-  // kept copy is put back.
-  auto restore = [&]() {
-    if (this->LastOutput)
-    {
-      output->ShallowCopy(this->LastOutput);
-    }
-    else
-    {
-      output->Initialize();
-    }
-  };
-  if (!this->FileName || !*this->FileName)
-  {
-    this->Fail("no file name was set");
-    restore();
-    return 0;
-  }
-  octoray::TextSource source;
-  std::string error;
-  if (!source.Open(this->FileName, error))
-  {
-    this->Fail(error);
-    restore();
-    return 0;
-  }
-  this->UpdateProgress(0.0);
-  auto fresh = vtkSmartPointer<vtkPolyData>::New();
-  bool ok = false;
-  try
-  {
-    ok = this->Read(source.Data(), source.Size(), fresh);
-  }
-  catch (const std::bad_alloc&)
-  {
-    this->Fail(std::string(this->FileName) + ": out of memory while reading " +
-      std::to_string(source.Size()) + " bytes");
-    ok = false;
-  }
-  // Truncated while mapped: the decoding went on over zeros (and may have
-  // failed on them, reported just before); what it found is not the file.
-  if (source.Truncated())
-  {
-    this->Fail(source.TruncationMessage(this->FileName));
-    ok = false;
-  }
-  else if (ok && source.ChangedSinceOpen())
-  {
-    this->Fail(std::string(this->FileName) +
-      ": the file changed while it was being read; nothing was read (read it again)");
-    ok = false;
-  }
-  if (!ok)
-  {
-    restore();
-    return 0;
-  }
-  output->ShallowCopy(fresh);
-  this->LastOutput = fresh;
-  this->UpdateProgress(1.0);
-  return 1;
+  return this->Superclass::RequestData(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------
-vtkMTimeType vtkPCDReader::GetMTime()
-{
-  const vtkMTimeType own = this->Superclass::GetMTime();
-  const std::string signature = octoray::FileSignature(this->FileName);
-  if (signature != this->FileSignature)
-  {
-    this->FileSignature = signature;
-    this->FileChangeTime.Modified();
-  }
-  return std::max(own, this->FileChangeTime.GetMTime());
-}
-
-//------------------------------------------------------------------------------
-bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
+bool vtkPCDReader::ReadPoints(const char* data, size_t size, vtkPolyData* output)
 {
   const std::string file = this->FileName;
   Header h;
@@ -249,7 +158,7 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
       });
     if (!parsed)
     {
-      this->Fail(aborted ? file + ": reading was aborted" : error);
+      aborted ? this->FailAborted() : this->Fail(error);
       return false;
     }
     for (size_t f = 0; f < nfields; ++f)
@@ -338,8 +247,8 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
       });
     if (!inflated)
     {
-      this->Fail(aborted ? file + ": reading was aborted"
-                         : file + ": corrupt binary_compressed data (LZF): " + error + sizes);
+      aborted ? this->FailAborted()
+              : this->Fail(file + ": corrupt binary_compressed data (LZF): " + error + sizes);
       return false;
     }
     for (size_t f = 0; f < nfields; ++f)
@@ -490,7 +399,7 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
       (0.95 - decodeEnd) * static_cast<double>(i0 + m) / static_cast<double>(n));
     if (aborting())
     {
-      this->Fail(file + ": reading was aborted");
+      this->FailAborted();
       return false;
     }
   }
@@ -581,25 +490,6 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
   {
     pd->AddArray(a);
   }
-  if (this->GenerateVertices)
-  {
-    const vtkIdType k = static_cast<vtkIdType>(kept);
-    auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
-    offsets->SetNumberOfTuples(k + 1);
-    auto conn = vtkSmartPointer<vtkIdTypeArray>::New();
-    conn->SetNumberOfTuples(k);
-    vtkIdType* o = offsets->GetPointer(0);
-    vtkIdType* cn = conn->GetPointer(0);
-    for (vtkIdType i = 0; i < k; ++i)
-    {
-      o[i] = i;
-      cn[i] = i;
-    }
-    o[k] = k;
-    auto verts = vtkSmartPointer<vtkCellArray>::New();
-    verts->SetData(offsets, conn);
-    output->SetVerts(verts);
-  }
   vtkFieldData* fd = output->GetFieldData();
   auto skipped = vtkSmartPointer<vtkIdTypeArray>::New();
   skipped->SetName("SkippedPointCount");
@@ -632,9 +522,6 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
 void vtkPCDReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
-  os << indent << "OutputPointsPrecision: " << this->OutputPointsPrecision << "\n";
-  os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
   os << indent << "NumberOfSkippedPoints: " << this->NumberOfSkippedPoints << "\n";
   os << indent << "FieldNames: " << this->FieldNames << "\n";
   os << indent << "DataEncoding: " << this->DataEncoding << "\n";

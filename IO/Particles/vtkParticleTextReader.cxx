@@ -1,9 +1,7 @@
 #include "vtkParticleTextReader.h"
 
 #include "octorayParticleTextFormat.h"
-#include "octorayTextSource.h"
 
-#include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -119,109 +117,26 @@ void ParallelChunks(int n, int threads, Work&& work, Progress&& progress)
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkParticleTextReader::vtkParticleTextReader()
-{
-  this->SetNumberOfInputPorts(0);
-}
+vtkParticleTextReader::vtkParticleTextReader() = default;
 
 //------------------------------------------------------------------------------
-vtkParticleTextReader::~vtkParticleTextReader()
-{
-  this->SetFileName(nullptr);
-}
-
-//------------------------------------------------------------------------------
-void vtkParticleTextReader::Fail(const std::string& message)
-{
-  this->ErrorMessage = message;
-  vtkErrorMacro(<< message);
-}
+vtkParticleTextReader::~vtkParticleTextReader() = default;
 
 //------------------------------------------------------------------------------
 int vtkParticleTextReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  this->ErrorMessage.clear();
   this->ColumnNames.clear();
   this->NumberOfSkippedLines = 0;
-
-  if (!this->FileName || !*this->FileName)
-  {
-    this->Fail("no file name was set");
-    return 0;
-  }
-  // A failed update leaves the output of the last successful one (or an
-  // empty one) in place, never a half-read file: the pipeline has already
-  // emptied the output, so the kept copy is put back.
-  auto restore = [&]() {
-    if (this->LastOutput)
-    {
-      output->ShallowCopy(this->LastOutput);
-    }
-    else
-    {
-      output->Initialize();
-    }
-  };
-  octoray::TextSource source;
-  std::string error;
-  if (!source.Open(this->FileName, error))
-  {
-    this->Fail(error);
-    restore();
-    return 0;
-  }
-  this->UpdateProgress(0.0);
-  auto fresh = vtkSmartPointer<vtkPolyData>::New();
-  bool ok = false;
-  try
-  {
-    ok = this->OutputPointsPrecision == DOUBLE_PRECISION
-      ? this->Parse<double>(source.Data(), source.Size(), fresh)
-      : this->Parse<float>(source.Data(), source.Size(), fresh);
-  }
-  catch (const std::bad_alloc&)
-  {
-    this->Fail(std::string(this->FileName) + ": out of memory while reading " +
-      std::to_string(source.Size()) + " bytes");
-    ok = false;
-  }
-  // Truncated while mapped: the parse went on over zeros (and may have
-  // failed on them, reported just before); what it found is not the file.
-  if (source.Truncated())
-  {
-    this->Fail(source.TruncationMessage(this->FileName));
-    ok = false;
-  }
-  else if (ok && source.ChangedSinceOpen())
-  {
-    this->Fail(std::string(this->FileName) +
-      ": the file changed while it was being read; nothing was read (read it again)");
-    ok = false;
-  }
-  if (!ok)
-  {
-    restore();
-    return 0;
-  }
-  output->ShallowCopy(fresh);
-  this->LastOutput = fresh;
-  this->UpdateProgress(1.0);
-  return 1;
+  return this->Superclass::RequestData(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------
-vtkMTimeType vtkParticleTextReader::GetMTime()
+bool vtkParticleTextReader::ReadPoints(const char* data, size_t size, vtkPolyData* output)
 {
-  const vtkMTimeType own = this->Superclass::GetMTime();
-  const std::string signature = octoray::FileSignature(this->FileName);
-  if (signature != this->FileSignature)
-  {
-    this->FileSignature = signature;
-    this->FileChangeTime.Modified();
-  }
-  return std::max(own, this->FileChangeTime.GetMTime());
+  return this->OutputPointsPrecision == DOUBLE_PRECISION
+    ? this->Parse<double>(data, size, output)
+    : this->Parse<float>(data, size, output);
 }
 
 //------------------------------------------------------------------------------
@@ -308,7 +223,7 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   auto notAborted = [&]() {
     if (aborted)
     {
-      this->Fail(file + ": reading was aborted");
+      this->FailAborted();
       return false;
     }
     return true;
@@ -674,8 +589,7 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   }
   if (changedBetweenPasses)
   {
-    this->Fail(file +
-      ": the file changed while it was being read; nothing was read (read it again)");
+    this->FailChanged();
     return false;
   }
 
@@ -797,24 +711,6 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
   {
     pd->AddArray(a);
   }
-  if (this->GenerateVertices)
-  {
-    auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
-    offsets->SetNumberOfTuples(kept + 1);
-    auto conn = vtkSmartPointer<vtkIdTypeArray>::New();
-    conn->SetNumberOfTuples(kept);
-    vtkIdType* o = offsets->GetPointer(0);
-    vtkIdType* cn = conn->GetPointer(0);
-    for (vtkIdType i = 0; i < kept; ++i)
-    {
-      o[i] = i;
-      cn[i] = i;
-    }
-    o[kept] = kept;
-    auto verts = vtkSmartPointer<vtkCellArray>::New();
-    verts->SetData(offsets, conn);
-    output->SetVerts(verts);
-  }
   // Lenient mode leaves its record in the data too, so a pipeline downstream
   // (or a saved file) still says what was skipped.
   if (lenient)
@@ -838,9 +734,6 @@ bool vtkParticleTextReader::Parse(const char* data, size_t size, vtkPolyData* ou
 void vtkParticleTextReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
-  os << indent << "OutputPointsPrecision: " << this->OutputPointsPrecision << "\n";
-  os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
   os << indent << "Lenient: " << this->Lenient << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "MaximumReportedLines: " << this->MaximumReportedLines << "\n";
