@@ -1,7 +1,8 @@
 // The ascii body of a PCD file, without VTK: each line's values parsed into
 // the declared types of the header's fields, so that the result has the
 // layout of a binary body and one conversion serves both. vtkPCDReader
-// parses with these. Private to the module; not wrapped.
+// parses with these (through octorayPCDBody.h). Private to the module; not
+// wrapped.
 #ifndef octorayPCDAscii_h
 #define octorayPCDAscii_h
 

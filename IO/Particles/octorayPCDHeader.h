@@ -1,9 +1,9 @@
 // The header of PCL's PCD point cloud files, without VTK: VERSION, FIELDS,
 // SIZE, TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS and DATA read and
 // checked against each other. vtkPCDReader reads with it, and the fuzz target
-// in Testing/Fuzz reaches it through the reader. The body is read with
-// octorayPCDAscii.h and octorayLZF.h, its values converted by
-// octorayPCDValues.h. Private to the module; not wrapped.
+// in Testing/Fuzz reaches it through the reader. The body is read by
+// octorayPCDBody.h (with octorayPCDAscii.h and octorayLZF.h), its values
+// converted by octorayPCDValues.h. Private to the module; not wrapped.
 //
 // The format, as PCL 1.13 writes and reads it:
 //
