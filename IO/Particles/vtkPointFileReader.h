@@ -9,9 +9,10 @@
  * successful one (empty when there was none), never a half-read file.
  *
  * A subclass reads the bytes in ReadPoints(): points, point data and field
- * data into the polydata it is given, or false after Fail(). Reported
- * besides as errors here: a file that cannot be opened, memory running out,
- * and a file truncated or written to while it was read.
+ * data into the polydata it is given, or false after Fail(). The errors
+ * that any file can give are reported here: no file name, a file that
+ * cannot be opened, memory running out, a file truncated or written to
+ * while it was read.
  */
 #ifndef vtkPointFileReader_h
 #define vtkPointFileReader_h
