@@ -6,11 +6,12 @@
 #ifndef octorayParticleTextFormat_h
 #define octorayParticleTextFormat_h
 
+#include "octorayTextScan.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -43,10 +44,6 @@ struct Column
   int Extra; // index into the extra arrays for Sink::Extra
 };
 
-inline bool IsBlank(char c)
-{
-  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
 inline bool EndsToken(char c)
 {
   return IsBlank(c) || c == ',' || c == '#';
@@ -119,10 +116,9 @@ inline const char* ParseNumber(const char* p, const char* e, Real& v)
   return r.ptr;
 }
 
-// The token at p for an error message: at most 40 characters (longer ones
-// end in "..."), and bytes that are not printable ASCII written as \xNN, so
-// that binary garbage gives a readable, bounded message. Looks at no more
-// than 41 bytes, whatever the token's length (a 10 GB line of NUL bytes).
+// The token at p for an error message (Printable: at most 40 characters,
+// bytes that are not printable ASCII as \xNN). Looks at no more than 41
+// bytes, whatever the token's length (a 10 GB line of NUL bytes).
 inline std::string TokenAt(const char* p, const char* e)
 {
   const char* q = p;
@@ -130,31 +126,7 @@ inline std::string TokenAt(const char* p, const char* e)
   {
     ++q;
   }
-  const bool cut = q - p > 40;
-  if (cut)
-  {
-    q = p + 37;
-  }
-  std::string t;
-  for (const char* c = p; c < q; ++c)
-  {
-    const unsigned char u = static_cast<unsigned char>(*c);
-    if (u >= 0x20 && u < 0x7f)
-    {
-      t += *c;
-    }
-    else
-    {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\x%02x", u);
-      t += buf;
-    }
-  }
-  if (cut)
-  {
-    t += "...";
-  }
-  return t;
+  return Printable(p, q);
 }
 
 // Splits a line into tokens (no number parsing); used for the header and

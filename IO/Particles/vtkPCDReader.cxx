@@ -1,9 +1,9 @@
 #include "vtkPCDReader.h"
 
-#include "octorayPCDFormat.h"
-#include "octorayTextSource.h"
+#include "octorayPCDBody.h"
+#include "octorayPCDHeader.h"
+#include "octorayPCDValues.h"
 
-#include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -19,10 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstring>
-#include <memory>
-#include <new>
 #include <vector>
 
 vtkStandardNewMacro(vtkPCDReader);
@@ -33,14 +30,6 @@ using namespace octoray::pcd;
 
 // Points converted between two progress reports (and abort checks).
 constexpr size_t ChunkPoints = size_t(1) << 16;
-
-// Where the values of one field are: point i's first value at
-// Base + i * Stride, its value c at + c * Size.
-struct Source
-{
-  const unsigned char* Base = nullptr;
-  size_t Stride = 0;
-};
 
 // An output array filled from one or more fields.
 struct Sink
@@ -57,133 +46,232 @@ struct Sink
   int Components = 1;
 };
 
-// PCL's writer leaves zeros after a compressed block (it reserves room for
-// the block before it knows its size): those are no data left unread.
-bool AllZero(const unsigned char* p, size_t n)
+// The output arrays; Sinks lists each with the fields it is made of.
+struct Arrays
 {
-  for (size_t i = 0; i < n; ++i)
+  std::vector<Sink> Sinks;
+  vtkSmartPointer<vtkDataArray> Points;
+  vtkSmartPointer<vtkUnsignedCharArray> Colors;
+  vtkSmartPointer<vtkFloatArray> Normals;
+  vtkSmartPointer<vtkFloatArray> Intensity;
+  std::vector<vtkSmartPointer<vtkFloatArray>> Extras;
+};
+
+// Points from x y z; Colors from rgba or rgb (4 bytes, one value); Normals
+// from normal_x normal_y normal_z; every other field but padding a float
+// array of its name (Intensity for intensity).
+Arrays MakeArrays(const Header& h, bool real64)
+{
+  Arrays a;
+  if (real64)
   {
-    if (p[i])
+    a.Points = vtkSmartPointer<vtkDoubleArray>::New();
+  }
+  else
+  {
+    a.Points = vtkSmartPointer<vtkFloatArray>::New();
+  }
+  a.Points->SetName("Points");
+  a.Sinks.push_back({ Sink::Points, { h.Find("x"), h.Find("y"), h.Find("z") }, a.Points, 3 });
+  for (const char* name : { "rgba", "rgb" })
+  {
+    const int k = h.Find(name);
+    if (!a.Colors && k >= 0 && h.Fields[k].Size == 4 && h.Fields[k].Count == 1)
     {
-      return false;
+      a.Colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
+      a.Colors->SetName("Colors");
+      a.Sinks.push_back({ Sink::Colors, { k }, a.Colors, std::strcmp(name, "rgba") == 0 ? 4 : 3 });
     }
   }
-  return true;
+  const int nx = h.Find("normal_x"), ny = h.Find("normal_y"), nz = h.Find("normal_z");
+  if (nx >= 0 && ny >= 0 && nz >= 0 && h.Fields[nx].Count == 1 && h.Fields[ny].Count == 1 &&
+    h.Fields[nz].Count == 1)
+  {
+    a.Normals = vtkSmartPointer<vtkFloatArray>::New();
+    a.Normals->SetName("Normals");
+    a.Sinks.push_back({ Sink::Values, { nx, ny, nz }, a.Normals, 3 });
+  }
+  std::vector<bool> used(h.Fields.size(), false);
+  for (const Sink& s : a.Sinks)
+  {
+    for (int k : s.Fields)
+    {
+      used[k] = true;
+    }
+  }
+  for (size_t f = 0; f < h.Fields.size(); ++f)
+  {
+    const Field& fd = h.Fields[f];
+    if (used[f] || fd.Padding())
+    {
+      continue;
+    }
+    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    array->SetName(fd.Name == "intensity" ? "Intensity" : fd.Name.c_str());
+    a.Sinks.push_back({ Sink::Values, { static_cast<int>(f) }, array, static_cast<int>(fd.Count) });
+    if (fd.Name == "intensity")
+    {
+      a.Intensity = array;
+    }
+    else
+    {
+      a.Extras.push_back(array);
+    }
+  }
+  return a;
 }
 
-std::string Plural(uint64_t n, const char* one, const char* many)
+// Converts points [i0, i0 + m) of the fields of s into its array.
+void Convert(const Header& h, const Body& body, const Sink& s, size_t i0, size_t m, bool real64)
 {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
+  const size_t comps = static_cast<size_t>(s.Components);
+  if (s.What == Sink::Colors)
+  {
+    const Source& src = body.Sources[s.Fields[0]];
+    UnpackColors(src.Base + i0 * src.Stride, src.Stride, m,
+      static_cast<vtkUnsignedCharArray*>(s.Array.Get())->GetPointer(0) + i0 * comps, s.Components);
+    return;
+  }
+  // Three fields of one value each (points, normals), or one field of
+  // `comps` values.
+  const bool perField = s.Fields.size() > 1;
+  for (size_t c = 0; c < comps; ++c)
+  {
+    const int k = perField ? s.Fields[c] : s.Fields[0];
+    const Field& fd = h.Fields[k];
+    const Source& src = body.Sources[k];
+    const unsigned char* base =
+      src.Base + i0 * src.Stride + (perField ? 0 : c * static_cast<size_t>(fd.Size));
+    if (s.What == Sink::Points && real64)
+    {
+      double* out = static_cast<vtkDoubleArray*>(s.Array.Get())->GetPointer(0);
+      Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
+    }
+    else
+    {
+      float* out = static_cast<vtkFloatArray*>(s.Array.Get())->GetPointer(0);
+      Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
+    }
+  }
+}
+
+// Leaves out the points without a position (x, y or z NaN or infinite: the
+// empty cells of organised clouds) from every array; returns how many.
+template <typename Real>
+size_t DropPointsWithoutPosition(const Arrays& a, const Real* p, size_t n)
+{
+  std::vector<unsigned char> valid;
+  size_t bad = 0;
+  for (size_t i = 0; i < n; ++i)
+  {
+    if (!(std::isfinite(p[3 * i]) && std::isfinite(p[3 * i + 1]) && std::isfinite(p[3 * i + 2])))
+    {
+      if (valid.empty())
+      {
+        valid.assign(n, 1);
+      }
+      valid[i] = 0;
+      ++bad;
+    }
+  }
+  for (const Sink& s : a.Sinks)
+  {
+    if (!bad)
+    {
+      break;
+    }
+    vtkDataArray* array = s.Array;
+    const size_t tuple = static_cast<size_t>(array->GetDataTypeSize()) * s.Components;
+    unsigned char* bytes = static_cast<unsigned char*>(array->GetVoidPointer(0));
+    size_t w = 0;
+    for (size_t i = 0; i < n; ++i)
+    {
+      if (valid[i])
+      {
+        if (w != i)
+        {
+          std::memcpy(bytes + w * tuple, bytes + i * tuple, tuple);
+        }
+        ++w;
+      }
+    }
+    array->SetNumberOfTuples(static_cast<vtkIdType>(n - bad));
+    array->Squeeze();
+  }
+  return bad;
+}
+
+void AddPointData(vtkPolyData* output, const Arrays& a)
+{
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetData(a.Points);
+  output->SetPoints(points);
+  vtkPointData* pd = output->GetPointData();
+  if (a.Colors)
+  {
+    pd->AddArray(a.Colors);
+    pd->SetScalars(a.Colors);
+  }
+  if (a.Normals)
+  {
+    pd->SetNormals(a.Normals);
+  }
+  if (a.Intensity)
+  {
+    pd->AddArray(a.Intensity);
+    if (!a.Colors)
+    {
+      pd->SetActiveScalars(a.Intensity->GetName());
+    }
+  }
+  for (auto& extra : a.Extras)
+  {
+    pd->AddArray(extra);
+  }
+}
+
+// SkippedPointCount, and what the header says of the cloud: PCDWidth,
+// PCDHeight, PCDViewpoint.
+void AddFieldData(vtkPolyData* output, const Header& h, vtkIdType skipped)
+{
+  vtkFieldData* fd = output->GetFieldData();
+  for (const auto& value : { std::make_pair("SkippedPointCount", skipped),
+         std::make_pair("PCDWidth", static_cast<vtkIdType>(h.Width)),
+         std::make_pair("PCDHeight", static_cast<vtkIdType>(h.Height)) })
+  {
+    auto a = vtkSmartPointer<vtkIdTypeArray>::New();
+    a->SetName(value.first);
+    a->InsertNextValue(value.second);
+    fd->AddArray(a);
+  }
+  auto viewpoint = vtkSmartPointer<vtkDoubleArray>::New();
+  viewpoint->SetName("PCDViewpoint");
+  for (double v : h.Viewpoint)
+  {
+    viewpoint->InsertNextValue(v);
+  }
+  fd->AddArray(viewpoint);
 }
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkPCDReader::vtkPCDReader()
-{
-  this->SetNumberOfInputPorts(0);
-}
+vtkPCDReader::vtkPCDReader() = default;
 
 //------------------------------------------------------------------------------
-vtkPCDReader::~vtkPCDReader()
-{
-  this->SetFileName(nullptr);
-}
-
-//------------------------------------------------------------------------------
-void vtkPCDReader::Fail(const std::string& message)
-{
-  this->ErrorMessage = message;
-  vtkErrorMacro(<< message);
-}
+vtkPCDReader::~vtkPCDReader() = default;
 
 //------------------------------------------------------------------------------
 int vtkPCDReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  this->ErrorMessage.clear();
   this->FieldNames.clear();
   this->DataEncoding.clear();
   this->NumberOfSkippedPoints = 0;
-  // A failed update leaves the output of the last successful one (or an
-  // empty one) in place: the pipeline has already emptied the output, so the
-  // kept copy is put back.
-  auto restore = [&]() {
-    if (this->LastOutput)
-    {
-      output->ShallowCopy(this->LastOutput);
-    }
-    else
-    {
-      output->Initialize();
-    }
-  };
-  if (!this->FileName || !*this->FileName)
-  {
-    this->Fail("no file name was set");
-    restore();
-    return 0;
-  }
-  octoray::TextSource source;
-  std::string error;
-  if (!source.Open(this->FileName, error))
-  {
-    this->Fail(error);
-    restore();
-    return 0;
-  }
-  this->UpdateProgress(0.0);
-  auto fresh = vtkSmartPointer<vtkPolyData>::New();
-  bool ok = false;
-  try
-  {
-    ok = this->Read(source.Data(), source.Size(), fresh);
-  }
-  catch (const std::bad_alloc&)
-  {
-    this->Fail(std::string(this->FileName) + ": out of memory while reading " +
-      std::to_string(source.Size()) + " bytes");
-    ok = false;
-  }
-  // Truncated while mapped: the decoding went on over zeros (and may have
-  // failed on them, reported just before); what it found is not the file.
-  if (source.Truncated())
-  {
-    this->Fail(source.TruncationMessage(this->FileName));
-    ok = false;
-  }
-  else if (ok && source.ChangedSinceOpen())
-  {
-    this->Fail(std::string(this->FileName) +
-      ": the file changed while it was being read; nothing was read (read it again)");
-    ok = false;
-  }
-  if (!ok)
-  {
-    restore();
-    return 0;
-  }
-  output->ShallowCopy(fresh);
-  this->LastOutput = fresh;
-  this->UpdateProgress(1.0);
-  return 1;
+  return this->Superclass::RequestData(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------
-vtkMTimeType vtkPCDReader::GetMTime()
-{
-  const vtkMTimeType own = this->Superclass::GetMTime();
-  const std::string signature = octoray::FileSignature(this->FileName);
-  if (signature != this->FileSignature)
-  {
-    this->FileSignature = signature;
-    this->FileChangeTime.Modified();
-  }
-  return std::max(own, this->FileChangeTime.GetMTime());
-}
-
-//------------------------------------------------------------------------------
-bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
+bool vtkPCDReader::ReadPoints(const char* data, size_t size, vtkPolyData* output)
 {
   const std::string file = this->FileName;
   Header h;
@@ -200,254 +288,24 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
   this->DataEncoding = EncodingName(h.Data);
   std::vector<std::string> warnings = h.Warnings;
 
-  const size_t n = static_cast<size_t>(h.Points);
-  const size_t nfields = h.Fields.size();
-  const unsigned char* const body = reinterpret_cast<const unsigned char*>(data) + h.DataOffset;
-  const size_t available = size - h.DataOffset;
-  std::vector<Source> sources(nfields);
-  // The ascii values, or the inflated block; not zero-filled (every byte is
-  // written before it is read).
-  std::unique_ptr<unsigned char[]> buffer;
+  // Progress [0, decoded] decodes the body (ascii, LZF), the rest converts.
+  const double decoded = DecodingShare(h.Data);
   bool aborted = false;
-  auto aborting = [&]() {
-    if (this->GetAbortExecute())
-    {
-      aborted = true;
-    }
-    return aborted;
-  };
-  // Progress [0, decodeEnd] decodes the body (ascii, LZF), the rest converts.
-  double decodeEnd = 0.0;
+  Body body;
+  if (!ReadBody(data, size, h, file, body, error, warnings, [&](double done) {
+        aborted = aborted || !this->ContinueReading(decoded * done);
+        return !aborted;
+      }))
+  {
+    aborted ? this->FailAborted() : this->Fail(error);
+    return false;
+  }
+  this->UpdateProgress(decoded);
 
-  if (h.Data == Encoding::Ascii)
-  {
-    decodeEnd = 0.7;
-    // Each value takes at least one character and a separator: a body too
-    // short for that cannot hold the points (and the buffer is not made).
-    uint64_t least = 0;
-    if (n > 0 &&
-      (!CheckedMultiply(n, 2 * static_cast<uint64_t>(h.ValuesPerPoint), least) ||
-        available + 1 < least))
-    {
-      size_t lines = 0;
-      const char* p = data + h.DataOffset;
-      const char* const e = data + size;
-      while (p < e)
-      {
-        const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(e - p)));
-        const char* le = nl ? nl : e;
-        const char* q = p;
-        while (q < le && IsBlank(*q))
-        {
-          ++q;
-        }
-        lines += q < le;
-        p = nl ? nl + 1 : e;
-      }
-      this->Fail(file + ": the ascii data after the DATA line (line " +
-        std::to_string(h.DataLine) + ") has " + Plural(lines, "line", "lines") + " in " +
-        Plural(available, "byte", "bytes") + "; the header promises POINTS " +
-        std::to_string(n) + " of " + std::to_string(h.ValuesPerPoint) + " value(s) each");
-      return false;
-    }
-    // The parse writes every value but those of padding fields, which
-    // nothing reads.
-    buffer.reset(new unsigned char[std::max<size_t>(n * h.PointStep, 1)]);
-    const bool parsed = ParseAscii(data + h.DataOffset, data + size, h.DataLine + 1, h, file,
-      buffer.get(), error, warnings, [&](uint64_t done) {
-        this->UpdateProgress(decodeEnd * static_cast<double>(done) / static_cast<double>(n));
-        return !aborting();
-      });
-    if (!parsed)
-    {
-      this->Fail(aborted ? file + ": reading was aborted" : error);
-      return false;
-    }
-    for (size_t f = 0; f < nfields; ++f)
-    {
-      sources[f] = { buffer.get() + h.Fields[f].Offset, h.PointStep };
-    }
-  }
-  else if (h.Data == Encoding::Binary)
-  {
-    const size_t need = n * h.PointStep;
-    if (available < need)
-    {
-      this->Fail(file + ": the binary data is shorter than the header promises: POINTS " +
-        std::to_string(n) + " x " + std::to_string(h.PointStep) + " bytes = " +
-        std::to_string(need) + " bytes after the header (from byte " +
-        std::to_string(h.DataOffset) + "), the file has " + Plural(available, "byte", "bytes") +
-        " (" + Plural(h.PointStep ? available / h.PointStep : 0, "whole point", "whole points") +
-        ")");
-      return false;
-    }
-    if (available > need && !AllZero(body + need, available - need))
-    {
-      warnings.push_back(file + ": " + Plural(available - need, "byte", "bytes") +
-        " (not all zero) after the binary data of the " + Plural(n, "point", "points") +
-        " were ignored");
-    }
-    for (size_t f = 0; f < nfields; ++f)
-    {
-      sources[f] = { body + h.Fields[f].Offset, h.PointStep };
-    }
-  }
-  else
-  {
-    decodeEnd = 0.6;
-    if (available < 8)
-    {
-      this->Fail(file + ": the binary_compressed data is cut off: its 8-byte block header "
-                        "(compressed and uncompressed sizes) needs 8 bytes after the header, "
-                        "the file has " +
-        Plural(available, "byte", "bytes"));
-      return false;
-    }
-    uint32_t compressed = 0, uncompressed = 0;
-    std::memcpy(&compressed, body, 4);
-    std::memcpy(&uncompressed, body + 4, 4);
-    const size_t expected = n * h.PackedStep;
-    const std::string sizes = " (the block header at byte " + std::to_string(h.DataOffset) +
-      " says " + std::to_string(compressed) + " bytes compressed, " +
-      std::to_string(uncompressed) + " uncompressed)";
-    if (compressed > available - 8)
-    {
-      this->Fail(file + ": the binary_compressed data is shorter than its block header says: " +
-        std::to_string(compressed) + " bytes of LZF data expected after the 8-byte block "
-                                     "header, the file has " +
-        Plural(available - 8, "byte", "bytes") + sizes);
-      return false;
-    }
-    if (uncompressed != expected)
-    {
-      this->Fail(file + ": the binary_compressed block does not match the header: it inflates "
-                        "to " +
-        std::to_string(uncompressed) + " bytes, POINTS " + std::to_string(n) + " x " +
-        std::to_string(h.PackedStep) + " bytes (the fields without padding) = " +
-        std::to_string(expected) + sizes);
-      return false;
-    }
-    if (uncompressed > static_cast<uint64_t>(compressed) * LzfMaximumExpansion)
-    {
-      this->Fail(file + ": the binary_compressed block is inconsistent: " +
-        std::to_string(compressed) + " bytes of LZF cannot inflate to " +
-        std::to_string(uncompressed) + " (at most " + std::to_string(LzfMaximumExpansion) +
-        " times as many)" + sizes);
-      return false;
-    }
-    if (available - 8 > compressed && !AllZero(body + 8 + compressed, available - 8 - compressed))
-    {
-      warnings.push_back(file + ": " + Plural(available - 8 - compressed, "byte", "bytes") +
-        " (not all zero) after the compressed block were ignored");
-    }
-    buffer.reset(new unsigned char[std::max<size_t>(uncompressed, 1)]);
-    const bool inflated = LzfDecompress(body + 8, compressed, buffer.get(), uncompressed,
-      error, [&](size_t done) {
-        this->UpdateProgress(
-          decodeEnd * static_cast<double>(done) / static_cast<double>(uncompressed));
-        return !aborting();
-      });
-    if (!inflated)
-    {
-      this->Fail(aborted ? file + ": reading was aborted"
-                         : file + ": corrupt binary_compressed data (LZF): " + error + sizes);
-      return false;
-    }
-    for (size_t f = 0; f < nfields; ++f)
-    {
-      const Field& fd = h.Fields[f];
-      // Padding fields are not in the block; nothing reads them.
-      sources[f] = { fd.Padding() ? nullptr : buffer.get() + n * fd.PackedOffset, fd.Bytes() };
-    }
-  }
-  this->UpdateProgress(decodeEnd);
-
-  // ---- Output arrays.
-  std::vector<Sink> sinks;
-  std::vector<bool> used(nfields, false);
-  auto field = [&](const char* name) { return h.Find(name); };
-  vtkSmartPointer<vtkDataArray> pointsArray;
-  if (this->OutputPointsPrecision == DOUBLE_PRECISION)
-  {
-    pointsArray = vtkSmartPointer<vtkDoubleArray>::New();
-  }
-  else
-  {
-    pointsArray = vtkSmartPointer<vtkFloatArray>::New();
-  }
-  pointsArray->SetName("Points");
-  {
-    Sink s;
-    s.What = Sink::Points;
-    s.Fields = { field("x"), field("y"), field("z") };
-    s.Array = pointsArray;
-    s.Components = 3;
-    sinks.push_back(s);
-  }
-  vtkSmartPointer<vtkUnsignedCharArray> colors;
-  for (const char* name : { "rgba", "rgb" })
-  {
-    const int k = field(name);
-    if (!colors && k >= 0 && h.Fields[k].Size == 4 && h.Fields[k].Count == 1)
-    {
-      colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
-      colors->SetName("Colors");
-      Sink s;
-      s.What = Sink::Colors;
-      s.Fields = { k };
-      s.Array = colors;
-      s.Components = std::strcmp(name, "rgba") == 0 ? 4 : 3;
-      sinks.push_back(s);
-    }
-  }
-  vtkSmartPointer<vtkFloatArray> normals;
-  {
-    const int nx = field("normal_x"), ny = field("normal_y"), nz = field("normal_z");
-    if (nx >= 0 && ny >= 0 && nz >= 0 && h.Fields[nx].Count == 1 && h.Fields[ny].Count == 1 &&
-      h.Fields[nz].Count == 1)
-    {
-      normals = vtkSmartPointer<vtkFloatArray>::New();
-      normals->SetName("Normals");
-      Sink s;
-      s.Fields = { nx, ny, nz };
-      s.Array = normals;
-      s.Components = 3;
-      sinks.push_back(s);
-    }
-  }
-  for (const Sink& s : sinks)
-  {
-    for (int k : s.Fields)
-    {
-      used[k] = true;
-    }
-  }
-  vtkSmartPointer<vtkFloatArray> intensity;
-  std::vector<vtkSmartPointer<vtkFloatArray>> extras;
-  for (size_t f = 0; f < nfields; ++f)
-  {
-    const Field& fd = h.Fields[f];
-    if (used[f] || fd.Padding())
-    {
-      continue;
-    }
-    auto a = vtkSmartPointer<vtkFloatArray>::New();
-    a->SetName(fd.Name == "intensity" ? "Intensity" : fd.Name.c_str());
-    Sink s;
-    s.Fields = { static_cast<int>(f) };
-    s.Array = a;
-    s.Components = static_cast<int>(fd.Count);
-    sinks.push_back(s);
-    if (fd.Name == "intensity")
-    {
-      intensity = a;
-    }
-    else
-    {
-      extras.push_back(a);
-    }
-  }
-  for (Sink& s : sinks)
+  const size_t n = static_cast<size_t>(h.Points);
+  const bool real64 = this->OutputPointsPrecision == DOUBLE_PRECISION;
+  Arrays arrays = MakeArrays(h, real64);
+  for (Sink& s : arrays.Sinks)
   {
     s.Array->SetNumberOfComponents(s.Components);
     s.Array->SetNumberOfTuples(static_cast<vtkIdType>(n));
@@ -459,179 +317,36 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
       return false;
     }
   }
-
-  // ---- Conversion, chunk by chunk of points.
-  const bool real64 = this->OutputPointsPrecision == DOUBLE_PRECISION;
   for (size_t i0 = 0; i0 < n; i0 += ChunkPoints)
   {
     const size_t m = std::min(ChunkPoints, n - i0);
-    for (const Sink& s : sinks)
+    for (const Sink& s : arrays.Sinks)
     {
-      const size_t comps = static_cast<size_t>(s.Components);
-      if (s.What == Sink::Colors)
-      {
-        const Source& src = sources[s.Fields[0]];
-        UnpackColors(src.Base + i0 * src.Stride, src.Stride, m,
-          static_cast<vtkUnsignedCharArray*>(s.Array.Get())->GetPointer(0) + i0 * comps,
-          s.Components);
-        continue;
-      }
-      // Three fields of one value each (points, normals), or one field of
-      // `comps` values.
-      const bool perField = s.Fields.size() > 1;
-      for (size_t c = 0; c < comps; ++c)
-      {
-        const Field& fd = h.Fields[perField ? s.Fields[c] : s.Fields[0]];
-        const Source& src = sources[perField ? s.Fields[c] : s.Fields[0]];
-        const unsigned char* base =
-          src.Base + i0 * src.Stride + (perField ? 0 : c * static_cast<size_t>(fd.Size));
-        if (s.What == Sink::Points && real64)
-        {
-          double* out = static_cast<vtkDoubleArray*>(s.Array.Get())->GetPointer(0);
-          Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
-        }
-        else
-        {
-          float* out = static_cast<vtkFloatArray*>(s.Array.Get())->GetPointer(0);
-          Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
-        }
-      }
+      Convert(h, body, s, i0, m, real64);
     }
-    this->UpdateProgress(decodeEnd +
-      (0.95 - decodeEnd) * static_cast<double>(i0 + m) / static_cast<double>(n));
-    if (aborting())
+    if (!this->ContinueReading(
+          decoded + (0.95 - decoded) * static_cast<double>(i0 + m) / static_cast<double>(n)))
     {
-      this->Fail(file + ": reading was aborted");
+      this->FailAborted();
       return false;
     }
   }
 
-  // ---- Points without a position (NaN cells of organised clouds): left out.
-  size_t kept = n;
+  const size_t bad = real64
+    ? DropPointsWithoutPosition(arrays, vtkDoubleArray::SafeDownCast(arrays.Points)->GetPointer(0), n)
+    : DropPointsWithoutPosition(arrays, vtkFloatArray::SafeDownCast(arrays.Points)->GetPointer(0), n);
+  if (bad)
   {
-    std::vector<unsigned char> valid;
-    size_t bad = 0;
-    auto check = [&](auto* p) {
-      for (size_t i = 0; i < n; ++i)
-      {
-        if (!(std::isfinite(p[3 * i]) && std::isfinite(p[3 * i + 1]) &&
-              std::isfinite(p[3 * i + 2])))
-        {
-          if (valid.empty())
-          {
-            valid.assign(n, 1);
-          }
-          valid[i] = 0;
-          ++bad;
-        }
-      }
-    };
-    if (real64)
-    {
-      check(static_cast<vtkDoubleArray*>(pointsArray.Get())->GetPointer(0));
-    }
-    else
-    {
-      check(static_cast<vtkFloatArray*>(pointsArray.Get())->GetPointer(0));
-    }
-    if (bad)
-    {
-      kept = n - bad;
-      for (const Sink& s : sinks)
-      {
-        vtkDataArray* a = s.Array;
-        const size_t tuple = static_cast<size_t>(a->GetDataTypeSize()) * s.Components;
-        unsigned char* p = static_cast<unsigned char*>(a->GetVoidPointer(0));
-        size_t w = 0;
-        for (size_t i = 0; i < n; ++i)
-        {
-          if (valid[i])
-          {
-            if (w != i)
-            {
-              std::memcpy(p + w * tuple, p + i * tuple, tuple);
-            }
-            ++w;
-          }
-        }
-        a->SetNumberOfTuples(static_cast<vtkIdType>(kept));
-        a->Squeeze();
-      }
-      this->NumberOfSkippedPoints = static_cast<vtkIdType>(bad);
-      warnings.push_back(file + ": skipped " + std::to_string(bad) + " of " +
-        Plural(n, "point", "points") + " whose x, y or z is NaN or infinite" +
-        (h.Height > 1 ? " (empty cells of the organised " + std::to_string(h.Width) + " x " +
-              std::to_string(h.Height) + " cloud)"
-                      : std::string()) +
-        "; kept " + std::to_string(kept) + " (field data SkippedPointCount)");
-    }
+    this->NumberOfSkippedPoints = static_cast<vtkIdType>(bad);
+    warnings.push_back(file + ": skipped " + std::to_string(bad) + " of " +
+      Plural(n, "point", "points") + " whose x, y or z is NaN or infinite" +
+      (h.Height > 1 ? " (empty cells of the organised " + std::to_string(h.Width) + " x " +
+            std::to_string(h.Height) + " cloud)"
+                    : std::string()) +
+      "; kept " + std::to_string(n - bad) + " (field data SkippedPointCount)");
   }
-
-  auto points = vtkSmartPointer<vtkPoints>::New();
-  points->SetData(pointsArray);
-  output->SetPoints(points);
-  vtkPointData* pd = output->GetPointData();
-  if (colors)
-  {
-    pd->AddArray(colors);
-    pd->SetScalars(colors);
-  }
-  if (normals)
-  {
-    pd->SetNormals(normals);
-  }
-  if (intensity)
-  {
-    pd->AddArray(intensity);
-    if (!colors)
-    {
-      pd->SetActiveScalars(intensity->GetName());
-    }
-  }
-  for (auto& a : extras)
-  {
-    pd->AddArray(a);
-  }
-  if (this->GenerateVertices)
-  {
-    const vtkIdType k = static_cast<vtkIdType>(kept);
-    auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
-    offsets->SetNumberOfTuples(k + 1);
-    auto conn = vtkSmartPointer<vtkIdTypeArray>::New();
-    conn->SetNumberOfTuples(k);
-    vtkIdType* o = offsets->GetPointer(0);
-    vtkIdType* cn = conn->GetPointer(0);
-    for (vtkIdType i = 0; i < k; ++i)
-    {
-      o[i] = i;
-      cn[i] = i;
-    }
-    o[k] = k;
-    auto verts = vtkSmartPointer<vtkCellArray>::New();
-    verts->SetData(offsets, conn);
-    output->SetVerts(verts);
-  }
-  vtkFieldData* fd = output->GetFieldData();
-  auto skipped = vtkSmartPointer<vtkIdTypeArray>::New();
-  skipped->SetName("SkippedPointCount");
-  skipped->InsertNextValue(this->NumberOfSkippedPoints);
-  fd->AddArray(skipped);
-  auto width = vtkSmartPointer<vtkIdTypeArray>::New();
-  width->SetName("PCDWidth");
-  width->InsertNextValue(static_cast<vtkIdType>(h.Width));
-  fd->AddArray(width);
-  auto height = vtkSmartPointer<vtkIdTypeArray>::New();
-  height->SetName("PCDHeight");
-  height->InsertNextValue(static_cast<vtkIdType>(h.Height));
-  fd->AddArray(height);
-  auto viewpoint = vtkSmartPointer<vtkDoubleArray>::New();
-  viewpoint->SetName("PCDViewpoint");
-  for (double v : h.Viewpoint)
-  {
-    viewpoint->InsertNextValue(v);
-  }
-  fd->AddArray(viewpoint);
-
+  AddPointData(output, arrays);
+  AddFieldData(output, h, this->NumberOfSkippedPoints);
   for (const std::string& w : warnings)
   {
     vtkWarningMacro(<< w);
@@ -643,9 +358,6 @@ bool vtkPCDReader::Read(const char* data, size_t size, vtkPolyData* output)
 void vtkPCDReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
-  os << indent << "OutputPointsPrecision: " << this->OutputPointsPrecision << "\n";
-  os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
   os << indent << "NumberOfSkippedPoints: " << this->NumberOfSkippedPoints << "\n";
   os << indent << "FieldNames: " << this->FieldNames << "\n";
   os << indent << "DataEncoding: " << this->DataEncoding << "\n";

@@ -11,8 +11,9 @@
  * itself: no PCL, no third-party library.
  *
  * Output (each only where the file has it):
- * - points from x y z (float, or double with SetOutputPointsPrecision);
- *   one vertex cell per point (GenerateVertices);
+ * - points from x y z (float, or double with SetOutputPointsPrecision;
+ *   the other arrays are float whatever the file stores); one vertex cell
+ *   per point (GenerateVertices);
  * - `Colors`: unsigned char RGB from a packed `rgb` field, RGBA from
  *   `rgba` (4 bytes, float or uint32, 0xAARRGGBB), the active scalars;
  * - `Normals`: from `normal_x normal_y normal_z`, the active normals;
@@ -43,80 +44,40 @@
 #define vtkPCDReader_h
 
 #include "octorayIOParticlesModule.h" // for export macro
-#include "vtkPolyDataAlgorithm.h"
-#include "vtkSmartPointer.h" // for vtkSmartPointer
+#include "vtkPointFileReader.h"
 
 #include <string> // for std::string
 
-class OCTORAYIOPARTICLES_EXPORT vtkPCDReader : public vtkPolyDataAlgorithm
+class OCTORAYIOPARTICLES_EXPORT vtkPCDReader : public vtkPointFileReader
 {
 public:
   static vtkPCDReader* New();
-  vtkTypeMacro(vtkPCDReader, vtkPolyDataAlgorithm);
+  vtkTypeMacro(vtkPCDReader, vtkPointFileReader);
   void PrintSelf(ostream& os, vtkIndent indent) override;
-
-  ///@{
-  /// The PCD file to read.
-  vtkSetStringMacro(FileName);
-  vtkGetStringMacro(FileName);
-  ///@}
-
-  ///@{
-  /// vtkAlgorithm::SINGLE_PRECISION (default) or DOUBLE_PRECISION for the
-  /// points. The other arrays are float whatever the file stores.
-  vtkSetClampMacro(OutputPointsPrecision, int, SINGLE_PRECISION, DOUBLE_PRECISION);
-  vtkGetMacro(OutputPointsPrecision, int);
-  ///@}
-
-  ///@{
-  /// Make one VTK_VERTEX cell per point (default on), so that ordinary VTK
-  /// mappers draw the points.
-  vtkSetMacro(GenerateVertices, bool);
-  vtkGetMacro(GenerateVertices, bool);
-  vtkBooleanMacro(GenerateVertices, bool);
-  ///@}
 
   /// Points left out by the last update because a coordinate was NaN or
   /// infinite.
   vtkGetMacro(NumberOfSkippedPoints, vtkIdType);
-
-  /// The message of the last error; empty when the last update succeeded.
-  const char* GetErrorMessage() { return this->ErrorMessage.c_str(); }
 
   /// The fields of the file read last, as its FIELDS line lists them, and
   /// its DATA form ("ascii", "binary", "binary_compressed").
   const char* GetFieldNames() { return this->FieldNames.c_str(); }
   const char* GetDataEncoding() { return this->DataEncoding.c_str(); }
 
-  /// Includes the file's modification time, size and inode: when the file
-  /// changes on disk, the next Update() reads it again.
-  vtkMTimeType GetMTime() override;
-
 protected:
   vtkPCDReader();
   ~vtkPCDReader() override;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool ReadPoints(const char* data, size_t size, vtkPolyData* output) override;
 
-  char* FileName = nullptr;
-  int OutputPointsPrecision = SINGLE_PRECISION;
-  bool GenerateVertices = true;
   vtkIdType NumberOfSkippedPoints = 0;
-  std::string ErrorMessage;
   std::string FieldNames;
   std::string DataEncoding;
-  std::string FileSignature;
-  vtkTimeStamp FileChangeTime;
-  // The output of the last successful update, which a failed update leaves
-  // in place.
-  vtkSmartPointer<vtkPolyData> LastOutput;
 
 private:
   vtkPCDReader(const vtkPCDReader&) = delete;
   void operator=(const vtkPCDReader&) = delete;
-
-  bool Read(const char* data, size_t size, vtkPolyData* output);
-  void Fail(const std::string& message);
 };
 
 #endif

@@ -21,17 +21,19 @@
  * blank lines and CRLF line ends are accepted; a gzip file (by its magic
  * bytes) is read as the text it holds.
  *
- * Output: points (float, or double with SetOutputPointsPrecision), one
- * vertex cell per point (GenerateVertices), and the arrays `Colors`
- * (unsigned char RGB), `Reflectivity`, `Refraction`, `Scalars` and the named
- * extras, each only where the file has it.
+ * Output: points (float, or double with SetOutputPointsPrecision, which
+ * the floating-point arrays follow too), one vertex cell per point
+ * (GenerateVertices), and the arrays `Colors` (unsigned char RGB),
+ * `Reflectivity`, `Refraction`, `Scalars` and the named extras, each only
+ * where the file has it.
  *
  * Errors name the file, line and column and what was expected:
  * `particles.txt:12:9: expected a number for column 3 (z), found 'abc'`.
  * Strict (the default): the first bad line (lowest line number) is an error
- * and the output is empty. Lenient: bad lines are skipped and counted; a
+ * and nothing is read (the output of the last successful update stays). Lenient: bad lines are skipped and counted; a
  * warning gives the count and the first line numbers, and so does the field
- * data (`SkippedLineCount`, `SkippedLineNumbers`). Nothing is dropped silently.
+ * data (`SkippedLineCount`, `SkippedLineNumbers`); GetErrorMessage() then
+ * returns the first skipped line's message. Nothing is dropped silently.
  *
  * Large files are memory-mapped and parsed by several threads; progress
  * events come from the calling thread.
@@ -44,38 +46,16 @@
 #define vtkParticleTextReader_h
 
 #include "octorayIOParticlesModule.h" // for export macro
-#include "vtkPolyDataAlgorithm.h"
-#include "vtkSmartPointer.h" // for vtkSmartPointer
+#include "vtkPointFileReader.h"
 
 #include <string> // for std::string
 
-class OCTORAYIOPARTICLES_EXPORT vtkParticleTextReader : public vtkPolyDataAlgorithm
+class OCTORAYIOPARTICLES_EXPORT vtkParticleTextReader : public vtkPointFileReader
 {
 public:
   static vtkParticleTextReader* New();
-  vtkTypeMacro(vtkParticleTextReader, vtkPolyDataAlgorithm);
+  vtkTypeMacro(vtkParticleTextReader, vtkPointFileReader);
   void PrintSelf(ostream& os, vtkIndent indent) override;
-
-  ///@{
-  /// The file to read (plain text or gzip-compressed text).
-  vtkSetStringMacro(FileName);
-  vtkGetStringMacro(FileName);
-  ///@}
-
-  ///@{
-  /// vtkAlgorithm::SINGLE_PRECISION (default) or DOUBLE_PRECISION for the
-  /// points and the floating-point arrays.
-  vtkSetClampMacro(OutputPointsPrecision, int, SINGLE_PRECISION, DOUBLE_PRECISION);
-  vtkGetMacro(OutputPointsPrecision, int);
-  ///@}
-
-  ///@{
-  /// Make one VTK_VERTEX cell per point (default on), so that ordinary VTK
-  /// mappers draw the points.
-  vtkSetMacro(GenerateVertices, bool);
-  vtkGetMacro(GenerateVertices, bool);
-  vtkBooleanMacro(GenerateVertices, bool);
-  ///@}
 
   ///@{
   /// Skip bad lines instead of failing (default off: strict).
@@ -99,16 +79,8 @@ public:
   /// Lines skipped in lenient mode by the last update.
   vtkGetMacro(NumberOfSkippedLines, vtkIdType);
 
-  /// The message of the last error (strict mode) or of the first skipped line
-  /// (lenient mode); empty when the last update read everything.
-  const char* GetErrorMessage() { return this->ErrorMessage.c_str(); }
-
   /// Numeric column layout found by the last update, e.g. "x y z r g b".
   const char* GetColumnNames() { return this->ColumnNames.c_str(); }
-
-  /// Includes the file's modification time, size and inode: when the file
-  /// changes on disk, the next Update() reads it again.
-  vtkMTimeType GetMTime() override;
 
   /// Whether this reader reads the file, for a reader factory choosing among
   /// the readers of one extension (ParaView's File › Open calls it on each
@@ -129,22 +101,13 @@ protected:
   ~vtkParticleTextReader() override;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool ReadPoints(const char* data, size_t size, vtkPolyData* output) override;
 
-  char* FileName = nullptr;
-  int OutputPointsPrecision = SINGLE_PRECISION;
-  bool GenerateVertices = true;
   bool Lenient = false;
   int NumberOfThreads = 0;
   int MaximumReportedLines = 10;
   vtkIdType NumberOfSkippedLines = 0;
-  std::string ErrorMessage;
   std::string ColumnNames;
-  // What the file looked like when GetMTime() last looked, and when that
-  // changed; the output of the last successful update, which a failed
-  // update leaves in place.
-  std::string FileSignature;
-  vtkTimeStamp FileChangeTime;
-  vtkSmartPointer<vtkPolyData> LastOutput;
 
 private:
   vtkParticleTextReader(const vtkParticleTextReader&) = delete;
@@ -152,7 +115,6 @@ private:
 
   template <typename Real>
   bool Parse(const char* data, size_t size, vtkPolyData* output);
-  void Fail(const std::string& message);
 };
 
 #endif

@@ -5,7 +5,7 @@
 // write past it). The reader must fail cleanly (an error naming the file)
 // or produce points whose arrays all have one tuple per point.
 #include "FuzzTempFile.h"
-#include "octorayPCDFormat.h"
+#include "octorayLZF.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkDataArray.h"

@@ -4,7 +4,7 @@
 // rgb/rgba packing, an organised cloud with NaN cells, each error by its
 // message, the previous output kept after a failure, abort, and random,
 // truncated and bit-flipped files that must give an error, never a crash.
-#include "octorayPCDFormat.h"
+#include "octorayLZF.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"

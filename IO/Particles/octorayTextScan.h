@@ -1,0 +1,64 @@
+// What the module's two text formats, particle text and PCD, share: which
+// bytes are blanks, and how a token is shown in an error message. VTK-free,
+// like the format headers that include it (the fuzz targets call them
+// without VTK). Private to the module; not wrapped.
+#ifndef octorayTextScan_h
+#define octorayTextScan_h
+
+#include <cstdio>
+#include <string>
+
+namespace octoray
+{
+// Field separators of both formats; '\r' too, so CRLF line ends read as LF.
+inline bool IsBlank(char c)
+{
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+// The first byte of [p, e) that is no blank, or e.
+inline const char* SkipBlanks(const char* p, const char* e)
+{
+  while (p < e && IsBlank(*p))
+  {
+    ++p;
+  }
+  return p;
+}
+
+// [b, e) for a message: at most 40 characters (longer ones end in "..."),
+// bytes that are not printable ASCII written as \xNN, so that binary garbage
+// gives a readable, bounded message.
+inline std::string Printable(const char* b, const char* e)
+{
+  const bool cut = e - b > 40;
+  const char* stop = cut ? b + 37 : e;
+  std::string t;
+  for (const char* c = b; c < stop; ++c)
+  {
+    const unsigned char u = static_cast<unsigned char>(*c);
+    if (u >= 0x20 && u < 0x7f)
+    {
+      t += *c;
+    }
+    else
+    {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\x%02x", u);
+      t += buf;
+    }
+  }
+  if (cut)
+  {
+    t += "...";
+  }
+  return t;
+}
+
+inline std::string Printable(const std::string& s)
+{
+  return Printable(s.data(), s.data() + s.size());
+}
+} // namespace octoray
+
+#endif
