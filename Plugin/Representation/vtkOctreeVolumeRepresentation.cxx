@@ -33,6 +33,9 @@
 #include "vtkVolumeProperty.h"
 
 #include <algorithm> // for std::copy
+#include <string>
+
+#include <dlfcn.h>
 
 namespace
 {
@@ -181,6 +184,34 @@ vtkSmartPointer<vtkUnstructuredGrid> PointCloudPiece(vtkPointSet* input)
 }
 
 vtkStandardNewMacro(vtkOctreeVolumeRepresentation);
+
+namespace
+{
+// ParaView 5.11's ranks exchange data as XML whose binary part VTK 9.2's
+// parser leaves to expat to skip; a libexpat that defers reparsing (expat
+// 2.6, and Debian 12's libexpat1 2.5.0-1+deb12u2 and later) does not, and
+// every exchange fails. Plugin/ExpatCompat, preloaded, turns the deferral off
+// and says so by a symbol. Returns the preload's path when it is needed and
+// missing, else an empty string.
+std::string MissingExpatCompat()
+{
+  if (!dlsym(RTLD_DEFAULT, "XML_SetReparseDeferralEnabled") ||
+    dlsym(RTLD_DEFAULT, "octoray_expat_reparse_deferral_off"))
+  {
+    return std::string();
+  }
+  // Beside the plugin's build: lib/paraview-5.11/plugins/Octoray/Octoray.so.
+  Dl_info self;
+  std::string dir = dladdr(reinterpret_cast<void*>(&MissingExpatCompat), &self) && self.dli_fname
+    ? self.dli_fname
+    : "lib/paraview-5.11/plugins/Octoray/Octoray.so";
+  for (int up = 0; up < 4 && dir.find('/') != std::string::npos; ++up)
+  {
+    dir.erase(dir.rfind('/'));
+  }
+  return dir + "/liboctorayExpatCompat.so";
+}
+}
 
 // A warning said by the first rank only: every rank runs the representation
 // with the same settings and data types, and the first rank's messages are
@@ -402,6 +433,14 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
           << " ranks the points are redistributed into disjoint pieces and blended in order; "
              "each piece has its own octree, so voxels along the cuts may differ from a "
              "one-rank picture. The surface modes composite exactly.");
+        const std::string compat = MissingExpatCompat();
+        if (!compat.empty())
+        {
+          vtkWarningOnFirstRankMacro("Octree Volume: this libexpat defers reparsing (Debian 12's "
+            "libexpat1 2.5.0-1+deb12u2 and later), and ParaView 5.11's ranks then cannot exchange "
+            "data: the redistribution fails and ranks draw nothing. Start ParaView with LD_PRELOAD="
+            << compat << " (see the README's ParaView section).");
+        }
       }
     }
     else if (this->IsTranslucentBlendMode() && ranks > 1 && !this->OrderWarningIssued)
