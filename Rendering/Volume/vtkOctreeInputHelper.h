@@ -8,8 +8,8 @@
  * which arrays play which part (colours or scalars, reflectivity,
  * refraction, normals), turns them into an octoray::PointCloudView (the
  * caller's arrays where their layout allows, converted host copies
- * otherwise; image voxels above the background become points), and
- * compares the input with what the current octree was built from: nothing
+ * otherwise; image voxels above the background become points), chooses
+ * the octree's cube and depth for images (Options), and compares the input with what the current octree was built from: nothing
  * changed, only the point positions moved (an in-place update), or
  * anything else (a build).
  */
@@ -18,6 +18,7 @@
 
 #include "vtkType.h" // for vtkIdType, vtkMTimeType
 
+#include <octoray/Octree.h>     // for octoray::BuildOptions
 #include <octoray/PointCloud.h> // for the views
 
 #include <array>      // for std::array
@@ -55,6 +56,7 @@ public:
     vtkDataArray* Normals = nullptr;
     bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
     double ImageBackground = 0.0;
+    bool ImageGradientNormals = true; // image input: normals from the scalar gradient
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
     unsigned long EngineGeneration = 0; // a new engine holds no octree
@@ -76,6 +78,19 @@ public:
    * (count 0) when an image has no voxel above the background.
    */
   octoray::PointCloudView PointCloud(const Request& request, const std::function<void(double)>& progress);
+
+  /**
+   * The engine's build options for `request`: LeafDepth and RootBounds as
+   * the mapper has them. An image's voxels are boxes of its spacing, not
+   * points: without RootBounds its cube is fitted to those boxes, and with
+   * LeafDepth 0 the depth is chosen from the spacing, the leaf the smallest
+   * spacing exactly (the cube is then 2^depth smallest spacings wide, so
+   * that voxel centres are leaf centres along the finest axes). Along an
+   * axis whose spacing is wider than a leaf (the slice distance of a CT),
+   * PointCloud puts a voxel's value at several points across its box, so
+   * the octree has no empty layers between slices.
+   */
+  octoray::BuildOptions Options(const Request& request) const;
 
   /**
    * The moved positions for Engine::Update (Change::Positions).
@@ -124,6 +139,15 @@ private:
 
   void PointSetView(const Request& request, octoray::PointCloudView& view);
   void ImageView(const Request& request, octoray::PointCloudView& view, const std::function<void(double)>& progress);
+
+  // An image's grid as the octree sees it (Options): the cube, the depth,
+  // and how many points each voxel becomes along each axis.
+  struct ImageLayout
+  {
+    octoray::BuildOptions Options;
+    int Split[3] = { 1, 1, 1 };
+  };
+  static ImageLayout Layout(const Request& request);
   void FindScalarRange(const octoray::PointCloudView& view);
 
   bool Built = false;

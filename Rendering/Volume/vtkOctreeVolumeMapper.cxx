@@ -79,6 +79,7 @@ public:
   vtkOctreeInputHelper Input;
   vtkOctreeCompositor Compositor;
   unsigned long OctreeVersion = 0; // bumped by every build and update
+  int Depth = 0;                    // leaf level of the last build
   bool CellScalarsWarned = false;
   bool InteropUnusable = false; // said once; the host path from then on
 
@@ -221,20 +222,13 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     return Step::Stop;
   }
   self->UpdateProgress(0.5);
-  octoray::BuildOptions options;
-  options.depth = request.LeafDepth;
-  if (vtkMath::AreBoundsInitialized(request.RootBounds.data()))
-  {
-    // The caller's cube (e.g. global bounds over parallel ranks): the same
-    // voxel grid on every rank.
-    const double* b = request.RootBounds.data();
-    const double lo[3] = { b[0], b[2], b[4] }, hi[3] = { b[1], b[3], b[5] };
-    options.fixedCube = true;
-    options.cube = octoray::RootCube::FromBounds(lo, hi);
-  }
-  const Step step = this->Run("build", [&] { this->Backend.Engine()->Build(view, options); });
+  // LeafDepth and RootBounds; for an image, the cube and depth of its voxel grid.
+  const octoray::BuildOptions options = this->Input.Options(request);
+  octoray::BuildStats stats;
+  const Step step = this->Run("build", [&] { stats = this->Backend.Engine()->Build(view, options); });
   if (step == Step::Done)
   {
+    this->Depth = stats.depth;
     this->Input.Remember(request);
     ++this->OctreeVersion;
     ++self->NumberOfBuilds;
@@ -634,6 +628,12 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
 }
 
 //------------------------------------------------------------------------------
+int vtkOctreeVolumeMapper::GetOctreeDepth()
+{
+  return this->Internals->Input.HasOctree() ? this->Internals->Depth : 0;
+}
+
+//------------------------------------------------------------------------------
 double vtkOctreeVolumeMapper::GetLeafSize()
 {
   octoray::Engine* engine = this->Internals->Backend.Engine();
@@ -674,6 +674,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DepthCue: " << this->DepthCue << "\n";
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "ImageBackground: " << this->ImageBackground << "\n";
+  os << indent << "ImageGradientNormals: " << (this->ImageGradientNormals ? "on" : "off") << "\n";
   os << indent << "ReflectivityArrayName: "
      << (this->ReflectivityArrayName ? this->ReflectivityArrayName : "(none)") << "\n";
   os << indent << "RefractionArrayName: "

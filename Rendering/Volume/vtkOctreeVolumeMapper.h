@@ -218,10 +218,26 @@ public:
   ///@{
   /**
    * vtkImageData input: voxels whose value (the largest component) is at or
-   * below this become no point. Default 0.
+   * below this become no point. Default 0. A voxel is a box of the image's
+   * spacing: with LeafDepth 0 the leaf is the finest spacing, and along
+   * wider axes (the slice distance of a CT) each voxel becomes as many
+   * points as it spans leaves, so the octree has no gaps between slices.
    */
   vtkSetMacro(ImageBackground, double);
   vtkGetMacro(ImageBackground, double);
+  ///@}
+
+  ///@{
+  /**
+   * vtkImageData input with one-component scalars: give each voxel the
+   * normal of the scalar field, the negated gradient by central differences
+   * (as VTK's volume mappers shade), so that shaded surfaces follow the
+   * tissue rather than the voxels' faces. On by default; off, the octree's
+   * occupancy gives the normals.
+   */
+  vtkSetMacro(ImageGradientNormals, bool);
+  vtkGetMacro(ImageGradientNormals, bool);
+  vtkBooleanMacro(ImageGradientNormals, bool);
   ///@}
 
   ///@{
@@ -287,6 +303,12 @@ public:
   double GetLeafSize();
 
   /**
+   * The leaf level of the current octree: LeafDepth, or the level chosen
+   * from the data when LeafDepth is 0 (0 before the first render).
+   */
+  int GetOctreeDepth();
+
+  /**
    * Number of points the current octree holds.
    */
   vtkIdType GetNumberOfOctreePoints();
@@ -320,6 +342,7 @@ protected:
   double DepthCue = 0.0;
   double ImageSampleDistance = 1.0;
   double ImageBackground = 0.0;
+  bool ImageGradientNormals = true;
   char* ReflectivityArrayName = nullptr;
   char* RefractionArrayName = nullptr;
   vtkIdType CudaMemoryBudget = 0;
