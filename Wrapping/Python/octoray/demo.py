@@ -61,28 +61,6 @@ def scaled(size, scale):
     return tuple(max(32, int(round(s * scale))) for s in size)
 
 
-def visible_bounds(image, threshold):
-    """Bounds of the voxels above `threshold` (what the camera should frame)."""
-    values = vtk_to_numpy(image.GetPointData().GetScalars())
-    nx, ny, nz = image.GetDimensions()
-    above = (values > threshold).reshape(nz, ny, nx)
-    if not above.any():
-        return image.GetBounds()
-    ks, js, is_ = (np.nonzero(above.any(axis=axes))[0] for axes in ((1, 2), (0, 2), (0, 1)))
-    lo, hi = [0.0] * 3, [0.0] * 3
-    e = image.GetExtent()
-    corners = []
-    for i in (is_[0] - 0.5, is_[-1] + 0.5):
-        for j in (js[0] - 0.5, js[-1] + 0.5):
-            for k in (ks[0] - 0.5, ks[-1] + 0.5):
-                p = [0.0, 0.0, 0.0]
-                image.TransformContinuousIndexToPhysicalPoint(e[0] + i, e[2] + j, e[4] + k, p)
-                corners.append(p)
-    c = np.array(corners)
-    lo, hi = c.min(axis=0), c.max(axis=0)
-    return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
-
-
 def render_octree(ren, window, mapper):
     """The first render (build and trace); returns its wall time."""
     with scene.Timer() as t:
@@ -150,7 +128,7 @@ def head_ct(args, timings, pictures):
         volume.SetProperty(prop)
         ren, window = new_view(size)
         ren.AddVolume(volume)
-        bounds = visible_bounds(image, threshold)
+        bounds = scene.visible_bounds(image, threshold)
         scene.look_at(ren, bounds, front, up, azimuth, elevation, zoom)
         wall = render_octree(ren, window, mapper)
         path = os.path.join(args.out, "ct-%s.png" % preset[3:])

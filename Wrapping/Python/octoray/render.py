@@ -59,7 +59,8 @@ def parse_size(text):
 
 
 def parser():
-    p = argparse.ArgumentParser(prog="python3 -m octoray.render", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="python3 -m octoray.render", description=__doc__.splitlines()[0],
+                                epilog=__doc__.split("\n\n", 2)[2], formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("input")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.add_argument("--backend", choices=["auto", "cuda", "cpu"], default="auto")
@@ -182,7 +183,8 @@ def main(argv=None):
     window.SetSize(*args.size)
     window.AddRenderer(ren)
     front, up = scene.default_view(data, kind, reader)
-    scene.look_at(ren, data.GetBounds(), front, up, args.azimuth, args.elevation, args.zoom)
+    bounds = scene.visible_bounds(data, mapper.GetImageBackground()) if image else data.GetBounds()
+    scene.look_at(ren, bounds, front, up, args.azimuth, args.elevation, args.zoom)
 
     # ---- Build and render: the first render builds the octree.
     with scene.Timer() as first:

@@ -290,6 +290,32 @@ def look_at(renderer, bounds, front, up, azimuth=0.0, elevation=0.0, zoom=1.0, v
     return cam
 
 
+def visible_bounds(image, threshold):
+    """Bounds of the voxels above `threshold` (what the camera should frame)."""
+    scalars = image.GetPointData().GetScalars()
+    if scalars is None:
+        return image.GetBounds()
+    values = vtk_to_numpy(scalars)
+    if values.ndim > 1:
+        values = values.max(axis=1)  # as the mapper: the largest component
+    nx, ny, nz = image.GetDimensions()
+    above = (values > threshold).reshape(nz, ny, nx)
+    if not above.any():
+        return image.GetBounds()
+    ks, js, is_ = (np.nonzero(above.any(axis=axes))[0] for axes in ((1, 2), (0, 2), (0, 1)))
+    e = image.GetExtent()
+    corners = []
+    for i in (is_[0] - 0.5, is_[-1] + 0.5):
+        for j in (js[0] - 0.5, js[-1] + 0.5):
+            for k in (ks[0] - 0.5, ks[-1] + 0.5):
+                p = [0.0, 0.0, 0.0]
+                image.TransformContinuousIndexToPhysicalPoint(e[0] + i, e[2] + j, e[4] + k, p)
+                corners.append(p)
+    c = np.array(corners)
+    lo, hi = c.min(axis=0), c.max(axis=0)
+    return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+
+
 def default_view(data, kind, reader=None):
     """(front, up) for the kind of data: a DICOM CT in patient coordinates
     (LPS: anterior is -y, superior +z) is seen from the front, head up; a
