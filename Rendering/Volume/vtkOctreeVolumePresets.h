@@ -31,8 +31,8 @@
  * vtkOctreeVolumeMapper's surface mode draws the first voxel a ray meets,
  * whatever its opacity, so the octree should hold only the voxels the
  * preset makes visible. GetSurfaceThreshold() gives that value: the lowest
- * value at which the preset's opacity reaches half of its maximum (ct-bone
- * about 300 HU, ct-skin -750 HU, ct-muscle about 30 HU). Use it as the
+ * value at which the preset's opacity reaches half of its maximum, in steps
+ * of 1 HU (ct-bone 306 HU, ct-skin -750 HU, ct-muscle 34 HU). Use it as the
  * mapper's ImageBackground for image input (or as the upper end of
  * vtkSliceStackReader's BackgroundRange for its particles).
  *
