@@ -2,7 +2,7 @@
 #   make demo   install what is missing, fetch the data, build, run the main job on bundled data
 #   make test   install what is missing, fetch the data, build, run every test
 # and `make bench` for the benchmarks (JSON into build/bench-results.json),
-# `make report` for Testing/Bench/RESULTS.md with its CSV files and plots.
+# `make report` for Benchmarks/RESULTS.md with its CSV files and plots.
 
 BUILD ?= build
 JOBS ?= $(shell nproc)
@@ -91,13 +91,13 @@ demo: build data
 bench: build
 	cd $(BUILD) && $(XVFB) ctest --verbose -L bench
 
-# Issue 7: regenerates Testing/Bench/RESULTS.md, its CSV files and plots
-# (Testing/Bench/report/) and the README's summary table from scratch on this
-# machine; GPU rows come from the committed GPU run in Testing/Bench/gpu/.
+# Issue 7: regenerates Benchmarks/RESULTS.md, its CSV files and plots
+# (Benchmarks/report/) and the README's summary table from scratch on this
+# machine; GPU rows come from the committed GPU run in Benchmarks/gpu/.
 # REPORT_ARGS, e.g. --only quality, to redo some sections.
 REPORT_ARGS ?=
 report: build
-	/usr/bin/python3 Testing/Report/make_report.py --build $(BUILD) $(REPORT_ARGS)
+	/usr/bin/python3 Benchmarks/Report/make_report.py --build $(BUILD) $(REPORT_ARGS)
 
 clean:
 	rm -rf $(BUILD)

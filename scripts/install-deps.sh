@@ -30,8 +30,9 @@ packages=(
   libopenimageio-dev openimageio-tools
   # DICOM series: image position, orientation and rescale through GDCM
   libgdcm-dev
-  # Python tests, rendering without a display
-  python3-pytest python3-numpy xvfb
+  # Python tests, rendering without a display (xvfb-run needs xauth, which
+  # xvfb only recommends)
+  python3-pytest python3-numpy xvfb xauth
   # reliability (issue 8): the ASan+UBSan build and the libFuzzer targets
   # (clang with its sanitizer and fuzzer runtimes; OpenMP for clang)
   clang-14 libclang-rt-14-dev libomp-14-dev

@@ -3,7 +3,11 @@
 #include "octorayDicomCheck.h"
 #include "octorayNaturalSort.h"
 
+#include <octorayLattice.h>
+
 #include "vtkCellArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
@@ -35,6 +39,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -137,28 +142,42 @@ inline unsigned char ToByte(T v)
   }
 }
 
-struct Selection
-{
-  int Lo[3], Hi[3], Step[3];
-  vtkIdType Dims[3];
-};
-
-// Two passes over the slices: count the particles of each slice, then fill
-// them at their offsets, so the output keeps slice order and needs no locks.
+// An interpolated colour channel to 8 bits: rounded to the channel's own
+// type first, so a sample on a slice gives exactly the slice's byte.
 template <typename T>
-void Extract(const T* data, int comps, const Selection& sel, const double bg[2],
-  const double origin[3], const double spacing[3], const double dir[9], vtkPolyData* output,
-  bool vertices)
+inline unsigned char InterpolatedToByte(double v)
 {
-  const int nk = (sel.Hi[2] - sel.Lo[2]) / sel.Step[2] + 1;
-  auto intensity = [&](const T* px) -> double {
+  if constexpr (std::is_integral<T>::value)
+  {
+    const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+    const double hi = static_cast<double>(std::numeric_limits<T>::max());
+    return ToByte(static_cast<T>(std::lround(std::clamp(v, lo, hi))));
+  }
+  else
+  {
+    return ToByte(static_cast<T>(v));
+  }
+}
+
+// The particles of the selected samples (octorayLattice.h: the selected
+// pixels and, with filling, the planes interpolated between slices), in
+// two passes over the planes: count the particles of each plane, then fill
+// them at their offsets, so the output keeps plane order and needs no locks.
+template <typename T>
+void Extract(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
+  const double bg[2], const octoray::lattice::Lattice& lattice, vtkPolyData* output, bool vertices)
+{
+  const vtkIdType nk = static_cast<vtkIdType>(axes[2].Samples());
+  // Grey, or the mean of R, G, B; background by intensity range or alpha 0
+  // (an interpolated alpha is 0 only between two transparent pixels).
+  auto intensity = [&](const double* px) -> double {
     if (comps >= 3)
     {
-      return (static_cast<double>(px[0]) + px[1] + px[2]) / 3.0;
+      return (px[0] + px[1] + px[2]) / 3.0;
     }
-    return static_cast<double>(px[0]);
+    return px[0];
   };
-  auto isParticle = [&](const T* px) -> bool {
+  auto isParticle = [&](const double* px) -> bool {
     if ((comps == 2 && px[1] == 0) || (comps == 4 && px[3] == 0))
     {
       return false;
@@ -166,22 +185,14 @@ void Extract(const T* data, int comps, const Selection& sel, const double bg[2],
     const double v = intensity(px);
     return !(v >= bg[0] && v <= bg[1]);
   };
-  auto at = [&](int i, int j, int k) {
-    return data + comps * (i + sel.Dims[0] * (j + sel.Dims[1] * static_cast<vtkIdType>(k)));
-  };
   std::vector<vtkIdType> counts(nk + 1, 0);
   vtkSMPTools::For(0, nk, [&](vtkIdType b, vtkIdType e) {
+    double values[4];
     for (vtkIdType s = b; s < e; ++s)
     {
-      const int k = sel.Lo[2] + static_cast<int>(s) * sel.Step[2];
       vtkIdType n = 0;
-      for (int j = sel.Lo[1]; j <= sel.Hi[1]; j += sel.Step[1])
-      {
-        for (int i = sel.Lo[0]; i <= sel.Hi[0]; i += sel.Step[0])
-        {
-          n += isParticle(at(i, j, k));
-        }
-      }
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, s, values,
+        [&](long long, long long, const double* px) { n += isParticle(px); });
       counts[s + 1] = n;
     }
   });
@@ -206,36 +217,32 @@ void Extract(const T* data, int comps, const Selection& sel, const double bg[2],
   float* sc = scalars->GetPointer(0);
   unsigned char* co = colors ? colors->GetPointer(0) : nullptr;
   vtkSMPTools::For(0, nk, [&](vtkIdType b, vtkIdType e) {
+    double values[4];
     for (vtkIdType s = b; s < e; ++s)
     {
-      const int k = sel.Lo[2] + static_cast<int>(s) * sel.Step[2];
       vtkIdType n = counts[s];
-      for (int j = sel.Lo[1]; j <= sel.Hi[1]; j += sel.Step[1])
-      {
-        for (int i = sel.Lo[0]; i <= sel.Hi[0]; i += sel.Step[0])
-        {
-          const T* px = at(i, j, k);
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, s, values,
+        [&](long long r0, long long r1, const double* px) {
           if (!isParticle(px))
           {
-            continue;
+            return;
           }
-          const double l[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
+          double xyz[3];
+          lattice.Position(r0, r1, s, xyz);
           for (int a = 0; a < 3; ++a)
           {
-            p[3 * n + a] =
-              static_cast<float>(origin[a] + dir[3 * a] * l[0] + dir[3 * a + 1] * l[1] + dir[3 * a + 2] * l[2]);
+            p[3 * n + a] = static_cast<float>(xyz[a]);
           }
           sc[n] = static_cast<float>(intensity(px));
           if (co)
           {
             for (int c = 0; c < 3; ++c)
             {
-              co[3 * n + c] = ToByte(px[c]);
+              co[3 * n + c] = InterpolatedToByte<T>(px[c]);
             }
           }
           ++n;
-        }
-      }
+        });
     }
   });
   auto points = vtkSmartPointer<vtkPoints>::New();
@@ -903,31 +910,53 @@ void vtkSliceStackReader::MakeParticles(vtkImageData* image, vtkPolyData* output
 {
   int dims[3];
   image->GetDimensions(dims);
-  Selection sel;
+  octoray::lattice::Axis axes[3];
+  const long long size[3] = { dims[0], dims[1], dims[2] };
   for (int a = 0; a < 3; ++a)
   {
-    int lo = this->RegionOfInterest[2 * a];
-    int hi = this->RegionOfInterest[2 * a + 1];
-    sel.Lo[a] = lo < 0 ? 0 : std::min(lo, dims[a] - 1);
-    sel.Hi[a] = hi < 0 ? dims[a] - 1 : std::min(hi, dims[a] - 1);
-    sel.Step[a] = std::max(1, this->Stride[a]);
-    sel.Dims[a] = dims[a];
+    const int lo = this->RegionOfInterest[2 * a];
+    const int hi = this->RegionOfInterest[2 * a + 1];
+    const int first = lo < 0 ? 0 : std::min(lo, dims[a] - 1);
+    const int last = hi < 0 ? dims[a] - 1 : std::min(hi, dims[a] - 1);
+    if (last < first)
+    {
+      output->SetPoints(vtkSmartPointer<vtkPoints>::New());
+      return;
+    }
+    axes[a].First = first;
+    axes[a].Stride = std::max(1, this->Stride[a]);
+    axes[a].Count = (last - first) / axes[a].Stride + 1;
   }
-  double dir[9];
-  const double* m = image->GetDirectionMatrix()->GetData();
-  std::copy(m, m + 9, dir);
-  const int comps = image->GetNumberOfScalarComponents();
-  if (sel.Hi[0] < sel.Lo[0] || sel.Hi[1] < sel.Lo[1] || sel.Hi[2] < sel.Lo[2])
+  const double* spacing = image->GetSpacing();
+  if (this->FillBetweenSlices)
   {
-    output->SetPoints(vtkSmartPointer<vtkPoints>::New());
-    return;
+    // Planes between the slices, so that the particles are no farther apart
+    // along the slice axis than across it (octorayLattice.h).
+    const double step[3] = { spacing[0] * axes[0].Stride, spacing[1] * axes[1].Stride,
+      spacing[2] * axes[2].Stride };
+    const long long count[3] = { axes[0].Count, axes[1].Count, axes[2].Count };
+    int fill[3];
+    octoray::lattice::FillFactors(step, count, fill);
+    for (int a = 0; a < 3; ++a)
+    {
+      axes[a].Fill = fill[a];
+    }
   }
+  const octoray::lattice::Lattice lattice = octoray::lattice::LatticeOf(
+    axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
+  const int comps = image->GetNumberOfScalarComponents();
   switch (image->GetScalarType())
   {
-    vtkTemplateMacro(Extract(static_cast<const VTK_TT*>(image->GetScalarPointer()), comps, sel,
-      this->BackgroundRange, image->GetOrigin(), image->GetSpacing(), dir, output,
-      this->GenerateVertices));
+    vtkTemplateMacro(Extract(static_cast<const VTK_TT*>(image->GetScalarPointer()), comps, axes, size,
+      this->BackgroundRange, lattice, output, this->GenerateVertices));
   }
+  // The lattice of the particles, for the octree mapper's leaf grid.
+  auto field = vtkSmartPointer<vtkDoubleArray>::New();
+  field->SetName(octoray::lattice::kFieldArrayName);
+  field->SetNumberOfComponents(octoray::lattice::kFieldArrayComponents);
+  field->SetNumberOfTuples(1);
+  octoray::lattice::ToTuple(lattice, field->GetPointer(0));
+  output->GetFieldData()->AddArray(field);
 }
 
 //------------------------------------------------------------------------------
@@ -1061,5 +1090,6 @@ void vtkSliceStackReader::PrintSelf(ostream& os, vtkIndent indent)
   os << "\n" << indent << "Stride: " << this->Stride[0] << " " << this->Stride[1] << " "
      << this->Stride[2] << "\n";
   os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
+  os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
   os << indent << "IsDICOM: " << this->IsDICOM << "\n";
 }

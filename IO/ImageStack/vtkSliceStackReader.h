@@ -27,6 +27,35 @@
  * A region of interest (in pixel indices of the stack) and a stride pick the
  * pixels that are looked at.
  *
+ * Closed volume (FillBetweenSlices, on by default). The slices of a stack
+ * are usually farther apart than its pixels (1.5 mm against 0.96 mm in a
+ * typical head CT, 3-5 times in many clinical CTs); particles on the slices
+ * alone, drawn as octree voxels of the pixel size, are plates with
+ * see-through gaps between them. So the reader fills the space between
+ * neighbouring (selected) slices with planes of particles whose values are
+ * interpolated linearly from the two slices, as many as make the particles
+ * no farther apart along the slice axis than across it (more precisely:
+ * the coarsest axis is filled down to the second-coarsest spacing; see
+ * octorayLattice.h, the rule the octree mapper follows for a vtkImageData
+ * too). The background test applies to the interpolated values, so an
+ * object's surface between two slices lies where its interpolated intensity
+ * crosses BackgroundRange. The particles of the slices themselves are the
+ * same as without filling (same positions and values); the others lie
+ * between them, in plane order. Filling multiplies the number of particles
+ * by about the ratio of slice to pixel spacing (2 for the head CT), at most
+ * by 32. Off, the particles are those of the slices only (the reader's
+ * output before filling existed).
+ *
+ * Either way, output 0 names the lattice its particles lie on in a
+ * field-data array "PointLattice" (15 doubles: origin, the three step
+ * vectors, the sample counts; octorayLattice.h). vtkOctreeVolumeMapper,
+ * with LeafDepth 0 (automatic), then makes its leaves exactly as large as
+ * the largest step and aligns them with the lattice, so that no leaf inside
+ * an object is empty: with filling the leaves are the pixel size; without,
+ * the slice spacing (closed too, but coarser). A filter that moves the
+ * points keeps the array, but the mapper checks the points against it and
+ * ignores it when they are off the lattice.
+ *
  * Output 1 (vtkImageData): the whole stack with the slices' own pixel type
  * (or float for rescaled DICOM), so VTK's volume mappers can draw the same data.
  * Its whole extent is announced in RequestInformation (from the headers).
@@ -108,6 +137,15 @@ public:
   ///@}
 
   ///@{
+  /// Fill the space between slices with particles interpolated from the two
+  /// neighbouring slices, so that the particles draw as a closed volume
+  /// (default on; see the class description).
+  vtkSetMacro(FillBetweenSlices, bool);
+  vtkGetMacro(FillBetweenSlices, bool);
+  vtkBooleanMacro(FillBetweenSlices, bool);
+  ///@}
+
+  ///@{
   /// One VTK_VERTEX per particle (default on).
   vtkSetMacro(GenerateVertices, bool);
   vtkGetMacro(GenerateVertices, bool);
@@ -152,6 +190,7 @@ protected:
   int RegionOfInterest[6] = { -1, -1, -1, -1, -1, -1 };
   int Stride[3] = { 1, 1, 1 };
   bool GenerateVertices = true;
+  bool FillBetweenSlices = true;
   bool IsDICOM = false;
   std::string ErrorMessage;
   std::vector<std::string> SliceFiles;

@@ -402,6 +402,75 @@ inline Prologue ParsePrologue(const char* data, size_t size, const std::string& 
   return r;
 }
 
+// Whether the start of a file is particle text, for CanReadFile (a reader
+// factory choosing among the readers of an ambiguous extension such as .txt
+// or .csv): the prologue parses as the reader parses it (comments, a header
+// line naming x, y and z, or a first data line of 3, 4, 6 or 8 columns), and
+// the first `lines` data lines each hold as many numbers as the layout has
+// columns. `complete` says the bytes are the whole file; otherwise a last
+// line without its newline is cut off there and not judged. `why` gets the
+// reason for a no.
+constexpr int SniffLines = 16;
+
+inline bool LooksLikeParticleText(
+  const char* data, size_t size, bool complete, std::string* why = nullptr, int lines = SniffLines)
+{
+  auto no = [why](std::string reason) {
+    if (why)
+    {
+      *why = std::move(reason);
+    }
+    return false;
+  };
+  if (!complete)
+  {
+    size_t whole = size;
+    while (whole > 0 && data[whole - 1] != '\n')
+    {
+      --whole;
+    }
+    if (whole == 0)
+    {
+      return no("no whole line in the first " + std::to_string(size) + " bytes");
+    }
+    size = whole;
+  }
+  const Prologue pro = ParsePrologue(data, size, "file");
+  if (!pro.Ok)
+  {
+    return no(pro.Error);
+  }
+  const size_t columns = pro.Columns.size();
+  const char* const end = data + size;
+  const char* p = data + pro.FirstData;
+  long long line = pro.FirstDataLine;
+  for (int checked = 0; p < end && checked < lines; ++line)
+  {
+    const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(end - p)));
+    const char* e = nl ? nl : end;
+    const auto tokens = SplitTokens(p, e); // stops at a comment
+    if (!tokens.empty())
+    {
+      ++checked;
+      if (tokens.size() != columns)
+      {
+        return no("line " + std::to_string(line) + ": " + std::to_string(tokens.size()) +
+          " fields, expected " + std::to_string(columns) + " (" + pro.Layout + ")");
+      }
+      for (const auto& t : tokens)
+      {
+        if (!IsNumber(t.first))
+        {
+          return no("line " + std::to_string(line) + ": '" +
+            TokenAt(t.first.data(), t.first.data() + t.first.size()) + "' is not a number");
+        }
+      }
+    }
+    p = nl ? nl + 1 : end;
+  }
+  return true;
+}
+
 } // namespace ptext
 } // namespace octoray
 

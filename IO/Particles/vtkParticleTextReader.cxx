@@ -16,6 +16,7 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtk_zlib.h"
 
 #include <algorithm>
 #include <atomic>
@@ -32,6 +33,9 @@
 #include <sstream>
 #include <thread>
 #include <vector>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 vtkStandardNewMacro(vtkParticleTextReader);
 
@@ -208,6 +212,58 @@ int vtkParticleTextReader::RequestData(
   this->LastOutput = fresh;
   this->UpdateProgress(1.0);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkParticleTextReader::CanReadFile(const char* filename)
+{
+  if (!filename || !*filename)
+  {
+    return 0;
+  }
+  struct stat st;
+  if (::stat(filename, &st) != 0 || !S_ISREG(st.st_mode))
+  {
+    return 0;
+  }
+  const std::string name = filename;
+  auto endsWith = [&name](const char* tail) {
+    const size_t n = std::strlen(tail);
+    if (name.size() < n)
+    {
+      return false;
+    }
+    for (size_t i = 0; i < n; ++i)
+    {
+      if (std::tolower(static_cast<unsigned char>(name[name.size() - n + i])) != tail[i])
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  if (endsWith(".particles") || endsWith(".particles.gz"))
+  {
+    return ::access(filename, R_OK) == 0 ? 1 : 0;
+  }
+  // The first bytes of the text (inflated when the file is gzip data; gzread
+  // passes plain files through).
+  constexpr int sniffBytes = 1 << 16;
+  gzFile in = gzopen(filename, "rb");
+  if (!in)
+  {
+    return 0;
+  }
+  std::string head(sniffBytes + 1, '\0');
+  const int got = gzread(in, &head[0], sniffBytes + 1);
+  gzclose(in);
+  if (got <= 0)
+  {
+    return 0;
+  }
+  const bool complete = got <= sniffBytes;
+  head.resize(complete ? static_cast<size_t>(got) : static_cast<size_t>(sniffBytes));
+  return octoray::ptext::LooksLikeParticleText(head.data(), head.size(), complete) ? 1 : 0;
 }
 
 //------------------------------------------------------------------------------

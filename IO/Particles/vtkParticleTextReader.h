@@ -110,6 +110,20 @@ public:
   /// changes on disk, the next Update() reads it again.
   vtkMTimeType GetMTime() override;
 
+  /// Whether this reader reads the file, for a reader factory choosing among
+  /// the readers of one extension (ParaView's File › Open calls it on each
+  /// reader that claims the file's extension). 1 for a file named
+  /// `.particles` or `.particles.gz` that can be opened (the extension is
+  /// this reader's own, and reading it reports what is wrong, with line and
+  /// column). For any other name (`.txt`, `.csv`, `.xyz`, ...; gzip or not)
+  /// the content decides, by the format code the reader parses with: the
+  /// first 64 KiB must hold a prologue the reader accepts (comments, a
+  /// header line naming x, y and z, or 3, 4, 6 or 8 columns) and first data
+  /// lines of as many numbers as the layout has columns (up to 16 lines);
+  /// anything else (text columns, other column counts, binary data, an
+  /// empty or unreadable file) is 0.
+  static int CanReadFile(VTK_FILEPATH const char* filename);
+
 protected:
   vtkParticleTextReader();
   ~vtkParticleTextReader() override;

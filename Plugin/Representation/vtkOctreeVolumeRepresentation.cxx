@@ -1,34 +1,215 @@
 #include "vtkOctreeVolumeRepresentation.h"
 
 #include "vtkAlgorithmOutput.h"
+#include "vtkBoundingBox.h"
+#include "vtkCellArray.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkCommunicator.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDataSet.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkLODProp3D.h"
 #include "vtkLogger.h"
 #include "vtkMath.h"
 #include "vtkMatrix4x4.h"
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkOctreeVolumeMapper.h"
-#include "vtkOutlineSource.h"
-#include "vtkPiecewiseFunction.h"
 #include "vtkOutputWindow.h"
-#include "vtkPVLODVolume.h"
-#include "vtkPVRenderView.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPointSet.h"
+#include "vtkPolyData.h"
+#include "vtkPVLODVolume.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPVRenderView.h"
 #include "vtkRenderer.h"
+#include "vtkTable.h"
+#include "vtkTrivialProducer.h"
+#include "vtkUnstructuredGrid.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm> // for std::copy
 
+namespace
+{
+//----------------------------------------------------------------------------
+// The volume of the representation: ParaView's vtkPVLODVolume, except
+//
+// - that it lets vtkOctreeVolumeMapper draw without scalars.
+//   vtkPVLODVolume::CanRender skips any vtkVolumeMapper whose input has no
+//   scalar array selected ("volume mappers are notorious for segfaulting when
+//   the scalar array is missing"); the octree mapper is not: without scalars
+//   it draws the points' own colours or white, and with an empty input it
+//   draws nothing. So "Solid Color" (e.g. PLY points with normals only)
+//   draws, and a rank with an empty piece is simply empty;
+// - that its bounds hold the voxels, not only the points
+//   (vtkOctreeVolumeMapper::GetVoxelBounds: out to the leaf grid): IceT crops each
+//   rank's picture to the screen rectangle of the renderer's prop bounds
+//   (vtkIceTCompositePass: ComputeVisiblePropBounds, icetBoundingVertices),
+//   and the voxels around the outermost points reach past the points' bounds
+//   by up to a leaf, so with the points' bounds the parallel picture lost
+//   the edge voxels' outer halves. (The view's camera reset also takes the
+//   props' bounds: it frames the voxels, up to a leaf wider than the
+//   points.)
+class vtkOctreeLODVolume : public vtkPVLODVolume
+{
+public:
+  static vtkOctreeLODVolume* New();
+  vtkTypeMacro(vtkOctreeLODVolume, vtkPVLODVolume);
+
+  int RenderOpaqueGeometry(vtkViewport* vp) override
+  {
+    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderOpaqueGeometry)
+                               : this->Superclass::RenderOpaqueGeometry(vp);
+  }
+  int RenderTranslucentPolygonalGeometry(vtkViewport* vp) override
+  {
+    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderTranslucentPolygonalGeometry)
+                               : this->Superclass::RenderTranslucentPolygonalGeometry(vp);
+  }
+  int RenderVolumetricGeometry(vtkViewport* vp) override
+  {
+    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderVolumetricGeometry)
+                               : this->Superclass::RenderVolumetricGeometry(vp);
+  }
+
+  double* GetBounds() override
+  {
+    const int lod = this->SelectLOD();
+    auto* mapper =
+      lod >= 0 ? vtkOctreeVolumeMapper::SafeDownCast(this->LODProp->GetLODMapper(lod)) : nullptr;
+    if (!mapper)
+    {
+      return this->Superclass::GetBounds();
+    }
+    double cube[6];
+    mapper->GetVoxelBounds(cube);
+    vtkMath::UninitializeBounds(this->Bounds);
+    if (!vtkMath::AreBoundsInitialized(cube))
+    {
+      return this->Bounds;
+    }
+    // The corners through the volume's matrix (position, scale, ...).
+    vtkBoundingBox box;
+    vtkMatrix4x4* matrix = this->GetMatrix();
+    for (int corner = 0; corner < 8; ++corner)
+    {
+      double p[4] = { cube[corner & 1], cube[2 + ((corner >> 1) & 1)],
+        cube[4 + ((corner >> 2) & 1)], 1.0 };
+      matrix->MultiplyPoint(p, p);
+      box.AddPoint(p[0] / p[3], p[1] / p[3], p[2] / p[3]);
+    }
+    box.GetBounds(this->Bounds);
+    return this->Bounds;
+  }
+
+protected:
+  vtkOctreeLODVolume() = default;
+  ~vtkOctreeLODVolume() override = default;
+
+private:
+  vtkOctreeLODVolume(const vtkOctreeLODVolume&) = delete;
+  void operator=(const vtkOctreeLODVolume&) = delete;
+
+  // The LOD chosen for this frame (by SetAllocatedRenderTime) is the octree.
+  bool DrawsOctree()
+  {
+    const int lod = this->LODProp->GetSelectedLODID();
+    return lod >= 0 && vtkOctreeVolumeMapper::SafeDownCast(this->LODProp->GetLODMapper(lod));
+  }
+  // As vtkPVLODVolume's passes, less CanRender.
+  int Draw(vtkViewport* vp, int (vtkLODProp3D::*pass)(vtkViewport*))
+  {
+    const int drawn = (this->LODProp->*pass)(vp);
+    this->EstimatedRenderTime = this->LODProp->GetEstimatedRenderTime();
+    return drawn;
+  }
+};
+vtkStandardNewMacro(vtkOctreeLODVolume);
+
+//----------------------------------------------------------------------------
+// The points of a point set as a vtkUnstructuredGrid with one vertex cell per
+// point, the piece the view redistributes before ordered compositing
+// (vtkOrderedCompositeDistributor, a vtkRedistributeDataSetFilter with the
+// view's k-d tree cuts):
+// - the filter moves cells, so points that no cell uses (a point cloud
+//   without vertex cells) would be lost, and the points of a mesh's faces
+//   would be duplicated along the cuts; with one vertex per point every
+//   point goes to exactly one rank;
+// - an unstructured grid, not polydata: the distributor turns redistributed
+//   polydata back into polydata with vtkDataSetSurfaceFilter, which
+//   dereferences the points of its input, and a rank that receives no cell
+//   gets a grid without points (ParaView 5.11 then crashes with SIGSEGV in
+//   vtkDataSetSurfaceFilter::UnstructuredGridExecuteInternal); an
+//   unstructured grid is passed on as it is.
+// Point data and field data are shallow copies; the octree uses neither
+// cells nor cell data.
+vtkSmartPointer<vtkUnstructuredGrid> PointCloudPiece(vtkPointSet* input)
+{
+  auto cloud = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  if (input->GetPoints())
+  {
+    cloud->SetPoints(input->GetPoints());
+  }
+  else
+  {
+    vtkNew<vtkPoints> none;
+    cloud->SetPoints(none);
+  }
+  const vtkIdType n = input->GetNumberOfPoints();
+  vtkNew<vtkIdTypeArray> offsets;
+  vtkNew<vtkIdTypeArray> connectivity;
+  offsets->SetNumberOfValues(n + 1);
+  connectivity->SetNumberOfValues(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    offsets->SetValue(i, i);
+    connectivity->SetValue(i, i);
+  }
+  offsets->SetValue(n, n);
+  vtkNew<vtkCellArray> verts;
+  verts->SetData(offsets, connectivity);
+  cloud->SetCells(VTK_VERTEX, verts);
+  cloud->GetPointData()->ShallowCopy(input->GetPointData());
+  cloud->GetFieldData()->ShallowCopy(input->GetFieldData());
+  return cloud;
+}
+}
+
 vtkStandardNewMacro(vtkOctreeVolumeRepresentation);
+
+// A warning said by the first rank only: every rank runs the representation
+// with the same settings and data types, and the first rank's messages are
+// the ones a ParaView client shows (pvbatch prints every rank's).
+#define vtkWarningOnFirstRankMacro(x)                                                              \
+  do                                                                                               \
+  {                                                                                                \
+    vtkMultiProcessController* firstRankController =                                               \
+      vtkMultiProcessController::GetGlobalController();                                            \
+    if (!firstRankController || firstRankController->GetLocalProcessId() == 0)                     \
+    {                                                                                              \
+      vtkWarningMacro(x);                                                                          \
+    }                                                                                              \
+  } while (false)
 
 //----------------------------------------------------------------------------
 vtkOctreeVolumeRepresentation::vtkOctreeVolumeRepresentation()
 {
+  this->Actor = vtkSmartPointer<vtkOctreeLODVolume>::New();
+  this->Actor->SetProperty(this->Property);
+  // The volume keeps its mapper on every rank, whatever the rank holds
+  // (ParaView's volume representations do the same): vtkPVLODVolume reports
+  // "You must give me a mapper!" and vtkLODProp3D then crashes when a
+  // visible volume has none. Where there is nothing to draw, the mapper's
+  // input is an empty vtkPolyData.
+  vtkNew<vtkPolyData> empty;
+  this->EmptyPiece->SetOutput(empty);
+  this->Mapper->SetInputConnection(this->EmptyPiece->GetOutputPort());
   // The mapper's own level of detail (LODPixelThreshold) replaces ParaView's
   // outline LOD: the octree is cheap to draw coarsely, so no LOD mapper.
   this->Actor->SetMapper(this->Mapper);
@@ -42,12 +223,49 @@ vtkOctreeVolumeRepresentation::~vtkOctreeVolumeRepresentation() = default;
 //----------------------------------------------------------------------------
 int vtkOctreeVolumeRepresentation::FillInputPortInformation(int, vtkInformation* info)
 {
-  // What the mapper draws: points of any point set, or the voxels of an
-  // image above ImageBackground.
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
-  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  // Any data object: the representation is offered for whatever the
+  // render view shows (composite data, rectilinear grids, ...), and says
+  // itself, once, when the mapper cannot draw it (see ReportUndrawable). A
+  // narrower type here would leave the pipeline to fail with a message that
+  // names neither the representation nor a remedy ("Can not execute simple
+  // algorithm ... without output ports" for composite data).
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObject");
   info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   return 1;
+}
+
+//----------------------------------------------------------------------------
+bool vtkOctreeVolumeRepresentation::IsDrawable(vtkDataObject* data)
+{
+  // What the mapper draws: the points of any point set, or the voxels of an
+  // image above ImageBackground.
+  return vtkPointSet::SafeDownCast(data) || vtkImageData::SafeDownCast(data);
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input)
+{
+  const std::string type = input->GetClassName();
+  if (type == this->ReportedType)
+  {
+    return;
+  }
+  this->ReportedType = type;
+  const char* remedy = "convert it first (e.g. Cell Centers, or Resample To Image)";
+  if (vtkCompositeDataSet::SafeDownCast(input))
+  {
+    remedy = "apply Merge Blocks first to make one unstructured grid of its blocks";
+  }
+  else if (vtkTable::SafeDownCast(input))
+  {
+    remedy = "apply Table To Points first (or open a particle text file with the Octoray "
+             "Particle Reader)";
+  }
+  // Every rank holds the same type: one message, from the first rank.
+  vtkWarningOnFirstRankMacro("Octree Volume cannot draw a "
+    << type << ": it draws point sets (vtkPointSet: vtkPolyData, vtkUnstructuredGrid, "
+    << "vtkStructuredGrid, ...) and images (vtkImageData); nothing is drawn. To draw this data, "
+    << remedy << ".");
 }
 
 //----------------------------------------------------------------------------
@@ -57,37 +275,65 @@ int vtkOctreeVolumeRepresentation::RequestData(
   vtkMath::UninitializeBounds(this->DataBounds);
   this->DataSize = 0;
   this->Cache = nullptr;
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
 
   if (inputVector[0]->GetNumberOfInformationObjects() == 1)
   {
-    vtkDataSet* input = vtkDataSet::GetData(inputVector[0], 0);
-    if (input)
+    vtkDataObject* data = vtkDataObject::GetData(inputVector[0], 0);
+    if (IsDrawable(data))
     {
-      // A shallow copy: the view may move or redistribute the piece, and the
-      // upstream filter's output must stay untouched.
-      this->Cache.TakeReference(input->NewInstance());
-      this->Cache->ShallowCopy(input);
+      vtkDataSet* input = vtkDataSet::SafeDownCast(data);
+      vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
+      if (pointSet && ranks > 1 && this->IsTranslucentBlendMode())
+      {
+        // The view will redistribute the piece for ordered compositing.
+        this->Cache = PointCloudPiece(pointSet);
+      }
+      else
+      {
+        // A shallow copy: the view may move the piece, and the upstream
+        // filter's output must stay untouched.
+        this->Cache.TakeReference(input->NewInstance());
+        this->Cache->ShallowCopy(input);
+      }
+      if (auto* cached = vtkPointSet::SafeDownCast(this->Cache))
+      {
+        if (!cached->GetPoints())
+        {
+          // An empty piece (a reader's output on the ranks it did not read
+          // on) has no vtkPoints at all; the view's redistribution and
+          // delivery expect one.
+          vtkNew<vtkPoints> none;
+          cached->SetPoints(none);
+        }
+      }
       if (this->Cache->GetNumberOfPoints() > 0)
       {
         this->Cache->GetBounds(this->DataBounds);
       }
       this->DataSize = this->Cache->GetActualMemorySize();
+      this->ReportedType.clear();
+    }
+    else if (data)
+    {
+      this->ReportUndrawable(data);
     }
   }
   // Data split over ranks: every rank builds its octree in the cube around
   // the global bounds (and, with LeafDepth set, at the same depth), so the
   // ranks' voxels align and depth compositing reproduces the one-rank
-  // picture. RequestData runs on every rank of the pipeline update, so the
-  // reduction is collective.
-  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  // picture. RequestData runs on every rank of the pipeline update (whatever
+  // each rank holds, also nothing or an undrawable type), so the reduction
+  // is collective.
   double globalBounds[6];
-  std::copy(this->DataBounds, this->DataBounds + 6, globalBounds);
-  if (controller && controller->GetNumberOfProcesses() > 1)
+  vtkMath::UninitializeBounds(globalBounds);
+  if (ranks > 1)
   {
     double local[6];
+    const bool valid = vtkMath::AreBoundsInitialized(this->DataBounds);
     for (int a = 0; a < 3; ++a)
     {
-      const bool valid = vtkMath::AreBoundsInitialized(this->DataBounds);
       // Minima and negated maxima: one MIN reduction gives both.
       local[2 * a] = valid ? this->DataBounds[2 * a] : VTK_DOUBLE_MAX;
       local[2 * a + 1] = valid ? -this->DataBounds[2 * a + 1] : VTK_DOUBLE_MAX;
@@ -99,23 +345,8 @@ int vtkOctreeVolumeRepresentation::RequestData(
       globalBounds[2 * a] = reduced[2 * a];
       globalBounds[2 * a + 1] = -reduced[2 * a + 1];
     }
-    this->Mapper->SetRootBounds(globalBounds);
   }
-  else
-  {
-    vtkMath::UninitializeBounds(globalBounds);
-    this->Mapper->SetRootBounds(globalBounds);
-  }
-
-  if (vtkMath::AreBoundsInitialized(this->DataBounds))
-  {
-    this->OutlineSource->SetBounds(this->DataBounds);
-  }
-  else
-  {
-    this->OutlineSource->SetBounds(0, 0, 0, 0, 0, 0);
-  }
-  this->OutlineSource->Update();
+  this->Mapper->SetRootBounds(globalBounds);
 
   return this->Superclass::RequestData(request, inputVector, outputVector);
 }
@@ -139,8 +370,10 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
 
   if (request_type == vtkPVView::REQUEST_UPDATE())
   {
+    // This rank's points, or an empty vtkPolyData where it has none (an
+    // empty piece, an input the mapper cannot draw, or no input at all).
     vtkDataObject* piece = this->Cache ? static_cast<vtkDataObject*>(this->Cache)
-                                       : this->OutlineSource->GetOutputDataObject(0);
+                                       : this->EmptyPiece->GetOutputDataObject(0);
     vtkPVRenderView::SetPiece(inInfo, this, piece, this->DataSize);
 
     // Every process traces its own points; the picture is composited, never
@@ -165,7 +398,7 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
       if (ranks > 1 && !this->OrderWarningIssued)
       {
         this->OrderWarningIssued = true;
-        vtkWarningMacro("Octree Volume: with a translucent blend mode over "
+        vtkWarningOnFirstRankMacro("Octree Volume: with a translucent blend mode over "
           << ranks
           << " ranks the points are redistributed into disjoint pieces and blended in order; "
              "each piece has its own octree, so voxels along the cuts may differ from a "
@@ -177,7 +410,7 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
       // Image data is not redistributed by the view: the pieces the reader
       // made are blended as they are.
       this->OrderWarningIssued = true;
-      vtkWarningMacro("Octree Volume: translucent blend modes on image data over "
+      vtkWarningOnFirstRankMacro("Octree Volume: translucent blend modes on image data over "
         << ranks << " ranks blend each rank's picture without ordering; use the surface modes "
         << "or one rank for an exact picture.");
     }
@@ -198,19 +431,20 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
                                    "vtkOctreeVolumeMapper uses its CPU backend.\n");
       }
     }
-    if (piece && (piece->IsA("vtkPointSet") || piece->IsA("vtkImageData")) &&
-      piece->GetNumberOfPoints() > 0 && this->Cache)
+    // Every rank keeps the mapper on the volume (vtkPVLODVolume has no
+    // other LOD to fall back on); a rank with nothing to draw gives it the
+    // empty piece, draws nothing, and adds only background (far depth) to
+    // the composite.
+    if (this->Cache && IsDrawable(piece) && piece->GetNumberOfPoints() > 0)
     {
       this->Mapper->SetInputConnection(producerPort);
-      this->UpdateMapperParameters();
-      this->Actor->SetMapper(this->Mapper);
     }
     else
     {
-      // Nothing to draw on this rank (e.g. fewer pieces than ranks): no
-      // mapper, so the volume adds nothing to the composite.
-      this->Actor->SetMapper(nullptr);
+      this->Mapper->SetInputConnection(this->EmptyPiece->GetOutputPort());
     }
+    this->UpdateMapperParameters();
+    this->Actor->SetMapper(this->Mapper);
   }
   return 1;
 }
@@ -389,6 +623,10 @@ void vtkOctreeVolumeRepresentation::SetImageBackground(double val)
 {
   this->ImageBackground = val; // a preset overrides it (UpdatePreset)
   this->Mapper->SetImageBackground(this->Preset.empty() ? val : this->Mapper->GetImageBackground());
+}
+void vtkOctreeVolumeRepresentation::SetFillBetweenSlices(bool val)
+{
+  this->Mapper->SetFillBetweenSlices(val);
 }
 
 //----------------------------------------------------------------------------

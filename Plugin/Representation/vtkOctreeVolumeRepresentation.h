@@ -9,7 +9,7 @@
  * of the input, REQUEST_UPDATE hands it to the render view as this
  * representation's piece, and REQUEST_RENDER connects the view's copy of the
  * piece to the mapper and pushes the colour array, the transfer functions
- * and the mapper's settings. The vtkVolume (a vtkPVLODVolume, from
+ * and the mapper's settings. The volume (a vtkPVLODVolume, from
  * vtkVolumeRepresentation) is added to the view's renderer.
  *
  * Data stays where it was produced: the piece is never gathered on the
@@ -17,6 +17,15 @@
  * builds and traces the octree of its own points and the view's compositor
  * (IceT) merges the pictures.
  *
+ * - Every rank keeps the mapper on its volume, also a rank whose piece is
+ *   empty (a reader that reads on rank 0 only, fewer pieces than ranks): it
+ *   gives the mapper an empty vtkPolyData and draws nothing. (A vtkPVLODVolume
+ *   without a mapper fails in vtkLODProp3D::SetAllocatedRenderTime: "You must
+ *   give me a mapper!", then SIGSEGV.)
+ * - The volume is a vtkPVLODVolume that lets the octree mapper draw without
+ *   a scalar array ("Solid Color": the points' own colours or white), and
+ *   whose bounds hold the voxels (vtkOctreeVolumeMapper::GetVoxelBounds), not
+ *   only the points: IceT crops each rank's picture to its props' bounds.
  * - Surface blend mode (first hit, shaded or not: the "Phong" picture) is
  *   opaque: the mapper writes window depth, and IceT's depth compositing
  *   gives the same picture as one rank.
@@ -24,9 +33,15 @@
  *   additive) need the pieces blended back to front. The representation
  *   then asks the view for ordered compositing: the view redistributes the
  *   points into spatially disjoint pieces (a k-d tree over the ranks) and
- *   IceT blends them in visibility order. Each rank's octree covers only its
- *   own piece, so voxels along the cuts may differ from the one-rank
- *   picture; a warning says so once.
+ *   IceT blends them in visibility order. The piece it redistributes is an
+ *   unstructured grid of one vertex per point (PointCloudPiece in the
+ *   .cxx says why). Every rank's octree uses the cube of the global bounds,
+ *   but a voxel that a cut crosses is drawn by two ranks, so pixels along
+ *   the cuts can differ from the one-rank picture; a warning says so once.
+ * - Input the mapper cannot draw (anything but vtkPointSet and vtkImageData:
+ *   composite data, tables, rectilinear grids, ...) is accepted by the
+ *   pipeline and draws nothing; a warning names its type, what can be drawn
+ *   and the filter that converts it, once per input type.
  *
  * The mapper is created with vtkOctreeVolumeMapper::New(): CUDA when the
  * server has a usable device, else the CPU backend; the first render logs
@@ -41,9 +56,9 @@
 #include "octorayViewsParaViewModule.h" // for export macro
 #include "vtkVolumeRepresentation.h"
 
-#include "vtkNew.h"                  // for vtkNew
-#include "vtkOctreeVolumePresets.h"  // for vtkNew<vtkOctreeVolumePresets>
-#include "vtkVolumeProperty.h"       // for vtkNew<vtkVolumeProperty>
+#include "vtkNew.h"                 // for vtkNew
+#include "vtkOctreeVolumePresets.h" // for vtkNew<vtkOctreeVolumePresets>
+#include "vtkVolumeProperty.h"      // for vtkNew<vtkVolumeProperty>
 
 #include <string> // for std::string
 
@@ -51,6 +66,7 @@ class vtkDataSet;
 class vtkOctreeVolumeMapper;
 class vtkOctreeVolumePresets;
 class vtkStringArray;
+class vtkTrivialProducer;
 
 class OCTORAYVIEWSPARAVIEW_EXPORT vtkOctreeVolumeRepresentation : public vtkVolumeRepresentation
 {
@@ -87,6 +103,7 @@ public:
   void SetDepthCue(double);
   void SetImageSampleDistance(double);
   void SetImageBackground(double);
+  void SetFillBetweenSlices(bool);
   ///@}
 
   ///@{
@@ -136,12 +153,34 @@ protected:
    */
   bool IsTranslucentBlendMode() const;
 
+  /**
+   * Whether the mapper can draw this data: a vtkPointSet or a vtkImageData.
+   */
+  static bool IsDrawable(vtkDataObject* data);
+
+  /**
+   * The warning for an input the mapper cannot draw, naming its type, what
+   * can be drawn and the filter that converts it. Issued once per input type
+   * (and on the first rank only): RequestData does not repeat it for
+   * property changes or frames.
+   */
+  void ReportUndrawable(vtkDataObject* input);
+
   vtkNew<vtkOctreeVolumeMapper> Mapper;
+  // This rank's piece (a shallow copy of the input); null when the input
+  // cannot be drawn or there is none (the client of a client-server
+  // session).
   vtkSmartPointer<vtkDataSet> Cache;
+  // An empty vtkPolyData: the piece and the mapper's input where this rank
+  // has nothing to draw, so that the volume always has its mapper (a
+  // vtkPVLODVolume without one fails to render: "You must give me a
+  // mapper!").
+  vtkNew<vtkTrivialProducer> EmptyPiece;
+  std::string ReportedType;
   bool BackendReported = false;
   bool OrderWarningIssued = false;
 
-  // The preset (SetPreset): its own property, whose shading follows
+  // The preset (SetPreset): its own property, whose settings follow
   // this->Property and whose functions are the preset's.
   void UpdatePreset();
   std::string Preset;

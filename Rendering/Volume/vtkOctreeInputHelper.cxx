@@ -3,20 +3,21 @@
 #include "vtkAbstractMapper.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
-#include "vtkMath.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkSMPTools.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <numeric>
 
 namespace
 {
@@ -75,6 +76,170 @@ void PositionArrays(vtkDataArray* xyz, const float*& f, const double*& d, std::v
   }
   d = storage.data();
 }
+
+// The points of an image: every sample of `axes` (the voxels and, with
+// filling, the planes between slices; octorayLattice.h) whose value (the
+// largest component) is above the background, with its component 0 as
+// scalar or its components as RGBA colour. Two passes over the planes
+// (count, then fill at each plane's offset), each in parallel.
+struct ImageOutput
+{
+  std::vector<double>& Xyz;
+  std::vector<float>& Scalar;
+  std::vector<std::uint8_t>& Color8;
+  std::vector<float>& ColorFloat;
+  std::vector<float>* Normal; // gradient normals (ImageGradientNormals), or null
+};
+
+// The normal of a one-component field at sample (r0, r1, r2) of the
+// (filled) lattice: the gradient by central differences (one-sided at the
+// border) at the source voxels around it, interpolated with the sample's
+// weights, through the direction matrix (row-major), negated and made unit
+// length: it points out of the denser material. (0, 0, 0) where flat.
+template <typename T>
+void GradientNormal(const T* data, int comps, const long long dims[3], const octoray::lattice::Axis axes[3],
+  const double spacing[3], const double* direction, const long long r[3], float normal[3])
+{
+  long long below[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    axes[a].Source(r[a], below[a], t[a]);
+  }
+  const long long stride[3] = { comps, comps * dims[0], comps * dims[0] * dims[1] };
+  double g[3] = { 0.0, 0.0, 0.0 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double weight = 1.0;
+    long long at[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool up = (corner >> a) & 1;
+      weight *= up ? t[a] : 1.0 - t[a];
+      at[a] = std::min(below[a] + (up ? 1 : 0), dims[a] - 1);
+    }
+    if (weight <= 0.0)
+    {
+      continue;
+    }
+    const long long id = at[0] * stride[0] + at[1] * stride[1] + at[2] * stride[2];
+    for (int a = 0; a < 3; ++a)
+    {
+      if (dims[a] < 2 || spacing[a] == 0.0)
+      {
+        continue;
+      }
+      const long long lo = at[a] > 0 ? id - stride[a] : id;
+      const long long hi = at[a] + 1 < dims[a] ? id + stride[a] : id;
+      const double steps = (at[a] > 0 && at[a] + 1 < dims[a]) ? 2.0 : 1.0;
+      g[a] += weight * (static_cast<double>(data[hi]) - static_cast<double>(data[lo])) / (steps * spacing[a]);
+    }
+  }
+  double world[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    world[row] = direction[3 * row] * g[0] + direction[3 * row + 1] * g[1] + direction[3 * row + 2] * g[2];
+  }
+  const double length = std::sqrt(world[0] * world[0] + world[1] * world[1] + world[2] * world[2]);
+  for (int a = 0; a < 3; ++a)
+  {
+    normal[a] = length > 0.0 ? static_cast<float>(-world[a] / length) : 0.0f;
+  }
+}
+
+template <typename T>
+void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
+  const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, bool scalar,
+  ImageOutput out, const std::function<void(double)>& progress, const double* spacing = nullptr,
+  const double* direction = nullptr)
+{
+  // Gradient normals: one-component scalars, and the caller asked for them.
+  const bool normals = out.Normal && data && scalar && !colours && comps == 1 && spacing && direction;
+  const vtkIdType planes = static_cast<vtkIdType>(axes[2].Samples());
+  auto above = [&](const double* v) {
+    double value = comps > 0 ? v[0] : 1.0; // no scalars: the whole grid
+    for (int c = 1; c < comps; ++c)
+    {
+      value = std::max(value, v[c]);
+    }
+    return value > background;
+  };
+  // Planes in blocks, so that progress is reported from this thread.
+  const vtkIdType block = std::max<vtkIdType>(1, planes / 20);
+  auto blocks = [&](double from, double to, const std::function<void(vtkIdType, vtkIdType)>& work) {
+    for (vtkIdType b = 0; b < planes; b += block)
+    {
+      vtkSMPTools::For(b, std::min(planes, b + block), work);
+      progress(from + (to - from) * static_cast<double>(std::min(planes, b + block)) / planes);
+    }
+  };
+  std::vector<vtkIdType> counts(planes + 1, 0);
+  blocks(0.0, 0.2, [&](vtkIdType b, vtkIdType e) {
+    std::vector<double> values(std::max(comps, 1));
+    for (vtkIdType k = b; k < e; ++k)
+    {
+      vtkIdType n = 0;
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, k, values.data(),
+        [&](long long, long long, const double* v) { n += above(v); });
+      counts[k + 1] = n;
+    }
+  });
+  std::partial_sum(counts.begin(), counts.end(), counts.begin());
+  const std::size_t total = static_cast<std::size_t>(counts[planes]);
+  out.Xyz.resize(3 * total);
+  if (colours)
+  {
+    (bytes ? out.Color8.resize(4 * total) : out.ColorFloat.resize(4 * total));
+  }
+  else if (scalar)
+  {
+    out.Scalar.resize(total);
+  }
+  if (normals)
+  {
+    out.Normal->resize(3 * total);
+  }
+  blocks(0.2, 0.5, [&](vtkIdType b, vtkIdType e) {
+    std::vector<double> values(std::max(comps, 1));
+    for (vtkIdType k = b; k < e; ++k)
+    {
+      std::size_t n = static_cast<std::size_t>(counts[k]);
+      octoray::lattice::ForEachSampleInPlane(axes, data, dims, comps, k, values.data(),
+        [&](long long r0, long long r1, const double* v) {
+          if (!above(v))
+          {
+            return;
+          }
+          lattice.Position(r0, r1, k, &out.Xyz[3 * n]);
+          if (colours)
+          {
+            for (int c = 0; c < 4; ++c)
+            {
+              const double x = c < comps ? v[c] : (bytes ? 255.0 : 1.0);
+              if (bytes)
+              {
+                out.Color8[4 * n + c] = static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0, 255.0)));
+              }
+              else
+              {
+                out.ColorFloat[4 * n + c] = static_cast<float>(x);
+              }
+            }
+          }
+          else if (scalar)
+          {
+            out.Scalar[n] = static_cast<float>(v[0]);
+          }
+          if (normals)
+          {
+            const long long r[3] = { r0, r1, static_cast<long long>(k) };
+            GradientNormal(data, comps, dims, axes, spacing, direction, r, &(*out.Normal)[3 * n]);
+          }
+          ++n;
+        });
+    }
+  });
+}
 }
 
 //------------------------------------------------------------------------------
@@ -110,7 +275,17 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
     }
   }
   r.ImageBackground = mapper->GetImageBackground();
+  r.FillBetweenSlices = mapper->GetFillBetweenSlices();
   r.ImageGradientNormals = mapper->GetImageGradientNormals();
+  if (vtkPointSet::SafeDownCast(input))
+  {
+    vtkDataArray* lattice = input->GetFieldData()->GetArray(octoray::lattice::kFieldArrayName);
+    if (lattice && lattice->GetNumberOfComponents() == octoray::lattice::kFieldArrayComponents &&
+      lattice->GetNumberOfTuples() >= 1)
+    {
+      r.Lattice = lattice;
+    }
+  }
   r.LeafDepth = mapper->GetLeafDepth();
   std::copy(mapper->GetRootBounds(), mapper->GetRootBounds() + 6, r.RootBounds.begin());
   r.EngineGeneration = engineGeneration;
@@ -128,9 +303,10 @@ vtkOctreeInputHelper::Signature vtkOctreeInputHelper::Sign(const Request& r)
   auto* pointSet = vtkPointSet::SafeDownCast(r.Input);
   if (!pointSet)
   {
-    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.ImageGradientNormals ? "+gradient" : "");
+    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.FillBetweenSlices ? "+fill" : "") +
+      (r.ImageGradientNormals ? "+gradient" : "");
   }
-  s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals) };
+  s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals), Stamp(r.Lattice) };
   // An image's points are its grid: any change of the image is a rebuild.
   s.Points = pointSet ? Stamp(pointSet->GetPoints() ? pointSet->GetPoints()->GetData() : nullptr)
                       : ArrayStamp{ r.Input, r.Input->GetMTime() };
@@ -186,8 +362,8 @@ octoray::PointCloudView vtkOctreeInputHelper::PointCloud(
   const Request& request, const std::function<void(double)>& progress)
 {
   octoray::PointCloudView view;
+  this->HasLattice = false;
   this->Xyz.clear();
-  this->Normal.clear();
   this->Scalar.clear();
   this->Color8.clear();
   this->ColorFloat.clear();
@@ -234,327 +410,104 @@ void vtkOctreeInputHelper::PointSetView(const Request& r, octoray::PointCloudVie
   view.reflectivity = r.Reflectivity ? FloatComponents(r.Reflectivity, 1, this->Reflectivity) : nullptr;
   view.refraction = r.Refraction ? FloatComponents(r.Refraction, 1, this->Refraction) : nullptr;
   view.normal = r.Normals ? FloatComponents(r.Normals, 3, this->Normal) : nullptr;
+
+  // The lattice the field data names (the slice-stack reader's particles),
+  // as long as the points still lie on it: a filter that moved them (a
+  // transform) passes the array on unchanged. Up to 1000 points checked.
+  if (r.Lattice && view.count > 0)
+  {
+    double tuple[octoray::lattice::kFieldArrayComponents];
+    r.Lattice->GetTuple(0, tuple);
+    const octoray::lattice::Lattice lattice = octoray::lattice::FromTuple(tuple);
+    const vtkIdType n = pointSet->GetNumberOfPoints();
+    const vtkIdType step = std::max<vtkIdType>(1, n / 1000);
+    bool on = true;
+    for (vtkIdType i = 0; on && i < n; i += step)
+    {
+      double p[3];
+      pointSet->GetPoint(i, p);
+      on = octoray::lattice::OnLattice(lattice, p);
+    }
+    if (on)
+    {
+      this->HasLattice = true;
+      this->Lattice = lattice;
+      pointSet->GetBounds(this->LatticeBounds);
+    }
+  }
 }
 
 //------------------------------------------------------------------------------
-octoray::BuildOptions vtkOctreeInputHelper::Options(const Request& r) const
+bool vtkOctreeInputHelper::PointLattice(octoray::lattice::Lattice& lattice, double bounds[6]) const
 {
-  if (vtkImageData::SafeDownCast(r.Input))
+  if (!this->HasLattice)
   {
-    return Layout(r).Options;
+    return false;
   }
-  octoray::BuildOptions options;
-  options.depth = r.LeafDepth;
-  if (vtkMath::AreBoundsInitialized(r.RootBounds.data()))
-  {
-    // The caller's cube (e.g. global bounds over parallel ranks): the same
-    // voxel grid on every rank.
-    const double* b = r.RootBounds.data();
-    const double lo[3] = { b[0], b[2], b[4] }, hi[3] = { b[1], b[3], b[5] };
-    options.fixedCube = true;
-    options.cube = octoray::RootCube::FromBounds(lo, hi);
-  }
-  return options;
+  lattice = this->Lattice;
+  std::copy(this->LatticeBounds, this->LatticeBounds + 6, bounds);
+  return true;
 }
 
 //------------------------------------------------------------------------------
-vtkOctreeInputHelper::ImageLayout vtkOctreeInputHelper::Layout(const Request& r)
-{
-  ImageLayout layout;
-  octoray::BuildOptions& options = layout.Options;
-  options.depth = r.LeafDepth;
-  auto* image = vtkImageData::SafeDownCast(r.Input);
-  int extent[6];
-  image->GetExtent(extent);
-  const double* spacing = image->GetSpacing();
-  // The voxels' boxes: continuous indices from -0.5 to n - 0.5 along each
-  // axis (through the direction matrix, so any orientation is covered).
-  double lo[3] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX };
-  double hi[3] = { -VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX };
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    const double index[3] = { (corner & 1) ? extent[1] + 0.5 : extent[0] - 0.5,
-      (corner & 2) ? extent[3] + 0.5 : extent[2] - 0.5, (corner & 4) ? extent[5] + 0.5 : extent[4] - 0.5 };
-    double p[3];
-    image->TransformContinuousIndexToPhysicalPoint(index, p);
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a]);
-    }
-  }
-  double finest = VTK_DOUBLE_MAX;
-  for (int a = 0; a < 3; ++a)
-  {
-    if (std::abs(spacing[a]) > 0.0)
-    {
-      finest = std::min(finest, std::abs(spacing[a]));
-    }
-  }
-  const bool fixed = vtkMath::AreBoundsInitialized(r.RootBounds.data());
-  if (fixed)
-  {
-    const double* b = r.RootBounds.data();
-    const double blo[3] = { b[0], b[2], b[4] }, bhi[3] = { b[1], b[3], b[5] };
-    options.cube = octoray::RootCube::FromBounds(blo, bhi);
-  }
-  else
-  {
-    options.cube = octoray::RootCube::FromBounds(lo, hi);
-  }
-  options.fixedCube = true;
-  if (options.depth == 0 && finest < VTK_DOUBLE_MAX)
-  {
-    // The shallowest level whose leaf is no wider than the finest spacing
-    // (a relative 1e-6 of slack: 256 voxels of 0.957 mm are depth 8, not 9,
-    // whatever the rounding of their bounds).
-    const double extent = std::max({ hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] });
-    const double levels = std::ceil(std::log2((fixed ? options.cube.size : extent) / finest) - 1e-6);
-    options.depth = static_cast<int>(std::min(21.0, std::max(1.0, levels)));
-    const double size = finest * std::ldexp(1.0, options.depth);
-    if (!fixed && size >= extent * (1.0 - 1e-6))
-    {
-      // A cube of 2^depth finest spacings, placed so that the voxel centres
-      // along the finest axes are leaf centres: leaves and voxels coincide.
-      options.cube.size = std::max(size, extent * (1.0 + 0x1p-20));
-      for (int a = 0; a < 3; ++a)
-      {
-        const double margin = std::max(0.0, std::floor(0.5 * (size - (hi[a] - lo[a])) / finest) * finest);
-        options.cube.origin[a] = lo[a] - margin;
-      }
-    }
-  }
-  if (options.depth == 0)
-  {
-    options.depth = 1; // a single voxel without spacing
-  }
-  // Points per voxel along each axis: enough that neighbouring points are
-  // at most a leaf apart, so every leaf a voxel's box covers gets one. At
-  // most 64 points per voxel (a depth chosen far finer than the spacing
-  // leaves gaps rather than exhausting memory).
-  const double leaf = options.cube.size / std::ldexp(1.0, options.depth);
-  int total = 1;
-  for (int a = 0; a < 3; ++a)
-  {
-    const int n = extent[2 * a + 1] - extent[2 * a] + 1;
-    const double s = std::abs(spacing[a]);
-    layout.Split[a] = 1;
-    if (s > 0.0 && leaf > 0.0 && n >= 1)
-    {
-      layout.Split[a] = static_cast<int>(std::min(64.0, std::max(1.0, std::ceil(s / leaf - 1e-6))));
-    }
-    total *= layout.Split[a];
-  }
-  while (total > 64)
-  {
-    int widest = 0;
-    for (int a = 1; a < 3; ++a)
-    {
-      widest = layout.Split[a] > layout.Split[widest] ? a : widest;
-    }
-    total /= layout.Split[widest];
-    layout.Split[widest] = std::max(1, layout.Split[widest] / 2);
-    total *= layout.Split[widest];
-  }
-  return layout;
-}
-
-//------------------------------------------------------------------------------
-// Every voxel above the background becomes a point at the voxel's position,
-// with its value as scalar (or its components as colour). Along axes whose
-// spacing is wider than a leaf a voxel becomes several points across its
-// box; one-component scalars are then interpolated linearly between the
-// voxel and its neighbours at each point (as resampling the image finer
-// would), so surfaces are as smooth across slices as within them, and a
-// point is kept where its interpolated value is above the background. With
-// ImageGradientNormals, one-component scalars also give each point the
-// normal of the field, interpolated the same way.
+// Every voxel above the background is a point at the voxel's position, with
+// its value as scalar (or its components as colour); with FillBetweenSlices,
+// so are the samples interpolated between slices (octorayLattice.h: along
+// the coarsest axis, down to the second-coarsest spacing).
 void vtkOctreeInputHelper::ImageView(
   const Request& r, octoray::PointCloudView& view, const std::function<void(double)>& progress)
 {
   auto* image = vtkImageData::SafeDownCast(r.Input);
   vtkDataArray* scalars = r.Scalars;
-  const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
-  const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
-  const ImageLayout layout = Layout(r);
-  const int* split = layout.Split;
-  const int copies = split[0] * split[1] * split[2];
-  // Sub-voxel offsets in index units.
-  std::vector<std::array<double, 3>> offsets;
-  for (int k = 0; k < split[2]; ++k)
+  int dims[3];
+  image->GetDimensions(dims);
+  const long long size[3] = { dims[0], dims[1], dims[2] };
+  octoray::lattice::Axis axes[3];
+  for (int a = 0; a < 3; ++a)
   {
-    for (int j = 0; j < split[1]; ++j)
-    {
-      for (int i = 0; i < split[0]; ++i)
-      {
-        offsets.push_back({ (i + 0.5) / split[0] - 0.5, (j + 0.5) / split[1] - 0.5, (k + 0.5) / split[2] - 0.5 });
-      }
-    }
+    axes[a].Count = size[a];
   }
-  const octoray::RootCube& cube = layout.Options.cube;
-  const double inside = cube.size * (1.0 - 0x1p-20);
-  int extent[6];
-  image->GetExtent(extent);
-  const vtkIdType size[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1, extent[5] - extent[4] + 1 };
-  const vtkIdType stride[3] = { 1, size[0], size[0] * size[1] };
-  const vtkIdType n = image->GetNumberOfPoints();
   const double* spacing = image->GetSpacing();
-  const double* direction = image->GetDirectionMatrix()->GetData();
-
-  // One-component scalars: a float copy to interpolate and differentiate.
-  const bool field = scalars && !r.Colours && comps == 1;
-  const bool gradient = field && r.ImageGradientNormals;
-  std::vector<float> values;
-  if (field)
+  if (r.FillBetweenSlices)
   {
-    values.resize(static_cast<std::size_t>(n));
-    for (vtkIdType id = 0; id < n; ++id)
-    {
-      values[id] = static_cast<float>(scalars->GetComponent(id, 0));
-    }
-  }
-  // The field's gradient at a voxel, per unit length along the index axes:
-  // central differences, one-sided at the border.
-  auto gradientAt = [&](const vtkIdType ijk[3], double g[3]) {
-    const vtkIdType id = ijk[0] + stride[1] * ijk[1] + stride[2] * ijk[2];
+    int fill[3];
+    octoray::lattice::FillFactors(spacing, size, fill);
     for (int a = 0; a < 3; ++a)
     {
-      g[a] = 0.0;
-      if (size[a] < 2 || spacing[a] == 0.0)
-      {
-        continue;
-      }
-      const vtkIdType below = ijk[a] > 0 ? id - stride[a] : id;
-      const vtkIdType above = ijk[a] + 1 < size[a] ? id + stride[a] : id;
-      const double steps = (ijk[a] > 0 && ijk[a] + 1 < size[a]) ? 2.0 : 1.0;
-      g[a] = (values[above] - values[below]) / (steps * spacing[a]);
+      axes[a].Fill = fill[a];
     }
-  };
-
-  for (vtkIdType id = 0; id < n; ++id)
+  }
+  const octoray::lattice::Lattice lattice =
+    octoray::lattice::LatticeOf(axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
+  const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
+  const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
+  this->Normal.clear();
+  const ImageOutput out{ this->Xyz, this->Scalar, this->Color8, this->ColorFloat,
+    r.ImageGradientNormals ? &this->Normal : nullptr };
+  const double* direction = image->GetDirectionMatrix()->GetData();
+  if (!scalars)
   {
-    const vtkIdType ijk[3] = { id % size[0], (id / size[0]) % size[1], id / stride[2] };
-    double value = scalars ? (field ? values[id] : scalars->GetComponent(id, 0)) : 1.0; // no scalars: the whole grid
-    for (int c = 1; c < comps; ++c)
+    const double* none = nullptr;
+    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, false, out, progress);
+  }
+  else if (scalars->HasStandardMemoryLayout())
+  {
+    switch (scalars->GetDataType())
     {
-      value = std::max(value, scalars->GetComponent(id, c));
+      vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
+        lattice, r.ImageBackground, r.Colours, bytes, true, out, progress, spacing, direction));
     }
-    if (id % 65536 == 0)
+  }
+  else
+  {
+    // Another memory layout (e.g. struct of arrays): the values as doubles.
+    std::vector<double> values(static_cast<std::size_t>(scalars->GetNumberOfTuples()) * comps);
+    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
     {
-      progress(0.5 * static_cast<double>(id) / n);
+      scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
     }
-    // Interpolated points may lie above the background where the voxel
-    // does not, next to one that does.
-    double reach = value;
-    if (field && copies > 1)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        if (split[a] > 1)
-        {
-          if (ijk[a] > 0)
-          {
-            reach = std::max(reach, static_cast<double>(values[id - stride[a]]));
-          }
-          if (ijk[a] + 1 < size[a])
-          {
-            reach = std::max(reach, static_cast<double>(values[id + stride[a]]));
-          }
-        }
-      }
-    }
-    if (!(reach > r.ImageBackground))
-    {
-      continue;
-    }
-    for (const auto& offset : offsets)
-    {
-      double sample = value;
-      double g[3] = { 0.0, 0.0, 0.0 };
-      if (field)
-      {
-        // Linear interpolation towards the neighbours the offset leans to
-        // (at most 8 corners; 1 when the voxel is not split).
-        sample = 0.0;
-        for (int corner = 0; corner < 8; ++corner)
-        {
-          double weight = 1.0;
-          vtkIdType at[3] = { ijk[0], ijk[1], ijk[2] };
-          for (int a = 0; a < 3 && weight > 0.0; ++a)
-          {
-            const double o = offset[a];
-            const bool toNeighbour = (corner >> a) & 1;
-            if (o == 0.0)
-            {
-              weight *= toNeighbour ? 0.0 : 1.0;
-              continue;
-            }
-            weight *= toNeighbour ? std::abs(o) : 1.0 - std::abs(o);
-            if (toNeighbour)
-            {
-              at[a] = std::min(std::max<vtkIdType>(at[a] + (o > 0.0 ? 1 : -1), 0), size[a] - 1);
-            }
-          }
-          if (weight <= 0.0)
-          {
-            continue;
-          }
-          sample += weight * values[at[0] + stride[1] * at[1] + stride[2] * at[2]];
-          if (gradient)
-          {
-            double gc[3];
-            gradientAt(at, gc);
-            g[0] += weight * gc[0], g[1] += weight * gc[1], g[2] += weight * gc[2];
-          }
-        }
-        if (!(sample > r.ImageBackground))
-        {
-          continue;
-        }
-      }
-      const double index[3] = { extent[0] + ijk[0] + offset[0], extent[2] + ijk[1] + offset[1],
-        extent[4] + ijk[2] + offset[2] };
-      double p[3];
-      image->TransformContinuousIndexToPhysicalPoint(index, p);
-      if (copies > 1)
-      {
-        // A voxel's box may reach past a caller's cube (RootBounds around
-        // the voxel centres): keep its points inside.
-        for (int a = 0; a < 3; ++a)
-        {
-          p[a] = std::min(std::max(p[a], cube.origin[a]), cube.origin[a] + inside);
-        }
-      }
-      this->Xyz.insert(this->Xyz.end(), p, p + 3);
-      if (r.Colours)
-      {
-        for (int c = 0; c < 4; ++c)
-        {
-          const double v = c < comps ? scalars->GetComponent(id, c) : (bytes ? 255.0 : 1.0);
-          bytes ? this->Color8.push_back(static_cast<std::uint8_t>(v))
-                : this->ColorFloat.push_back(static_cast<float>(v));
-        }
-      }
-      else if (scalars)
-      {
-        this->Scalar.push_back(static_cast<float>(field ? sample : scalars->GetComponent(id, 0)));
-      }
-      if (gradient)
-      {
-        // Through the direction matrix (row-major); the normal points down
-        // the gradient, out of the denser material.
-        double world[3];
-        for (int row = 0; row < 3; ++row)
-        {
-          world[row] = direction[3 * row] * g[0] + direction[3 * row + 1] * g[1] + direction[3 * row + 2] * g[2];
-        }
-        const double length = std::sqrt(world[0] * world[0] + world[1] * world[1] + world[2] * world[2]);
-        for (int a = 0; a < 3; ++a)
-        {
-          this->Normal.push_back(length > 0.0 ? static_cast<float>(-world[a] / length) : 0.0f);
-        }
-      }
-    }
+    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, true, out, progress,
+      spacing, direction);
   }
   view.count = this->Xyz.size() / 3;
   view.xyzDouble = this->Xyz.data();
@@ -563,6 +516,26 @@ void vtkOctreeInputHelper::ImageView(
   view.colorComponents = r.Colours ? 4 : 0;
   view.scalar = this->Scalar.empty() ? nullptr : this->Scalar.data();
   view.normal = this->Normal.empty() ? nullptr : this->Normal.data();
+
+  // The points' lattice and bounds, for the leaf grid.
+  if (view.count > 0)
+  {
+    double* b = this->LatticeBounds;
+    for (int a = 0; a < 3; ++a)
+    {
+      b[2 * a] = b[2 * a + 1] = this->Xyz[a];
+    }
+    for (std::size_t i = 0; i < view.count; ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        b[2 * a] = std::min(b[2 * a], this->Xyz[3 * i + a]);
+        b[2 * a + 1] = std::max(b[2 * a + 1], this->Xyz[3 * i + a]);
+      }
+    }
+    this->Lattice = lattice;
+    this->HasLattice = true;
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -8,18 +8,20 @@
  * which arrays play which part (colours or scalars, reflectivity,
  * refraction, normals), turns them into an octoray::PointCloudView (the
  * caller's arrays where their layout allows, converted host copies
- * otherwise; image voxels above the background become points), chooses
- * the octree's cube and depth for images (Options), and compares the input with what the current octree was built from: nothing
- * changed, only the point positions moved (an in-place update), or
- * anything else (a build).
+ * otherwise; image voxels above the background become points, with the
+ * planes between slices filled as octorayLattice.h says), knows the lattice
+ * the points lie on where there is one (an image; a point set whose field
+ * data names it and whose points lie on it), and compares the input with
+ * what the current octree was built from: nothing changed, only the point
+ * positions moved (an in-place update), or anything else (a build).
  */
 #ifndef vtkOctreeInputHelper_h
 #define vtkOctreeInputHelper_h
 
 #include "vtkType.h" // for vtkIdType, vtkMTimeType
 
-#include <octoray/Octree.h>     // for octoray::BuildOptions
 #include <octoray/PointCloud.h> // for the views
+#include <octorayLattice.h>      // for octoray::lattice::Lattice
 
 #include <array>      // for std::array
 #include <cstdint>    // for std::uint8_t
@@ -56,7 +58,9 @@ public:
     vtkDataArray* Normals = nullptr;
     bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
     double ImageBackground = 0.0;
+    bool FillBetweenSlices = true; // image input: fill between slices (octorayLattice.h)
     bool ImageGradientNormals = true; // image input: normals from the scalar gradient
+    vtkDataArray* Lattice = nullptr; // point set input: the field-data array naming its lattice
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
     unsigned long EngineGeneration = 0; // a new engine holds no octree
@@ -80,19 +84,6 @@ public:
   octoray::PointCloudView PointCloud(const Request& request, const std::function<void(double)>& progress);
 
   /**
-   * The engine's build options for `request`: LeafDepth and RootBounds as
-   * the mapper has them. An image's voxels are boxes of its spacing, not
-   * points: without RootBounds its cube is fitted to those boxes, and with
-   * LeafDepth 0 the depth is chosen from the spacing, the leaf the smallest
-   * spacing exactly (the cube is then 2^depth smallest spacings wide, so
-   * that voxel centres are leaf centres along the finest axes). Along an
-   * axis whose spacing is wider than a leaf (the slice distance of a CT),
-   * PointCloud puts a voxel's value at several points across its box, so
-   * the octree has no empty layers between slices.
-   */
-  octoray::BuildOptions Options(const Request& request) const;
-
-  /**
    * The moved positions for Engine::Update (Change::Positions).
    */
   octoray::PositionsView Positions(const Request& request);
@@ -106,6 +97,13 @@ public:
    * The octree is gone (a failed build, a new engine).
    */
   void Forget() { this->Built = false; }
+
+  /**
+   * The lattice the points of the last PointCloud() lie on, and their
+   * bounds: false when they lie on none (scattered points, a point set
+   * without the field-data array, or one whose points left the lattice).
+   */
+  bool PointLattice(octoray::lattice::Lattice& lattice, double bounds[6]) const;
 
   bool HasOctree() const { return this->Built; }
   bool HasScalar() const { return this->ScalarPresent; }
@@ -128,7 +126,7 @@ private:
     const void* Input = nullptr;
     vtkIdType Count = 0;
     std::string Layout; // which arrays play which role
-    std::array<ArrayStamp, 4> Arrays{};
+    std::array<ArrayStamp, 5> Arrays{}; // scalars, reflectivity, refraction, normals, lattice
     ArrayStamp Points;
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
@@ -139,19 +137,13 @@ private:
 
   void PointSetView(const Request& request, octoray::PointCloudView& view);
   void ImageView(const Request& request, octoray::PointCloudView& view, const std::function<void(double)>& progress);
-
-  // An image's grid as the octree sees it (Options): the cube, the depth,
-  // and how many points each voxel becomes along each axis.
-  struct ImageLayout
-  {
-    octoray::BuildOptions Options;
-    int Split[3] = { 1, 1, 1 };
-  };
-  static ImageLayout Layout(const Request& request);
   void FindScalarRange(const octoray::PointCloudView& view);
 
   bool Built = false;
   Signature Current;
+  bool HasLattice = false;
+  octoray::lattice::Lattice Lattice;
+  double LatticeBounds[6] = { 0, 0, 0, 0, 0, 0 };
   bool ScalarPresent = false;
   double Range[2] = { 0.0, 1.0 };
 

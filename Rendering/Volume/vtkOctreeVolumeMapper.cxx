@@ -25,6 +25,7 @@
 
 #include <octoray/DepthSignature.h>
 #include <octoray/Engine.h>
+#include <octoray/RootCube.h>
 
 #include <algorithm>
 #include <chrono>
@@ -79,7 +80,12 @@ public:
   vtkOctreeInputHelper Input;
   vtkOctreeCompositor Compositor;
   unsigned long OctreeVersion = 0; // bumped by every build and update
-  int Depth = 0;                    // leaf level of the last build
+  // The leaf size of the last build and the input it was built for
+  // (GetVoxelBounds).
+  octoray::RootCube BuiltCube;
+  int BuiltDepth = 0;
+  vtkDataSet* BuiltFor = nullptr;
+  vtkMTimeType BuiltMTime = 0;
   bool CellScalarsWarned = false;
   bool InteropUnusable = false; // said once; the host path from then on
 
@@ -222,13 +228,49 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     return Step::Stop;
   }
   self->UpdateProgress(0.5);
-  // LeafDepth and RootBounds; for an image, the cube and depth of its voxel grid.
-  const octoray::BuildOptions options = this->Input.Options(request);
+  octoray::BuildOptions options;
+  options.depth = request.LeafDepth;
+  const bool rootBounds = vtkMath::AreBoundsInitialized(request.RootBounds.data());
+  if (rootBounds)
+  {
+    // The caller's cube (e.g. global bounds over parallel ranks): the same
+    // voxel grid on every rank.
+    const double* b = request.RootBounds.data();
+    const double lo[3] = { b[0], b[2], b[4] }, hi[3] = { b[1], b[3], b[5] };
+    options.fixedCube = true;
+    options.cube = octoray::RootCube::FromBounds(lo, hi);
+  }
+  // Points on a lattice (an image, the slice-stack reader's particles) with
+  // the depth left automatic: leaves as large as the lattice's largest step
+  // and aligned with it, so that the volume has no gap (octorayLattice.h),
+  // in a cube around the caller's bounds where there are some (then the
+  // same on every rank).
+  octoray::lattice::Lattice lattice;
+  double bounds[6];
+  if (request.LeafDepth == 0 && this->Input.PointLattice(lattice, bounds))
+  {
+    if (rootBounds)
+    {
+      std::copy(request.RootBounds.begin(), request.RootBounds.end(), bounds);
+    }
+    const octoray::lattice::LeafGrid grid = octoray::lattice::ChooseLeafGrid(lattice, bounds, octoray::kMaxLevel);
+    if (grid.Valid)
+    {
+      options.depth = grid.Depth;
+      options.fixedCube = true;
+      std::copy(grid.Origin, grid.Origin + 3, options.cube.origin);
+      options.cube.size = grid.Size;
+    }
+  }
   octoray::BuildStats stats;
   const Step step = this->Run("build", [&] { stats = this->Backend.Engine()->Build(view, options); });
   if (step == Step::Done)
   {
-    this->Depth = stats.depth;
+    // The leaf grid, for GetVoxelBounds.
+    this->BuiltCube = stats.cube;
+    this->BuiltDepth = stats.depth;
+    this->BuiltFor = request.Input;
+    this->BuiltMTime = request.Input->GetMTime();
     this->Input.Remember(request);
     ++this->OctreeVersion;
     ++self->NumberOfBuilds;
@@ -630,7 +672,7 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
 //------------------------------------------------------------------------------
 int vtkOctreeVolumeMapper::GetOctreeDepth()
 {
-  return this->Internals->Input.HasOctree() ? this->Internals->Depth : 0;
+  return this->Internals->Input.HasOctree() ? this->Internals->BuiltDepth : 0;
 }
 
 //------------------------------------------------------------------------------
@@ -644,6 +686,67 @@ double vtkOctreeVolumeMapper::GetLeafSize()
   octoray::HostOctree tree;
   engine->CopyToHost(tree);
   return tree.cube.size / static_cast<double>(1u << tree.depth);
+}
+
+//------------------------------------------------------------------------------
+void vtkOctreeVolumeMapper::GetVoxelBounds(double bounds[6])
+{
+  vtkMath::UninitializeBounds(bounds);
+  vtkDataSet* input = this->GetInput();
+  const vtkIdType n = input ? input->GetNumberOfPoints() : 0;
+  if (n == 0)
+  {
+    return;
+  }
+  double box[6];
+  input->GetBounds(box);
+  const bool image = vtkImageData::SafeDownCast(input) != nullptr;
+  const vtkInternals& in = *this->Internals;
+  octoray::RootCube cube;
+  int depth = 0;
+  if (in.Input.HasOctree() && in.BuiltFor == input && in.BuiltMTime == input->GetMTime())
+  {
+    cube = in.BuiltCube;
+    depth = in.BuiltDepth;
+  }
+  else
+  {
+    // Not built yet: the cube the build will use and a depth not above the
+    // one it will choose. Leaves of a shallower level of the same cube hold
+    // the deeper ones, so the bounds below still hold the voxels.
+    const bool fixed = vtkMath::AreBoundsInitialized(this->RootBounds);
+    if (image && !fixed)
+    {
+      // The cube is fitted to the voxels above the background, unknown
+      // until the build: the image's bounds widened by half their largest
+      // extent hold any such cube.
+      const double half = 0.5 * std::max({ box[1] - box[0], box[3] - box[2], box[5] - box[4] });
+      for (int a = 0; a < 3; ++a)
+      {
+        bounds[2 * a] = box[2 * a] - half;
+        bounds[2 * a + 1] = box[2 * a + 1] + half;
+      }
+      return;
+    }
+    const double* c = fixed ? this->RootBounds : box;
+    const double lo[3] = { c[0], c[2], c[4] }, hi[3] = { c[1], c[3], c[5] };
+    cube = octoray::RootCube::FromBounds(lo, hi);
+    depth = this->LeafDepth;
+    if (depth == 0)
+    {
+      depth = image
+        ? 1
+        : std::max(1, static_cast<int>(std::floor(std::log(std::max(0.5 * n, 1.0)) / std::log(8.0))));
+    }
+  }
+  // The input's bounds out to the boundaries of the leaves that hold them.
+  const double leaf = std::ldexp(cube.size, -depth);
+  for (int a = 0; a < 3; ++a)
+  {
+    const double o = cube.origin[a];
+    bounds[2 * a] = o + std::floor((box[2 * a] - o) / leaf) * leaf;
+    bounds[2 * a + 1] = o + (std::floor((box[2 * a + 1] - o) / leaf) + 1.0) * leaf;
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -674,6 +777,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DepthCue: " << this->DepthCue << "\n";
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "ImageBackground: " << this->ImageBackground << "\n";
+  os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
   os << indent << "ImageGradientNormals: " << (this->ImageGradientNormals ? "on" : "off") << "\n";
   os << indent << "ReflectivityArrayName: "
      << (this->ReflectivityArrayName ? this->ReflectivityArrayName : "(none)") << "\n";

@@ -4,7 +4,9 @@
  *
  * vtkOctreeVolumeMapper renders point data (a vtkPointSet: points with
  * optional colours, scalars, reflectivity, refraction and normals) or a
- * vtkImageData (every voxel above ImageBackground becomes a point) by
+ * vtkImageData (every voxel above ImageBackground becomes a point, and
+ * between slices farther apart than the pixels, interpolated points fill
+ * the gaps: FillBetweenSlices) by
  * building the octree engine's sparse voxel octree of the points and
  * ray-tracing it. It holds the VTK plumbing shared by both backends:
  *
@@ -151,7 +153,12 @@ public:
 
   ///@{
   /**
-   * Octree leaf level, 1..21, or 0 (the default) to choose it from the data.
+   * Octree leaf level, 1..21, or 0 (the default) to choose it from the data:
+   * for points on a lattice (a vtkImageData; a point set whose field data
+   * names its lattice, as vtkSliceStackReader's particles do) the leaves are
+   * as large as the lattice's largest step and aligned with it, so the
+   * volume has no gap (octorayLattice.h); for other points, the engine's
+   * choice (the median leaf holds one point).
    */
   vtkSetClampMacro(LeafDepth, int, 0, 21);
   vtkGetMacro(LeafDepth, int);
@@ -170,10 +177,32 @@ public:
   vtkGetVector6Macro(RootBounds, double);
   ///@}
 
+  /**
+   * Bounds that hold the voxels the mapper draws: the input's bounds out to
+   * the boundaries of the leaves around the outermost points, which reach
+   * past the points by up to a leaf (GetBounds() gives the points' bounds,
+   * as vtkVolumeMapper does). Exact once the octree is built for the current
+   * input; before that (the first frame) from the cube the build will use
+   * and LeafDepth, or, with the automatic depth, a depth of log8(n / 2) for
+   * n points, which the automatic choice (half the leaves hold one point)
+   * does not go below: leaves of that shallower level hold the deeper ones.
+   * (Image input without RootBounds, whose cube is fitted to the voxels
+   * above ImageBackground: the image's bounds widened by half their largest
+   * extent until the build.) A compositor that crops each process's picture
+   * to the screen rectangle of its props' bounds (IceT in ParaView) must be
+   * given these, or the outer parts of the edge voxels are cut off.
+   * Uninitialized (min > max) without input points.
+   */
+  void GetVoxelBounds(double bounds[6]);
+
   ///@{
   /**
    * Level of detail: rays stop descending at voxels smaller than this many
-   * pixels. 0 (the default) always descends to the leaves.
+   * pixels and draw the node there (its averaged attributes). 1 (the
+   * default): leaves smaller than a pixel, which a ray would mostly miss
+   * (a see-through, speckled picture of a dense cloud), are drawn by their
+   * ancestor of about a pixel, and the trace does not pay for descending
+   * below what the screen shows. 0 always descends to the leaves.
    */
   vtkSetClampMacro(LODPixelThreshold, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(LODPixelThreshold, double);
@@ -218,10 +247,7 @@ public:
   ///@{
   /**
    * vtkImageData input: voxels whose value (the largest component) is at or
-   * below this become no point. Default 0. A voxel is a box of the image's
-   * spacing: with LeafDepth 0 the leaf is the finest spacing, and along
-   * wider axes (the slice distance of a CT) each voxel becomes as many
-   * points as it spans leaves, so the octree has no gaps between slices.
+   * below this become no point. Default 0.
    */
   vtkSetMacro(ImageBackground, double);
   vtkGetMacro(ImageBackground, double);
@@ -229,11 +255,30 @@ public:
 
   ///@{
   /**
-   * vtkImageData input with one-component scalars: give each voxel the
+   * vtkImageData input whose spacing differs between axes (a slice stack:
+   * slices farther apart than pixels): fill the space between slices with
+   * points interpolated linearly from the two neighbouring slices, so that
+   * the points are no farther apart along the coarsest axis than along the
+   * next (for a stack, the pixel spacing); ImageBackground applies to
+   * the interpolated values. With LeafDepth 0 the leaves are then the pixel
+   * size and the volume is closed. Off, the voxels alone become points and
+   * the leaves are as large as the slice spacing (closed too, coarser).
+   * The same rule as vtkSliceStackReader's FillBetweenSlices
+   * (octorayLattice.h). Default on.
+   */
+  vtkSetMacro(FillBetweenSlices, bool);
+  vtkGetMacro(FillBetweenSlices, bool);
+  vtkBooleanMacro(FillBetweenSlices, bool);
+  ///@}
+
+  ///@{
+  /**
+   * vtkImageData input with one-component scalars: give each point the
    * normal of the scalar field, the negated gradient by central differences
-   * (as VTK's volume mappers shade), so that shaded surfaces follow the
-   * tissue rather than the voxels' faces. On by default; off, the octree's
-   * occupancy gives the normals.
+   * (interpolated like the values between slices), as VTK's volume mappers
+   * shade, so that shaded surfaces follow the tissue rather than the
+   * voxels' faces. On by default; off, the octree's occupancy gives the
+   * normals.
    */
   vtkSetMacro(ImageGradientNormals, bool);
   vtkGetMacro(ImageGradientNormals, bool);
@@ -335,13 +380,14 @@ protected:
   int CudaDevice = -1;
   bool UseCudaGLInterop = true;
   int LeafDepth = 0;
-  double LODPixelThreshold = 0.0;
+  double LODPixelThreshold = 1.0;
   double RootBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   bool Shadows = false;
   int MaximumBounces = 2;
   double DepthCue = 0.0;
   double ImageSampleDistance = 1.0;
   double ImageBackground = 0.0;
+  bool FillBetweenSlices = true;
   bool ImageGradientNormals = true;
   char* ReflectivityArrayName = nullptr;
   char* RefractionArrayName = nullptr;

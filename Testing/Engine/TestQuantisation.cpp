@@ -1,10 +1,11 @@
 // The octree's quantisation error as the report measures it
-// (Testing/Bench/Engine/Quantisation.h): on the engine's own tree, the
+// (octoray/Quantisation.h): on the engine's own tree, the
 // distance from each point to the centre of its leaf must equal a
 // brute-force recomputation from the point, the root cube and the depth
 // alone, and never exceed half the leaf voxel's diagonal.
-#include "Quantisation.h"
 #include "TestSupport.h"
+
+#include <octoray/Quantisation.h>
 
 #include <cmath>
 
@@ -14,9 +15,9 @@ namespace
 {
 // Brute force, independent of Morton keys and of the tree: the leaf cell is
 // floor((p - origin) / side) per axis with side = cube / 2^depth.
-bench::QuantisationError BruteForce(const Cloud& c, const RootCube& cube, int depth)
+QuantisationError BruteForce(const Cloud& c, const RootCube& cube, int depth)
 {
-  bench::QuantisationError q;
+  QuantisationError q;
   q.leafSide = cube.size / std::pow(2.0, depth);
   q.bound = std::sqrt(3.0) / 2.0 * q.leafSide;
   double sum = 0;
@@ -55,8 +56,8 @@ TEST_P(Quantisation, EqualsBruteForceAndStaysWithinHalfTheLeafDiagonal)
       HostOctree tree;
       engine->CopyToHost(tree);
       ASSERT_EQ(tree.depth, depth);
-      const bench::QuantisationError q = bench::MeasureQuantisation(tree, cloud.View());
-      const bench::QuantisationError ref = BruteForce(cloud, tree.cube, depth);
+      const QuantisationError q = MeasureQuantisation(tree, cloud.View());
+      const QuantisationError ref = BruteForce(cloud, tree.cube, depth);
       EXPECT_DOUBLE_EQ(q.bound, ref.bound);
       EXPECT_NEAR(q.max, ref.max, 1e-12 * tree.cube.size);
       EXPECT_NEAR(q.mean, ref.mean, 1e-12 * tree.cube.size);
@@ -87,14 +88,14 @@ TEST_P(Quantisation, CornersReachTheBoundAndCentresAreExact)
   engine->Build(corners.View(), options);
   HostOctree tree;
   engine->CopyToHost(tree);
-  const bench::QuantisationError atCorners = bench::MeasureQuantisation(tree, corners.View());
+  const QuantisationError atCorners = MeasureQuantisation(tree, corners.View());
   EXPECT_DOUBLE_EQ(atCorners.max, std::sqrt(3.0) / 16.0);
   EXPECT_DOUBLE_EQ(atCorners.mean, std::sqrt(3.0) / 16.0);
   EXPECT_DOUBLE_EQ(atCorners.bound, std::sqrt(3.0) / 16.0);
 
   engine->Build(centres.View(), options);
   engine->CopyToHost(tree);
-  const bench::QuantisationError atCentres = bench::MeasureQuantisation(tree, centres.View());
+  const QuantisationError atCentres = MeasureQuantisation(tree, centres.View());
   EXPECT_EQ(atCentres.max, 0.0);
 }
 
@@ -112,8 +113,8 @@ TEST_P(Quantisation, APointOutsideTheTreeIsAnError)
   std::mt19937_64 rng(1);
   Cloud stranger;
   stranger.Add(0.9, 0.9, 0.9, rng);
-  EXPECT_THROW(bench::MeasureQuantisation(tree, stranger.View()), std::runtime_error);
-  EXPECT_NO_THROW(bench::MeasureQuantisation(tree, corner.View()));
+  EXPECT_THROW(MeasureQuantisation(tree, stranger.View()), std::runtime_error);
+  EXPECT_NO_THROW(MeasureQuantisation(tree, corner.View()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Quantisation, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);

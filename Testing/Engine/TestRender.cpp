@@ -272,7 +272,7 @@ TEST_P(RenderTest, DepthBufferInDeviceMemory)
   {
     for (int a = 0; a < 3; ++a)
     {
-      front.xyz[i + a] = 0.3 * front.xyz[i + a] + 0.5 * (eye[a] + target[a]) * 0.6;
+      front.xyz[i + a] = 0.8 * front.xyz[i + a] + 0.3 * (eye[a] + target[a]);
     }
   }
   auto occluder = CreateEngine(Backend::CUDA);

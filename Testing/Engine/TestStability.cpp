@@ -6,7 +6,7 @@
 // reference (TestSupport.h), or geometry worked out here (Snell's law, the
 // Phong formula, a box's outline). Each test records for the report what
 // it compared ("check") and what it measured ("outcome") as properties of
-// its <testcase> in the GoogleTest XML (Testing/Report/section_stability.py
+// its <testcase> in the GoogleTest XML (Benchmarks/Report/section_stability.py
 // reads them).
 #include "TestRenderSupport.h"
 

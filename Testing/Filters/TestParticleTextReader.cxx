@@ -156,6 +156,55 @@ int main(int argc, char* argv[])
     CHECK_CONTAINS(r->GetErrorMessage(), "missing.txt: cannot open the file");
   }
 
+  // CanReadFile: the content decides for names other than .particles (a
+  // reader factory asks it for .txt, .csv, .xyz), a .particles name is ours.
+  {
+    std::string numbers;
+    for (int i = 0; i < 5000; ++i) // more than the 64 KiB looked at
+    {
+      numbers += std::to_string(i) + ".5 " + std::to_string(-i) + " 3.25\n";
+    }
+    const struct
+    {
+      const char* Name;
+      std::string Text;
+      int Expected;
+    } cases[] = {
+      { "thesis.txt", "# x y z r g b reflectivity refraction\n1 2 3 4 5 6 0.5 0\n", 1 },
+      { "xyz.xyz", "1 2 3\n4 5 6\n", 1 },
+      { "scalar.txt", "1 2 3 0.5\r\n4 5 6 0.25\r\n", 1 },
+      { "rgb.csv", "1,2,3,255,0,0\n4,5,6,0,255,0\n", 1 },
+      { "named.csv", "x,y,z,intensity,return\n1,2,3,0.5,1\n", 1 },
+      { "comments.txt", "# scan 7\n\n1 2 3 # first\n4 5 6\n", 1 },
+      { "long.txt", numbers, 1 },
+      { "text.csv", "name,value,unit\nfoo,1,m\n", 0 },
+      { "xyzfirst.csv", "a,b,c\n1,2,3\n", 0 }, // 3 names, but not x y z
+      { "five.csv", "1,2,3,4,5\n", 0 },
+      { "ragged.txt", "1 2 3\n4 5\n", 0 },
+      { "word.txt", "1 2 3\n4 5 six\n", 0 },
+      { "molecule.xyz", "3\nwater\nO 0 0 0\nH 1 0 0\nH 0 1 0\n", 0 },
+      { "note.txt", "hello world\n", 0 },
+      { "header-only.csv", "x,y,z\n", 0 },
+      { "binary.txt", std::string("1 2 3\n\0\x01\x02\n", 10), 0 },
+      { "empty.txt", "", 0 },
+      { "bad.particles", "not particles at all\n", 1 }, // the reader reports what is wrong
+    };
+    for (const auto& c : cases)
+    {
+      const std::string path = Write(c.Name, c.Text);
+      const int got = vtkParticleTextReader::CanReadFile(path.c_str());
+      if (got != c.Expected)
+      {
+        std::cerr << "CanReadFile(" << c.Name << ") = " << got << ", expected " << c.Expected
+                  << std::endl;
+      }
+      CHECK(got == c.Expected);
+    }
+    CHECK(vtkParticleTextReader::CanReadFile((Dir + "/missing.txt").c_str()) == 0);
+    CHECK(vtkParticleTextReader::CanReadFile(Dir.c_str()) == 0); // a directory
+    CHECK(vtkParticleTextReader::CanReadFile(nullptr) == 0);
+  }
+
   if (octorayTestFailures)
   {
     std::cerr << octorayTestFailures << " check(s) failed" << std::endl;

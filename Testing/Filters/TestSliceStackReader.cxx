@@ -5,6 +5,7 @@
 
 #include "vtkDataArray.h"
 #include "vtkDepthMapReader.h"
+#include "vtkFieldData.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkParticleNormals.h"
@@ -57,8 +58,24 @@ int main(int argc, char* argv[])
     im->GetScalarRange(range);
     // Rescale intercept -1024 applied: air is near -1000 HU.
     CHECK(range[0] < -800 && range[1] > 0);
-    CHECK(r->GetOutput()->GetNumberOfPoints() > 0);
-    CHECK(r->GetOutput()->GetNumberOfPoints() < 16 * 16 * 5);
+    // Filled between slices (the default): 6 planes per 2.5 mm gap (the
+    // pixels are 0.488 mm), so 25 planes; the slices' own particles are
+    // those of the reader without filling.
+    CHECK(r->GetFillBetweenSlices());
+    const vtkIdType filled = r->GetOutput()->GetNumberOfPoints();
+    CHECK(filled > 0 && filled < 16 * 16 * 25);
+    vtkDataArray* lattice = r->GetOutput()->GetFieldData()->GetArray("PointLattice");
+    CHECK(lattice && lattice->GetNumberOfComponents() == 15);
+    if (lattice)
+    {
+      CHECK(std::abs(lattice->GetComponent(0, 11) - 2.5 / 6) < 1e-9); // step along the slice normal
+      CHECK(lattice->GetComponent(0, 14) == 25);                      // planes
+    }
+    r->FillBetweenSlicesOff();
+    r->Update();
+    const vtkIdType slices = r->GetOutput()->GetNumberOfPoints();
+    CHECK(slices > 0 && slices < 16 * 16 * 5);
+    CHECK(filled > 4 * slices);
   }
 
   {

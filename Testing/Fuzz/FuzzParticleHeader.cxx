@@ -1,7 +1,7 @@
 // libFuzzer target: the particle text format without VTK (the prologue:
-// comments, header line, first data line; and every token through the
-// number parser). Invariants are checked with abort(), which the fuzzer
-// reports as a crash.
+// comments, header line, first data line; CanReadFile's sniffer; and every
+// token through the number parser). Invariants are checked with abort(),
+// which the fuzzer reports as a crash.
 #include "octorayParticleTextFormat.h"
 
 #include <cstdint>
@@ -24,6 +24,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* bytes, size_t size)
   {
     std::abort(); // every error names the file and line
   }
+  // The sniffer of CanReadFile: a yes implies a prologue the reader
+  // accepts; on a cut-off start it never reads past the bytes given.
+  if (LooksLikeParticleText(data, size, true) && !p.Ok)
+  {
+    std::abort();
+  }
+  LooksLikeParticleText(data, size, false);
   // Every token of the first line through both number parsers and the
   // error-message token (bounded, printable).
   const char* e = data + size;

@@ -1,6 +1,6 @@
-"""octoray_bench_quality's image metrics (Testing/Bench/Engine/ImageMetrics.h)
+"""octoray_bench_quality's image metrics (Benchmarks/Engine/ImageMetrics.h)
 against scikit-image on real rendered pictures: the program renders the CT
-series (written by Testing/Report/scenes.py), the LiDAR tile and the sphere
+series (written by Benchmarks/Report/scenes.py), the LiDAR tile and the sphere
 field at a small size, dumps every compared pair as PFM, and each record's
 RMSE, PSNR and SSIM must equal what scikit-image computes from the same
 floats (SSIM per Wang et al. 2004: 11x11 Gaussian window, sigma 1.5,
@@ -16,7 +16,7 @@ import pytest
 from skimage.metrics import peak_signal_noise_ratio, structural_similarity
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "Report"))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "Benchmarks", "Report"))
 import scenes  # noqa: E402
 
 PROGRAM = os.environ.get("OCTORAY_BENCH_QUALITY")

@@ -68,9 +68,11 @@ def test_16bit_tiff_stack_pattern(tmp_path):
     vol[vol < 1500] = 0  # a background of zeros
     folder = os.path.join(str(tmp_path), "tif")
     write_slices(vtk.vtkTIFFWriter, folder, "ct_%02d.tif", vol)
+    # The slices' pixels only (FillBetweenSlices off): test_fill_* below
+    # check the particles between slices.
     r, out, msgs = reader_for(FilePattern=os.path.join(folder, "ct_%02d.tif"),
                               FileNameRange=(0, 5), Spacing=(0.5, 0.25, 2.0),
-                              Origin=(10.0, 20.0, 30.0))
+                              Origin=(10.0, 20.0, 30.0), FillBetweenSlices=False)
     assert not msgs.errors, msgs.errors
     im = r.GetImageOutput()
     assert im.GetDimensions() == (30, 20, 6)
@@ -92,6 +94,16 @@ def test_16bit_tiff_stack_pattern(tmp_path):
     r.SetBackgroundRange(0, 2500)
     r.Update()
     assert r.GetOutput().GetNumberOfPoints() == np.count_nonzero(vol > 2500)
+    # Filled (the default): the same particles on the slices, and planes
+    # between them 0.5 apart (the second-coarsest spacing: x) with values
+    # interpolated from the two neighbouring slices.
+    r.SetBackgroundRange(0, 0)
+    r.SetFillBetweenSlices(True)
+    r.Update()
+    filled = points(r.GetOutput())
+    on_slices = np.isclose((filled[:, 2] - 30.0) / 2.0, np.round((filled[:, 2] - 30.0) / 2.0), atol=1e-6)
+    np.testing.assert_allclose(np.sort(array(r.GetOutput(), "Scalars")[on_slices]), np.sort(vol[vol > 0]))
+    np.testing.assert_allclose(np.unique(np.round(filled[:, 2], 4)), 30.0 + 0.5 * np.arange(21), atol=1e-4)
 
 
 def test_rgb_png_stack_directory_natural_order(tmp_path):
@@ -124,7 +136,8 @@ def test_rgb_png_stack_directory_natural_order(tmp_path):
 def test_roi_and_stride(tmp_path):
     vol = np.arange(1, 5 * 6 * 7 + 1, dtype=np.uint16).reshape(5, 6, 7)
     files = write_slices(vtk.vtkTIFFWriter, str(tmp_path), "s%d.tif", vol)
-    r, out, msgs = reader_for(Files=files, RegionOfInterest=(1, 5, 0, 3, 1, 4), Stride=(2, 3, 2))
+    r, out, msgs = reader_for(Files=files, RegionOfInterest=(1, 5, 0, 3, 1, 4), Stride=(2, 3, 2),
+                              FillBetweenSlices=False)
     assert not msgs.errors
     flipped = vol[:, ::-1]  # index j counts up from the bottom row
     sub = flipped[1:5:2, 0:4:3, 1:6:2]
@@ -195,7 +208,8 @@ def test_dicom_series_out_of_order(tmp_path, data_dir):
     os.makedirs(folder)
     for a, b in names.items():
         shutil.copy(os.path.join(src, a), os.path.join(folder, b))
-    r, out, msgs = reader_for(DirectoryName=folder, BackgroundRange=(-10000, -500))
+    r, out, msgs = reader_for(DirectoryName=folder, BackgroundRange=(-10000, -500),
+                              FillBetweenSlices=False)
     assert not msgs.errors, msgs.errors
     assert r.GetIsDICOM()
     # Reference from pydicom: sort by ImagePositionPatient z (axial, normal +z).
@@ -220,6 +234,22 @@ def test_dicom_series_out_of_order(tmp_path, data_dir):
     ipp = np.array([float(v) for v in ds[0].ImagePositionPatient])
     expected = ipp + np.column_stack([i * 0.488281, j * 0.488281, k * 2.5])
     np.testing.assert_allclose(points(out), expected, atol=1e-4)
+    # Filled: 6 planes per 2.5 mm (2.5 / 0.488 = 5.1), the slices' particles
+    # among them unchanged, values between slices linear in z.
+    r.SetFillBetweenSlices(True)
+    r.Update()
+    filled = points(r.GetOutput())
+    zs = np.unique(np.round(filled[:, 2] - ipp[2], 5))
+    np.testing.assert_allclose(np.diff(zs), 2.5 / 6, atol=1e-4)
+    assert len(zs) == 4 * 6 + 1
+    on_slices = np.isclose(filled[:, 2] - ipp[2], np.round((filled[:, 2] - ipp[2]) / 2.5) * 2.5, atol=1e-4)
+    np.testing.assert_allclose(filled[on_slices], expected, atol=1e-4)
+    t = 2.0 / 6  # the plane 2/6 of the way from slice 1 to slice 2
+    between = hu[1] * (1 - t) + hu[2] * t
+    jj, ii = np.nonzero(between > -500)
+    sel = np.isclose(filled[:, 2], ipp[2] + 2.5 * (1 + t), atol=1e-4)
+    assert sel.sum() == len(ii)
+    np.testing.assert_allclose(array(r.GetOutput(), "Scalars")[sel], between[jj, ii], rtol=1e-5, atol=1e-3)
 
 
 def test_dicom_single_ct_slice(data_dir):
@@ -230,6 +260,122 @@ def test_dicom_single_ct_slice(data_dir):
     hu = d.pixel_array * float(d.RescaleSlope) + float(d.RescaleIntercept)
     assert r.GetImageOutput().GetDimensions() == (128, 128, 1)
     assert out.GetNumberOfPoints() == np.count_nonzero(hu > 0)
+
+
+# --- a closed volume: filling between slices -------------------------------
+
+def block_stack(tmp_path, slices=6, h=10, w=12, value=1000):
+    """A solid block (value inside, 0 around) written as 16-bit PNG slices:
+    slices 1..slices-2, rows 2..h-3, columns 2..w-3."""
+    vol = np.zeros((slices, h, w), np.uint16)
+    vol[1:slices - 1, 2:h - 2, 2:w - 2] = value
+    folder = os.path.join(str(tmp_path), "block")
+    write_slices(vtk.vtkPNGWriter, folder, "b%02d.png", vol)
+    return folder, vol
+
+
+def lattice_of(out):
+    a = out.GetFieldData().GetArray("PointLattice")
+    assert a is not None and a.GetNumberOfComponents() == 15 and a.GetNumberOfTuples() == 1
+    t = np.array(a.GetTuple(0))
+    return t[0:3], t[3:12].reshape(3, 3), t[12:15]
+
+
+def test_fill_closes_a_block(tmp_path):
+    """Slices 3 pixel spacings apart: the particles are no farther apart
+    along the slice axis than across it, the background test applies to
+    the interpolated values, and the slices' own particles are unchanged."""
+    folder, vol = block_stack(tmp_path)
+    r, out, msgs = reader_for(DirectoryName=folder, Spacing=(0.5, 0.5, 1.5), Origin=(1.0, 2.0, 3.0),
+                              BackgroundRange=(0, 500))
+    assert not msgs.errors, msgs.errors
+    assert r.GetFillBetweenSlices()  # the default
+    np.testing.assert_array_equal(stack_of(r), vol)  # output 1: the stack as read
+    p = points(out)
+    zs = np.unique(np.round(p[:, 2], 6))
+    # Planes 0.5 apart; the block (slices 1..4) reaches a third of the way to
+    # the empty slices 0 and 5, where the interpolated value 1000 * 2/3
+    # is still above 500 and 1000 * 1/3 is not.
+    np.testing.assert_allclose(zs, 3.0 + 0.5 * np.arange(2, 14), atol=1e-5)
+    assert out.GetNumberOfPoints() == 8 * 6 * 12
+    assert out.GetNumberOfVerts() == out.GetNumberOfPoints()
+    xs, ys = np.unique(np.round(p[:, 0], 6)), np.unique(np.round(p[:, 1], 6))
+    np.testing.assert_allclose(np.diff(xs), 0.5)
+    np.testing.assert_allclose(np.diff(ys), 0.5)
+    scalars = array(out, "Scalars")
+    np.testing.assert_allclose(np.unique(np.round(scalars, 3)), [666.667, 1000.0], atol=1e-3)
+    # The lattice the mapper reads: origin, step vectors, counts (16 planes).
+    origin, steps, counts = lattice_of(out)
+    np.testing.assert_allclose(origin, (1.0, 2.0, 3.0))
+    np.testing.assert_allclose(steps, np.diag((0.5, 0.5, 0.5)))
+    np.testing.assert_array_equal(counts, (12, 10, 16))
+
+    # Off: the slices' pixels only, as before filling existed.
+    r.SetFillBetweenSlices(False)
+    r.Update()
+    out = r.GetOutput()
+    assert out.GetNumberOfPoints() == 8 * 6 * 4
+    np.testing.assert_allclose(np.unique(np.round(points(out)[:, 2], 6)), 3.0 + 1.5 * np.arange(1, 5))
+    origin, steps, counts = lattice_of(out)
+    np.testing.assert_allclose(steps, np.diag((0.5, 0.5, 1.5)))
+    np.testing.assert_array_equal(counts, (12, 10, 6))
+
+
+def test_fill_interpolates_between_neighbouring_slices(tmp_path):
+    """Values between slices come from the two slices around each plane,
+    also with a stride along the slices (which fills the wider gaps); a
+    region of interest moves the lattice's origin."""
+    vol = np.stack([np.full((4, 5), 100 * (k + 1), np.uint16) for k in range(5)])
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "s%d.png", vol)
+    r, out, msgs = reader_for(Files=files, Spacing=(1.0, 1.0, 2.0))
+    z = np.round(points(out)[:, 2], 6)
+    s = array(out, "Scalars")
+    assert sorted(set(z)) == [float(v) for v in range(9)]  # 2 planes per slice gap
+    np.testing.assert_allclose(s[z == 1.0], 150.0)
+    np.testing.assert_allclose(s[z == 8.0], 500.0)
+    # Stride 2 along the slices: slices 0, 2, 4 selected, 4 mm apart, filled
+    # every 1 mm from the real slices in between.
+    r.SetStride(1, 1, 2)
+    r.Update()
+    z = np.round(points(r.GetOutput())[:, 2], 6)
+    s = array(r.GetOutput(), "Scalars")
+    assert sorted(set(z)) == [float(v) for v in range(9)]
+    np.testing.assert_allclose(s[z == 1.0], 150.0)
+    np.testing.assert_allclose(s[z == 3.0], 250.0)
+    # A region of interest from slice 1: the lattice starts there.
+    r.SetStride(1, 1, 1)
+    r.SetRegionOfInterest(1, 3, -1, -1, 1, 3)
+    r.Update()
+    origin, steps, counts = lattice_of(r.GetOutput())
+    np.testing.assert_allclose(origin, (1.0, 0.0, 2.0))
+    np.testing.assert_array_equal(counts, (3, 4, 5))
+    assert r.GetOutput().GetNumberOfPoints() == 3 * 4 * 5
+
+
+def test_fill_colours(tmp_path):
+    vol = np.zeros((2, 2, 2, 3), np.uint8)
+    vol[0] = (10, 20, 30)
+    vol[1] = (41, 51, 61)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "c%d.png", vol)
+    r, out, msgs = reader_for(Files=files, Spacing=(1.0, 1.0, 2.0))
+    z = np.round(points(out)[:, 2], 6)
+    colors = array(out, "Colors")
+    assert sorted(set(z)) == [0.0, 1.0, 2.0]
+    np.testing.assert_array_equal(colors[z == 0.0], [[10, 20, 30]] * 4)
+    np.testing.assert_array_equal(colors[z == 1.0], [[26, 36, 46]] * 4)  # 25.5, 35.5, 45.5 rounded
+    np.testing.assert_allclose(array(out, "Scalars")[z == 1.0], 35.5)
+
+
+def test_fill_single_slice_and_equal_spacing(tmp_path):
+    """Nothing to fill: one slice, or slices as far apart as the pixels."""
+    vol = np.ones((1, 3, 3), np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "o%d.png", vol)
+    r, out, msgs = reader_for(Files=files, Spacing=(0.5, 0.5, 5.0))
+    assert out.GetNumberOfPoints() == 9
+    vol = np.ones((3, 3, 3), np.uint8)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "e%d.png", vol)
+    r, out, msgs = reader_for(Files=files, Spacing=(0.7, 0.7, 0.7))
+    assert out.GetNumberOfPoints() == 27
 
 
 # --- errors ----------------------------------------------------------------

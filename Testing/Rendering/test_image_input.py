@@ -1,14 +1,15 @@
-"""vtkOctreeVolumeMapper on vtkImageData: voxels are boxes of the image's
-spacing (label python, vtk; run under a display by ctest).
+"""vtkOctreeVolumeMapper on vtkImageData, as the demo's CT uses it (label
+python, vtk; run under a display by ctest):
 
 - LeafDepth 0 chooses the depth from the spacing: the leaf is the finest
   spacing, and the voxel centres are leaf centres;
-- along an axis whose spacing is wider than a leaf (a CT's slice distance)
-  the octree has no empty layers between slices, and values are
-  interpolated linearly between slices;
-- with RootBounds around the voxel centres (what parallel ranks set) every
-  point stays inside the cube;
-- gradient normals: a sphere's shading follows the sphere, not the voxels.
+- with slices farther apart than the pixels the octree has no empty layers
+  between slices (FillBetweenSlices), and values are interpolated linearly
+  between slices;
+- with RootBounds around the voxel centres (what parallel ranks set) the
+  build succeeds;
+- gradient normals (ImageGradientNormals): a sphere's shading follows the
+  sphere (Lambert's law), not the voxels.
 """
 import numpy as np
 import pytest
@@ -80,36 +81,33 @@ def test_depth_from_the_spacing_and_leaves_on_the_voxels():
 
 
 def test_no_empty_layers_between_slices():
-    # 8 x 8 voxels of 1, 4 slices 2.5 apart: the leaf is 1 wide, so each
-    # slice spans 2.5 leaves; without filling, 6 of the 10 leaf layers
-    # would be empty.
+    # 8 x 8 voxels of 1, 4 slices 2.5 apart (z 0 .. 7.5): planes of points
+    # are filled in between, the leaf is the pixel (1), and every leaf layer
+    # from the first slice to the last holds points: 9 of them.
     im = image(np.full((4, 8, 8), 100.0), (1.0, 1.0, 2.5))
     mapper, _ = render(im, configure=lambda m: m.SetImageBackground(50.0))
     assert mapper.GetLeafSize() == pytest.approx(1.0, rel=1e-5)
     centres, _ = leaves(mapper)
     layers = np.unique(np.round(centres[:, 2], 3))
-    # The slices' boxes span z -1.25 .. 8.75: 10 leaf layers, all present.
-    assert len(layers) == 10, layers
-    assert np.all(np.diff(layers) == pytest.approx(1.0, rel=1e-4))
-    assert len(centres) == 8 * 8 * 10
+    assert len(layers) == 9, layers
+    assert np.allclose(np.diff(layers), 1.0, rtol=1e-4)
+    assert layers[0] == pytest.approx(0.0, abs=1e-3) and layers[-1] == pytest.approx(8.0, abs=1e-3)
+    assert len(centres) == 8 * 8 * 9
 
 
 def test_values_are_interpolated_between_slices():
-    # Two slices 4 apart, 0 and 100: the points between them take the
-    # values in between, and only those above the background are kept.
+    # Two slices 4 apart, 0 and 100: the planes between them take the values
+    # in between (25, 50, 75), and only those above the background (40) are
+    # kept: the planes at z = 2, 3, 4 with 50, 75 and 100.
     values = np.zeros((2, 4, 4))
     values[1] = 100.0
     im = image(values, (1.0, 1.0, 4.0))
     mapper, _ = render(im, configure=lambda m: m.SetImageBackground(40.0))
     centres, pd = leaves(mapper)
     scalars = vtk_to_numpy(pd.GetPointData().GetArray("Scalars"))
-    # Slice 0 (value 0) is below the background; its upper sub-points lean
-    # towards slice 1 and reach 37.5 at most: below 40, left out. Slice 1's
-    # lower sub-points: 100 - 12.5 * k.
-    z = np.round(centres[:, 2], 3)
-    assert z.min() > 2.0  # nothing of slice 0's box (z -2 .. 2)
-    assert scalars.min() > 40.0 and scalars.max() <= 100.0
-    assert len(np.unique(np.round(scalars, 3))) > 1  # interpolated, not replicated
+    assert sorted(np.unique(np.round(scalars, 3))) == [50.0, 75.0, 100.0]
+    assert sorted(np.unique(np.round(centres[:, 2], 3))) == [2.0, 3.0, 4.0]
+    assert len(centres) == 3 * 16
 
 
 def test_root_bounds_around_the_voxel_centres():

@@ -77,6 +77,28 @@ def test_render_dicom_folder(tmp_path):
     assert read_png(str(out))[2][:, :3].max() > 0
 
 
+def test_render_slice_stack_closed(tmp_path):
+    """A CT series (slices 2.5 mm apart, pixels 0.488 mm): filled between
+    slices, leaves of the pixel size; the same points from the stack's
+    volume (--image); unfilled, leaves of the slice spacing."""
+    folder = os.path.join(DATA, "DICOM", "CT5N")
+    common = ["--backend", "cpu", "--size", "96x96", "--background", "-10000", "-500", "--parallel"]
+
+    def values(stdout):
+        return {k: v.split()[0] for k, v in (line.split(": ", 1) for line in stdout.splitlines() if ": " in line)}
+
+    runs = {}
+    for name, extra in (("particles", []), ("image", ["--image"]), ("unfilled", ["--no-fill"])):
+        r = run(folder, "-o", str(tmp_path / (name + ".png")), *common, *extra)
+        assert r.returncode == 0, r.stderr
+        runs[name] = values(r.stdout)
+    assert abs(float(runs["particles"]["leaf"]) - 0.488281) < 1e-4
+    assert runs["image"]["points"] == runs["particles"]["points"]
+    assert runs["image"]["leaf"] == runs["particles"]["leaf"]
+    assert abs(float(runs["unfilled"]["leaf"]) - 2.5) < 1e-4
+    assert int(runs["unfilled"]["points"]) * 4 < int(runs["particles"]["points"])
+
+
 def test_missing_input_is_an_error(tmp_path):
     r = run(str(tmp_path / "nothing.particles"), "-o", str(tmp_path / "x.png"))
     assert r.returncode != 0

@@ -274,6 +274,7 @@ BuildStats CpuEngine::BuildFromPointState(const RootCube& cube, int requestedDep
   stats.levelSeconds = SecondsSince(phase);
 
   stats.depth = depth;
+  stats.cube = cube;
   stats.nodes = Tree.NodeCount();
   for (int l = 0; l <= depth; ++l)
   {

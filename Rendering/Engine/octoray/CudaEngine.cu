@@ -775,6 +775,7 @@ BuildStats CudaEngine::BuildFromState(DeviceState& s, const RootCube& cube, int 
   stats.levelSeconds = SecondsSince(phase);
 
   stats.depth = depth;
+  stats.cube = cube;
   stats.nodes = nodes;
   for (int l = 0; l <= depth; ++l)
   {

@@ -137,6 +137,7 @@ struct BuildStats
 {
   std::size_t points = 0;
   int depth = 0;
+  RootCube cube; // the root cube the octree was built in (fixed or fitted)
   std::vector<std::uint32_t> nodesPerLevel;
   std::size_t nodes = 0;
   std::size_t bytes = 0;     // MemoryReport::Total() after the build

@@ -4,16 +4,20 @@
         [--size 1920x1080] [--mode surface|phong|depthcue|composite|mip|minip|average|additive]
         [--shadows] [--preset ct-bone|ct-skin|ct-muscle] [--threshold V]
         [--color-by auto|colors|intensity|z|none|ARRAY] [--normals auto|pcl|none]
-        [--azimuth DEG] [--elevation DEG] [--zoom F] [--depth N] [--background LO HI]
+        [--azimuth DEG] [--elevation DEG] [--zoom F] [--parallel] [--depth N]
+        [--background LO HI] [--particles] [--no-fill]
 
 INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
 cloud (.pcd: ascii, binary or binary_compressed), a folder of image slices or
 DICOM files, or a printf pattern of slice names ("ct_%03d.png", with --range
-FIRST LAST). Slice stacks are drawn from the reader's image output: voxels
-above --threshold (default: the preset's, else 0) become the octree, which
-fills the space between slices. Reading, normals and building show a
-progress bar on stderr; the backend and the load, normals, build and render
-times are printed on stdout.
+FIRST LAST). Slice stacks are drawn from the reader's image output (its
+volume, a vtkImageData; --particles: its particles): voxels above
+--threshold (default: the preset's, else 0) become the octree, with
+interpolated points between slices (--no-fill: not), so the stack draws as a
+closed volume, shaded by the CT's gradient. Reading, normals and building
+show a progress bar on stderr; the backend, the octree's points, depth and
+leaf size and the load, normals, build and render times are printed on
+stdout.
 
 Defaults: --preset applies a CT transfer function (Hounsfield units) and its
 threshold; points without RGB colours are coloured by their Intensity array,
@@ -82,7 +86,15 @@ def parser():
     p.add_argument("--depth", type=int, default=0, help="octree leaf level (0: automatic)")
     p.add_argument("--range", type=int, nargs=2, default=(0, 0), metavar=("FIRST", "LAST"))
     p.add_argument("--background", type=float, nargs=2, default=None, metavar=("LO", "HI"),
-                   help="slice intensities that are background: as --threshold HI")
+                   help="slice intensities that are background: as --threshold HI (--particles: the "
+                        "reader's BackgroundRange)")
+    p.add_argument("--parallel", action="store_true", help="parallel projection")
+    p.add_argument("--image", action="store_true",
+                   help="slice stacks: draw the stack's volume (a vtkImageData; the default)")
+    p.add_argument("--particles", action="store_true",
+                   help="slice stacks: draw the reader's particles instead of its volume")
+    p.add_argument("--no-fill", action="store_true",
+                   help="slice stacks: no points between slices (leaves as large as the slice spacing)")
     return p
 
 
@@ -101,7 +113,28 @@ def main(argv=None):
 
     # ---- Load.
     kind = scene.input_kind(args.input)
-    reader, data, load = scene.read(args.input, args.range)
+    if (args.image or args.particles or args.no_fill) and kind != "slices":
+        p.error("--image, --particles and --no-fill need a slice stack (a folder or a pattern of slices)")
+    if args.image and args.particles:
+        p.error("--image and --particles exclude each other")
+    threshold = args.threshold
+    if args.background is not None and threshold is None:
+        threshold = args.background[1]
+    if args.preset is not None and threshold is None and blend == "surface":
+        threshold = octoray.vtkOctreeVolumePresets.GetSurfaceThreshold(args.preset)
+
+    def configure(reader):
+        if kind != "slices":
+            return
+        reader.SetFillBetweenSlices(not args.no_fill)
+        if args.particles and args.background is not None:
+            reader.SetBackgroundRange(*args.background)
+        elif args.particles and threshold is not None:
+            reader.SetBackgroundRange(-1e300, threshold)
+
+    reader, data, load = scene.read(args.input, args.range, configure=configure)
+    if args.particles:
+        data = reader.GetOutput()
     if data is None or data.GetNumberOfPoints() == 0:
         print("error: nothing read from %s" % args.input, file=sys.stderr)
         return 1
@@ -127,11 +160,9 @@ def main(argv=None):
     if args.mode == "depthcue":
         mapper.SetDepthCue(0.7)
     mapper.SetShadows(args.shadows and shade)
+    mapper.SetFillBetweenSlices(not args.no_fill)
     prop = vtk.vtkVolumeProperty()
     colouring = None
-    threshold = args.threshold
-    if args.background is not None and threshold is None:
-        threshold = args.background[1]
     if args.preset is not None:
         scalars = data.GetPointData().GetScalars()
         if scalars is None or scalars.GetNumberOfComponents() != 1:
@@ -139,9 +170,7 @@ def main(argv=None):
                   % (args.input, "none" if scalars is None else "%d components" % scalars.GetNumberOfComponents()),
                   file=sys.stderr)
             return 1
-        preset_threshold = octoray.apply_preset(args.preset, prop)
-        if threshold is None and blend == "surface":
-            threshold = preset_threshold
+        octoray.apply_preset(args.preset, prop)
         colouring = "preset %s" % args.preset
     else:
         try:
@@ -150,8 +179,10 @@ def main(argv=None):
             print("error: --color-by: %s" % e, file=sys.stderr)
             return 1
         scalars = data.GetPointData().GetScalars()
-        if image and scalars is not None and scalars.GetNumberOfComponents() == 1:
+        if kind == "slices" and scalars is not None and scalars.GetNumberOfComponents() == 1:
             lo, hi = scalars.GetRange()
+            if image and threshold is not None:
+                lo = max(lo, min(threshold, hi))  # the transfer function over the drawn values
             ctf = vtk.vtkColorTransferFunction()
             ctf.AddRGBPoint(lo, 0.2, 0.2, 0.9)
             ctf.AddRGBPoint(0.5 * (lo + hi), 0.9, 0.8, 0.3)
@@ -185,6 +216,7 @@ def main(argv=None):
     front, up = scene.default_view(data, kind, reader)
     bounds = scene.visible_bounds(data, mapper.GetImageBackground()) if image else data.GetBounds()
     scene.look_at(ren, bounds, front, up, args.azimuth, args.elevation, args.zoom)
+    ren.GetActiveCamera().SetParallelProjection(args.parallel)
 
     # ---- Build and render: the first render builds the octree.
     with scene.Timer() as first:
@@ -196,12 +228,15 @@ def main(argv=None):
     scene.write_png(scene.grab(window), args.output)
 
     print("backend: %s (%s)" % (mapper.GetLastUsedBackendName(), mapper.GetBackendDescription()))
-    print("points: %d%s" % (data.GetNumberOfPoints(), " voxels" if image else ""))
     if image:
+        d = data.GetDimensions()
+        print("input: %d voxels (%d x %d x %d)" % (data.GetNumberOfPoints(), d[0], d[1], d[2]))
         print("threshold: %g (voxels at or below are empty)" % mapper.GetImageBackground())
-    print("octree: %d points, depth %d%s, leaf %.4g"
-          % (mapper.GetNumberOfOctreePoints(), mapper.GetOctreeDepth(),
-             " (automatic)" if args.depth == 0 else "", mapper.GetLeafSize()))
+    else:
+        print("input: %d points" % data.GetNumberOfPoints())
+    print("points: %d (in the octree%s)" % (mapper.GetNumberOfOctreePoints(), ", of the image" if image else ""))
+    print("depth: %d%s" % (mapper.GetOctreeDepth(), " (automatic)" if args.depth == 0 else ""))
+    print("leaf: %.6g" % mapper.GetLeafSize())
     if colouring:
         print("colour: %s" % colouring)
     print("load: %.3f s" % load)

@@ -100,11 +100,13 @@ def make_reader(path, file_range=(0, 0)):
     return reader
 
 
-def read(path, file_range=(0, 0), progress_label="reading", stream=None):
+def read(path, file_range=(0, 0), progress_label="reading", stream=None, configure=None):
     """Reads `path` with a progress line; returns (reader, data, seconds).
     Slice stacks give the reader's image output (vtkImageData), the others
-    the points (vtkPolyData)."""
+    the points (vtkPolyData). `configure(reader)` is called before reading."""
     reader = make_reader(path, file_range)
+    if configure:
+        configure(reader)
     if progress_label:
         reader.AddObserver("ProgressEvent", ProgressBar(progress_label, stream))
     with Timer() as t:

@@ -3,8 +3,8 @@ would do today with the same points (vtkPointInterpolator or
 vtkGaussianSplatter into an image drawn by vtkSmartVolumeMapper;
 vtkPointGaussianMapper), and the mapper's own cost in a VTK render window.
 
-produce: Testing/Rendering/bench_pictures.py (JSON + the first frame of every
-method as PNG under work/pictures/) and Testing/Rendering/bench_mapper.py
+produce: Benchmarks/Python/bench_pictures.py (JSON + the first frame of every
+method as PNG under work/pictures/) and Benchmarks/Python/bench_mapper.py
 (its printed table, in work/pictures-mapper.log), both under an X display.
 render: one table and one montage per scene, a CSV, the mapper's table.
 """
@@ -46,7 +46,7 @@ def produce(ctx):
     for stale in ("pictures.json", "pictures-mapper.json"):
         if os.path.exists(ctx.work_path(stale)):
             os.remove(ctx.work_path(stale))
-    rendering = os.path.join(ctx.root, "Testing", "Rendering")
+    rendering = os.path.join(ctx.root, "Benchmarks", "Python")
     ctx.run("pictures", [PYTHON, os.path.join(rendering, "bench_pictures.py"),
                          "--json", ctx.work_path("pictures.json"), "--images", images],
             env=_env(ctx), display=True, timeout=600)

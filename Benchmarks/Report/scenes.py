@@ -3,7 +3,7 @@
 the project's own VTK readers and writers (so the engine-only benchmarks,
 which cannot link VTK, read them as particle files).
 
-    Testing/Report/scenes.py ct5n OUT.particles   # needs the build's octoray package on PYTHONPATH
+    Benchmarks/Report/scenes.py ct5n OUT.particles   # needs the build's octoray package on PYTHONPATH
 
 From a section: `ct_particles(ctx)` writes build/report/scenes/ct5n.particles
 once per report run and returns its path.
@@ -54,6 +54,10 @@ def write_ct5n(out):
     reader = octoray.vtkSliceStackReader()
     reader.SetDirectoryName(CT5N)
     reader.SetBackgroundRange(-1e9, CT_AIR_BELOW_HU)  # intensity in this range: no particle
+    # The scene is the voxels themselves (as RESULTS.md and the GPU run's
+    # copy of this file have it), not the planes the reader fills between
+    # slices by default.
+    reader.SetFillBetweenSlices(False)
     reader.Update()
     if reader.GetErrorCode() or reader.GetOutput().GetNumberOfPoints() == 0:
         raise RuntimeError(f"{CT5N}: {reader.GetErrorMessage() or 'no points'}")

@@ -21,7 +21,7 @@ REPEATS = 3
 
 def produce(ctx):
     record_machine(ctx, "readers", "start")
-    ctx.run("readers", ["/usr/bin/python3", os.path.join(ctx.root, "Testing", "Python", "bench_readers.py"),
+    ctx.run("readers", ["/usr/bin/python3", os.path.join(ctx.root, "Benchmarks", "Python", "bench_readers.py"),
                         "--json", fresh(ctx.work_path("readers.json")), "--workdir", ctx.work_path("readers"),
                         "--mb", PARTICLE_MB, "--vtk-mb", VTK_MB, "--slices", SLICES, "--size", SLICE_SIZE,
                         "--repeats", REPEATS], env=scenes.python_env(ctx))

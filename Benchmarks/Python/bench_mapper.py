@@ -8,7 +8,7 @@ records {name, backend, n, depth, seconds, peer, peer_seconds} into
 bench-results.json.
 
     PYTHONPATH=build/lib/python3/dist-packages xvfb-run -a python3 \\
-        Testing/Rendering/bench_mapper.py --json build/bench-results.json
+        Benchmarks/Python/bench_mapper.py --json build/bench-results.json
 """
 import argparse
 import os

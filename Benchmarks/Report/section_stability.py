@@ -4,7 +4,7 @@ backends. Each test records what it compared ("check") and what it measured
 ("outcome") as properties of its <testcase> in the GoogleTest XML; this
 section turns that XML into the table. The CPU column is run here; the CUDA
 column comes from the GPU run's XML of the whole engine test binary
-(Testing/Bench/gpu/engine-tests.xml)."""
+(Benchmarks/gpu/engine-tests.xml)."""
 import os
 import xml.etree.ElementTree as ET
 
@@ -158,7 +158,7 @@ def render(ctx):
                   if gpu_path and ctx.gpu_command() else
                   (f"the GPU run's `{GPU_XML}` in [gpu/](gpu/)" if gpu_path else
                    "no GPU run yet: `octoray_engine_tests --gtest_output=xml:$out/engine-tests.xml` on the GPU "
-                   "machine (Testing/Bench/gpu-check.sh) fills it"))
+                   "machine (scripts/gpu/gpu-check.sh) fills it"))
     text = f"""
 Every row is a test of the engine's suite `Stability` (Testing/Engine/TestStability.cpp), run by `make test`
 on both backends (`Backends/Stability.<case>/CPU` and `/CUDA`; the CUDA half is skipped, with the reason,

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""Regenerates Testing/Bench/RESULTS.md, its CSV files and plots (issue 7).
+"""Regenerates Benchmarks/RESULTS.md, its CSV files and plots (issue 7).
 
-    make report                      # = Testing/Report/make_report.py --build build
-    Testing/Report/make_report.py --build build --only quality,stability
-    Testing/Report/make_report.py --build build --render-only   # no programs run
+    make report                      # = Benchmarks/Report/make_report.py --build build
+    Benchmarks/Report/make_report.py --build build --only quality,stability
+    Benchmarks/Report/make_report.py --build build --render-only   # no programs run
 
 Each section of the report is a module `section_<name>.py` beside this file
 with
@@ -15,13 +15,13 @@ with
                                      # ctx.gpu), writes CSV/plots, returns Markdown
 
 `produce` runs on this machine (CPU rows). GPU rows are never measured here:
-they are read from Testing/Bench/gpu/, the output of Testing/Bench/gpu-check.sh
+they are read from Benchmarks/gpu/, the output of scripts/gpu/gpu-check.sh
 on a GPU machine, committed with the command that made it (gpu/COMMAND.md).
 A section that has no GPU file says so in its table instead of leaving a gap.
 
 Raw results under ctx.work (build/report/) are rebuilt from scratch by every
-`produce`; everything `render` writes goes to Testing/Bench/ (RESULTS.md)
-and Testing/Bench/report/ (CSV, PNG) so it can be committed and linked.
+`produce`; everything `render` writes goes to Benchmarks/ (RESULTS.md)
+and Benchmarks/report/ (CSV, PNG) so it can be committed and linked.
 """
 import argparse
 import csv
@@ -50,6 +50,8 @@ SECTIONS = [
     "readers",      # readers vs VTK's own and pandas
     "thesis",       # the thesis's table 2 and two-sphere timings, ours beside them
     "gpu",          # the GPU run's checks: tests and compute-sanitizer
+    "mapper",       # the CUDA mapper in VTK windows on the GPU: its tests, memcheck, the orbit
+                    # against VTK's GPU mappers
 ]
 
 README_BEGIN = "<!-- report:summary begin (written by make report) -->"
@@ -143,7 +145,7 @@ class Context:
             return f.read().strip()
 
     def write_csv(self, name, header, rows):
-        """Writes Testing/Bench/report/<name>.csv; returns the link for RESULTS.md."""
+        """Writes Benchmarks/report/<name>.csv; returns the link for RESULTS.md."""
         path = os.path.join(self.figures, name + ".csv")
         with open(path, "w", newline="") as f:
             w = csv.writer(f)
@@ -185,7 +187,7 @@ def write_readme_summary(rows):
         print("report: README.md has no summary markers; summary not written", file=sys.stderr)
         return
     table = Context.table(["what", "octoray", "compared with", "ratio"], rows, "lrrr")
-    body = (f"{README_BEGIN}\n{table}\n\nFrom [Testing/Bench/RESULTS.md](Testing/Bench/RESULTS.md), "
+    body = (f"{README_BEGIN}\n{table}\n\nFrom [Benchmarks/RESULTS.md](Benchmarks/RESULTS.md), "
             f"where each figure has the command that measured it.\n{README_END}")
     head, rest = text.split(README_BEGIN, 1)
     _, tail = rest.split(README_END, 1)
@@ -197,7 +199,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--build", default=os.path.join(ROOT, "build"))
     parser.add_argument("--work", help="raw results (default: BUILD/report)")
-    parser.add_argument("--out", default=os.path.join(ROOT, "Testing", "Bench"))
+    parser.add_argument("--out", default=os.path.join(ROOT, "Benchmarks"))
     parser.add_argument("--only", help="comma-separated sections to produce (others are re-rendered from earlier raw results)")
     parser.add_argument("--render-only", action="store_true", help="run no program; re-render from raw results")
     args = parser.parse_args()
@@ -222,7 +224,7 @@ def main():
     header = [
         "# Benchmark results and the report",
         "",
-        "Written by `make report` (Testing/Report/make_report.py): every table, CSV and plot below",
+        "Written by `make report` (Benchmarks/Report/make_report.py): every table, CSV and plot below",
         "is regenerated from scratch on this machine (CPU rows); GPU rows are read from the files",
         "of the last GPU run in [gpu/](gpu/), made by: " + (f"`{gpu}`" if gpu else "(no GPU run committed)") + ".",
         "Each section gives the command its figures came from. Machines here are shared and",

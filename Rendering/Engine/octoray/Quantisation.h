@@ -9,12 +9,14 @@
 // through the stored child masks and child offsets down to its leaf, and the
 // leaf's centre is taken from the leaf's stored Morton key. A point whose
 // leaf is missing from the tree is an error, not a figure.
-// Header-only and VTK-free (the GPU machine runs it too).
+// Header-only. The report's quantisation section measures it against leaf
+// depth (Benchmarks/Engine/BenchQuantisation.cpp); TestQuantisation checks it
+// against a brute-force recomputation.
 #pragma once
 
-#include <octoray/Octree.h>
-#include <octoray/PointCloud.h>
-#include <octoray/Types.h>
+#include "Octree.h"
+#include "PointCloud.h"
+#include "Types.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,8 +24,6 @@
 #include <string>
 
 namespace octoray
-{
-namespace bench
 {
 struct QuantisationError
 {
@@ -103,6 +103,5 @@ inline QuantisationError MeasureQuantisation(const HostOctree& tree, const Point
   }
   q.mean = points.count ? sum / double(points.count) : 0.0;
   return q;
-}
 }
 }

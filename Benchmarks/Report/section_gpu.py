@@ -1,7 +1,7 @@
 """The GPU run's checks: engine tests on both backends and compute-sanitizer.
 
-Nothing is measured here: the files come from Testing/Bench/gpu-check.sh on a
-GPU machine (copied into Testing/Bench/gpu/ with COMMAND.md)."""
+Nothing is measured here: the files come from scripts/gpu/gpu-check.sh on a
+GPU machine (copied into Benchmarks/gpu/ with COMMAND.md)."""
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -44,7 +44,7 @@ def test_counts(xml_path):
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
     if not summary_path:
-        return Section("Not run on a GPU yet: `Testing/Bench/gpu-check.sh OUTDIR` on a GPU machine writes the "
+        return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
     with open(summary_path) as f:
         summary = f.read()
@@ -52,7 +52,7 @@ def render(ctx):
     if ctx.gpu_file("gpu.txt"):
         with open(ctx.gpu_file("gpu.txt")) as f:
             device = f.read().strip()
-    date = re.search(r"CUDA check, (\d{4}-\d\d-\d\d)", summary)
+    date = re.search(r"(?:CUDA|GPU) check, (\d{4}-\d\d-\d\d)", summary)
 
     rows = []
     if ctx.gpu_file("engine-tests.xml"):
@@ -61,9 +61,9 @@ def render(ctx):
             total, passed, failed, skipped = counts[group]
             rows.append((label, f"{passed} passed, {failed} failed, {skipped} skipped of {total}"))
     for log, what in SANITIZERS:
-        found = re.search(rf"{re.escape(log)}\.log:=+ (ERROR SUMMARY|RACECHECK SUMMARY): (.*)", summary)
+        found = re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ (?:ERROR SUMMARY|RACECHECK SUMMARY): (.*)$", summary, re.M)
         step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", summary, re.M)
-        result = found.group(2) if found else "no summary line"
+        result = found.group(1) if found else "no summary line"
         if step:
             result += f" (exit status: {step.group(1)})"
         rows.append((what, result))
@@ -71,12 +71,12 @@ def render(ctx):
 
     text = [
         f"Device: {device or 'see gpu/gpu.txt'}; run of {date.group(1) if date else 'unknown date'}. Command: "
-        f"`{ctx.gpu_command() or 'Testing/Bench/gpu-check.sh OUTDIR'}`.",
+        f"`{ctx.gpu_command() or 'scripts/gpu/gpu-check.sh OUTDIR'}`.",
         "",
-        "gpu-check.sh configures `Rendering/Engine` on its own (the GPU machine has only CUDA, CMake and a",
-        "compiler), builds for sm_90, runs every engine test on both backends (the CPU backend is the",
-        "reference the CUDA pictures and octrees are compared with), then the CUDA tests under each",
-        "compute-sanitizer tool. The fault tests are among them: out of memory injected at every",
+        "gpu-check.sh builds the whole project for sm_90 against VTK 9.2 with EGL (the GPU machine has",
+        "only CUDA, CMake and a compiler; VTK comes with the call), runs every engine test on both backends",
+        "(the CPU backend is the reference the CUDA pictures and octrees are compared with), then the",
+        "CUDA tests under each compute-sanitizer tool. The fault tests are among them: out of memory injected at every",
         "allocation site of build, update and render through the engine's memory budget",
         "(`CudaFaults.*`), and a launch refused by the CUDA runtime at every kernel of build, update",
         "and render (`CudaFaultsLaunch.*`, through octoray/FaultInjection.h): each failure names what",
@@ -91,13 +91,13 @@ def render(ctx):
         *steps,
         "```",
         "",
-        "Not covered on the GPU: the VTK mapper and the ParaView plugin with the CUDA backend (the lent",
-        "GPU machine has no VTK or ParaView); their CPU backend runs in `make test`.",
+        "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",
+        "plugin (ParaView is not built there); its CPU backend runs in `make test`.",
     ]
     summary_rows = []
     if ctx.gpu_file("engine-tests.xml"):
         clean = [log for log, _ in SANITIZERS
-                 if re.search(rf"{re.escape(log)}\.log:=+ [A-Z ]+: 0 ", summary)]
+                 if re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ [A-Z ]+: 0 ", summary, re.M)]
         summary_rows.append((f"engine tests on {device.split(',')[0] if device else 'the GPU'}", rows[0][1],
                              "compute-sanitizer", f"{len(clean)} of {len(SANITIZERS)} tool runs clean"))
     return Section("\n".join(text), summary_rows)

@@ -13,7 +13,7 @@
 #   googletest/          Debian's GoogleTest sources
 # A VTK found in /tmp/vtk-egl (an earlier call on the same machine) is reused.
 #
-#   Testing/Bench/gpu-check.sh OUTDIR [PARTS]
+#   scripts/gpu/gpu-check.sh OUTDIR [PARTS]
 # PARTS, comma-separated (default all): tests (engine and mapper tests, both
 # backends), sanitize (compute-sanitizer memcheck, initcheck and synccheck on
 # the engine's CUDA tests, memcheck on the mapper's), racecheck (on the
@@ -21,7 +21,7 @@
 # benchmarks), report (the report's engine programs), orbit (the mapper
 # against VTK's GPU mappers; ORBIT_ARGS adds arguments).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
-# report` reads (unpack it into Testing/Bench/gpu/).
+# report` reads (unpack it into Benchmarks/gpu/).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 out=$(realpath -m "${1:-build-gpu/logs}")

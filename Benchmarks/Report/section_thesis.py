@@ -114,7 +114,7 @@ the figure of each row, so the thesis row gives the ranges (the project's design
 one: 1.94 s to build the 3.28 M-point cloud).
 
 Ours: the same kind of scene from one generator shared by the CPU and CUDA programs
-(`ThesisSliceStack` in Testing/Bench/Engine/BenchScenes.h: grid points inside an ellipsoid with semi-axes 1, 0.8,
+(`ThesisSliceStack` in Benchmarks/Engine/BenchScenes.h: grid points inside an ellipsoid with semi-axes 1, 0.8,
 0.6, slice by slice, the first n kept, so the counts are the thesis's exactly), depth 7, 800×600, Phong with a
 headlight, the fixed camera of the CUDA benchmark (`CubeCamera`). Build: whole `Engine::Build` call, median of
 {repeats} after a warm-up on one engine (buffers reused, as the thesis rebuilt per frame). Trace:

@@ -11,7 +11,7 @@
 // Scenes:
 //   ct5n     DIR/ct5n.particles: the bundled CT series (Data/DICOM/CT5N)
 //            read by vtkSliceStackReader, air removed (HU <= -500), written
-//            as x y z HU by vtkParticleTextWriter (Testing/Report/scenes.py);
+//            as x y z HU by vtkParticleTextWriter (Benchmarks/Report/scenes.py);
 //            coloured through a transfer function on HU. Skipped without
 //            --scenes.
 //   lidar    the bundled LiDAR tile (Data/Particles/lidar_simple.particles):
@@ -552,7 +552,7 @@ int main(int argc, char** argv)
     {
       if (scenesDir.empty())
       {
-        std::printf("ct5n skipped: no --scenes DIR holding ct5n.particles (Testing/Report/scenes.py writes it)\n");
+        std::printf("ct5n skipped: no --scenes DIR holding ct5n.particles (Benchmarks/Report/scenes.py writes it)\n");
       }
       else
       {

@@ -127,7 +127,7 @@ def gpu_records(ctx, name):
 def gpu_source(ctx, name):
     """Where a GPU table's figures came from, for the text."""
     made = ("made by the command in [gpu/COMMAND.md](gpu/COMMAND.md)" if ctx.gpu_command() else
-            "made by Testing/Bench/gpu-check.sh on a GPU machine")
+            "made by scripts/gpu/gpu-check.sh on a GPU machine")
     return "[gpu/%s](gpu/%s), %s" % (name, name, made)
 
 
@@ -441,7 +441,7 @@ def render(ctx):
     text = """
 {machine}
 
-Point sets (fixed seed, Testing/Bench/Engine/BenchUtil.h): `uniform` = uniform in the unit cube; `clustered` = 32
+Point sets (fixed seed, Benchmarks/Engine/BenchUtil.h): `uniform` = uniform in the unit cube; `clustered` = 32
 Gaussian blobs, sigma 0.02, centres uniform in the cube. Depth is octoray's automatic choice (the median leaf holds
 one point); PCL gets the same root cube and resolution = leaf voxel, and builds the identical tree (leaf and branch
 counts compared in the run: "same tree" below).
@@ -509,7 +509,7 @@ Drawing a point as its leaf voxel moves it to the voxel's centre; the octree's d
 memory. For every leaf depth 1–21 the engine builds the octree (fresh engine per depth; build time median of 3 after
 a warm-up; engine MB = `Engine::Memory().Total()`), the tree is copied to the host (`Engine::CopyToHost`), and each
 point is walked from the root through the stored child masks to its leaf, whose centre comes from the leaf's stored
-Morton key and the engine's double-precision root cube (Testing/Bench/Engine/Quantisation.h). Distances are in the
+Morton key and the engine's double-precision root cube (Benchmarks/Engine/Quantisation.h). Distances are in the
 scene's data units. Why the figure is trustworthy: the walk fails if the tree lacks a point's leaf, no distance may
 exceed the analytic bound (half the leaf diagonal, √3/2 · side / 2^depth; max / bound below), and the engine test
 `Quantisation.*` (Testing/Engine/TestQuantisation.cpp, in `make test`) checks the same measurement against a

@@ -1,7 +1,7 @@
 """Report section: image error against render time for each quality knob
 (leaf depth, level of detail, bounce limit, shadows, image size), one table
 per scene, a Pareto plot per backend. Measured by octoray_bench_quality
-(Testing/Bench/Engine/BenchQuality.cpp; metrics in ImageMetrics.h)."""
+(Benchmarks/Engine/BenchQuality.cpp; metrics in ImageMetrics.h)."""
 import math
 import os
 
@@ -27,7 +27,7 @@ SCENE_NOTES = {
              "1065 points over the tile make voxels many pixels wide, which is why small LOD k changes "
              "nothing.",
     "spheres": "Points on sphere surfaces with radial normals and reflectivity 0.4; the generator is "
-               "Testing/Bench/Engine/BenchScenes.h (shared with octoray_bench_render).",
+               "Benchmarks/Engine/BenchScenes.h (shared with octoray_bench_render).",
 }
 KNOBS = ["depth", "lod", "bounces", "shadows", "size"]
 KNOB_TEXT = {"depth": "leaf depth", "lod": "LOD k (pixels)", "bounces": "bounces", "shadows": "shadows",
@@ -194,11 +194,11 @@ def render(ctx):
               f"`{ctx.command('scene-ct5n')}`), on {first['device']}.")
     if gpu:
         md.append(f"CUDA rows: `build-gpu/bin/octoray_bench_quality --backend cuda --scenes DIR --json "
-                  f"quality-cuda.json` (Testing/Bench/gpu-check.sh; DIR holds the ct5n.particles written here), "
+                  f"quality-cuda.json` (scripts/gpu/gpu-check.sh; DIR holds the ct5n.particles written here), "
                   f"on {gpu[0]['device']}, from [gpu/{GPU_JSON}](gpu/{GPU_JSON}).")
     else:
-        md.append("CUDA rows: not run on a GPU yet (Testing/Bench/gpu-check.sh writes "
-                  f"`{GPU_JSON}`, to be committed in Testing/Bench/gpu/).")
+        md.append("CUDA rows: not run on a GPU yet (scripts/gpu/gpu-check.sh writes "
+                  f"`{GPU_JSON}`, to be committed in Benchmarks/gpu/).")
     md.append("""
 **The references, and why they can be trusted.**
 
@@ -227,7 +227,7 @@ def render(ctx):
   picture equals the CPU one), so a reference is the engine's exact answer at its setting, not an
   approximation of it.
 
-**Metrics** (Testing/Bench/Engine/ImageMetrics.h): on the premultiplied RGB (the picture over black),
+**Metrics** (Benchmarks/Engine/ImageMetrics.h): on the premultiplied RGB (the picture over black),
 each channel clamped to [0, 1], data range 1. RMSE over all channels and pixels; PSNR = 10 log10(1/MSE)
 (∞: identical); SSIM after Wang et al. 2004: 11×11 Gaussian window, σ = 1.5, population statistics,
 K1 = 0.01, K2 = 0.03, over the pixels whose window lies inside the picture, per RGB channel and the three

@@ -18,7 +18,7 @@ through /proc/self/clear_refs). The first frame of each method is written to
 IMAGES/<scene>-<method>.png; the figures go to JSON.
 
     PYTHONPATH=build/lib/python3/dist-packages xvfb-run -a /usr/bin/python3 \\
-        Testing/Rendering/bench_pictures.py --json build/report/pictures.json --images build/report/pictures
+        Benchmarks/Python/bench_pictures.py --json build/report/pictures.json --images build/report/pictures
 """
 import argparse
 import gc
@@ -84,6 +84,7 @@ def ct_points(threshold):
     r = octoray.vtkSliceStackReader()
     r.SetDirectoryName(os.path.join(DATA, "DICOM", "CT5N"))
     r.SetBackgroundRange(-1e30, threshold)  # air and below: background
+    r.SetFillBetweenSlices(False)  # the scene is the voxels as points, as RESULTS.md has it
     r.Update()
     return r.GetOutput(), r.GetOutputDataObject(1)
 

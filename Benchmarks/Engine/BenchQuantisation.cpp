@@ -17,7 +17,7 @@
 #include "BenchScenes.h"
 #include "BenchUtil.h"
 #include "PointFile.h"
-#include "Quantisation.h"
+#include <octoray/Quantisation.h>
 
 #include <octoray/Engine.h>
 

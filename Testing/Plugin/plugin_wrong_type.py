@@ -1,0 +1,114 @@
+""""Octree Volume" on data it cannot draw says so, once.
+
+usage: plugin_wrong_type.py LAUNCHER... -- PLUGIN DATA_DIR WORK_DIR
+
+Runs this file again as the ParaView script under LAUNCHER (e.g. `pvbatch`
+or `mpiexec -np 2 pvbatch`), collects what it prints (stdout and stderr,
+where ParaView's output window writes), and checks the warnings of
+vtkOctreeVolumeRepresentation:
+
+- a vtkMultiBlockDataSet (Group Datasets of a sphere and a cone) shown as
+  "Octree Volume", then rendered five times with camera and property changes
+  (the blend mode makes the representation run its RequestData again): the
+  warning naming vtkMultiBlockDataSet exactly once;
+- a vtkTable (ParaView's CSV reader on a particle file named .csv) given to
+  the representation directly, rendered three times: the warning naming
+  vtkTable, with the Table To Points hint, exactly once;
+- in both, what the representation can draw (vtkPointSet, vtkImageData);
+- on several ranks, still one of each (the first rank speaks for all);
+- no pipeline error about the representation's input ("Can not execute
+  simple algorithm ... without output ports", which ParaView printed for
+  composite data before), and the script ran to its end.
+"""
+import os
+import subprocess
+import sys
+
+MULTIBLOCK = ("Octree Volume cannot draw a vtkMultiBlockDataSet: it draws point sets "
+              "(vtkPointSet: vtkPolyData, vtkUnstructuredGrid, vtkStructuredGrid, ...) and "
+              "images (vtkImageData); nothing is drawn. To draw this data, apply Merge Blocks "
+              "first to make one unstructured grid of its blocks.")
+TABLE = ("Octree Volume cannot draw a vtkTable: it draws point sets (vtkPointSet: vtkPolyData, "
+         "vtkUnstructuredGrid, vtkStructuredGrid, ...) and images (vtkImageData); nothing is "
+         "drawn. To draw this data, apply Table To Points first (or open a particle text file "
+         "with the Octoray Particle Reader).")
+
+
+def child(plugin, data, workdir):
+    from paraview.simple import (LoadPlugin, GroupDatasets, Sphere, Cone, Show, Render,
+                                 GetActiveViewOrCreate, CSVReader)
+    from paraview import servermanager
+    LoadPlugin(plugin, remote=False, ns=globals())
+    view = GetActiveViewOrCreate("RenderView")
+    view.ViewSize = [200, 150]
+
+    group = GroupDatasets(Input=[Sphere(), Cone()])
+    display = Show(group, view)
+    display.SetRepresentationType("Octree Volume")
+    for frame in range(5):
+        view.GetActiveCamera().Azimuth(10)
+        if frame == 3:
+            display.OctreeBlendMode = "Composite"
+        Render(view)
+    display.Visibility = 0
+
+    # A particle file named .csv through ParaView's CSV reader: a vtkTable.
+    csv = os.path.join(workdir, "particles.csv")
+    with open(os.path.join(data, "Particles", "lidar_simple.particles")) as src, \
+            open(csv, "w") as dst:
+        dst.write("x,y,z,r,g,b,reflectivity,refraction\n")
+        for line in src:
+            if not line.startswith("#"):
+                dst.write(",".join(line.split()) + "\n")
+    table = CSVReader(FileName=[csv])
+    table.UpdatePipeline()
+    print("CSV reader output:", table.GetDataInformation().GetDataSetTypeAsString())
+    rep = servermanager.rendering.OctreeVolumeRepresentation(Input=table)
+    view.Representations.append(rep)
+    for _ in range(3):
+        view.GetActiveCamera().Elevation(5)
+        Render(view)
+    print("SCRIPT-END")
+
+
+def main():
+    argv = sys.argv[1:]
+    split = argv.index("--")
+    launcher, (plugin, data, workdir) = argv[:split], argv[split + 1:]
+    workdir = os.path.abspath(workdir)
+    os.makedirs(workdir, exist_ok=True)
+    run = subprocess.run(launcher + [os.path.abspath(__file__), "--child", plugin, data, workdir],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         timeout=240)
+    out = run.stdout
+    print(out)
+    failures = []
+
+    def check(what, got, expected):
+        print(f"{what}: {got} (expected {expected})")
+        if got != expected:
+            failures.append(what)
+
+    check("exit status", run.returncode, 0)
+    check("script ran to its end", "SCRIPT-END" in out, True)
+    check("CSV reader gives a vtkTable", "CSV reader output: vtkTable" in out, True)
+    check("warnings naming vtkMultiBlockDataSet", out.count(MULTIBLOCK), 1)
+    check("warnings naming vtkTable", out.count(TABLE), 1)
+    check("'Octree Volume cannot draw' in all", out.count("Octree Volume cannot draw"), 2)
+    check("pipeline errors about the representation's input",
+          out.count("Can not execute simple algorithm vtkOctreeVolumeRepresentation") +
+          out.count("vtkOctreeVolumeRepresentation) is of type"), 0)
+    if failures:
+        print("FAILED:", ", ".join(failures))
+        return 1
+    print("OK")
+    return 0
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] == ["--child"]:
+        # No sys.exit in pvbatch: it crashes ParaView 5.11's teardown (SIGSEGV
+        # in vtkXOpenGLRenderWindow::MakeCurrent while the view is deleted).
+        child(*sys.argv[2:5])
+    else:
+        sys.exit(main())
