@@ -75,14 +75,17 @@ test-asan: deps
 	  ctest --output-on-failure -j $(JOBS) \
 	  -R '^(deps\.|engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|octoray::IOParticlesCxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
 
-# The LiDAR tile's reflectivity column is the scanner's intensity (0.3-0.6):
-# taken as mirror weight it would blend every voxel with the empty sky, so
-# the demo pictures draw first hits only (--bounces 0).
-DEMO_DATA = Data/Particles/lidar_simple.particles
+# The demo (Wrapping/Python/octoray/demo.py): the head CT (DICOM, bone and
+# skin presets, and side by side with vtkSmartVolumeMapper), the PCL laser
+# scan and the thesis's LiDAR file, Phong with shadows, into $(BUILD)/demo/,
+# printing what each step cost. About a minute on 2 cores without a GPU; a
+# quarter-size run of it is the test python.demo. DEMO_ARGS, e.g.
+# --backend cpu, --scale 0.5, --thumbnails Testing/Data.
+PYTHON = /usr/bin/python3
+DEMO_ARGS ?=
 demo: build data
-	$(BUILD)/bin/octoray stats $(DEMO_DATA)
-	$(BUILD)/bin/octoray render $(DEMO_DATA) -o $(BUILD)/demo-phong.png --mode phong --shadows --bounces 0 --zoom 1.3
-	$(BUILD)/bin/octoray render $(DEMO_DATA) -o $(BUILD)/demo-surface.png --mode surface --bounces 0 --zoom 1.3
+	PYTHONPATH=$(abspath $(BUILD))/lib/python3/dist-packages VTK_LOGGING_LEVEL=ERROR \
+	  $(XVFB) $(PYTHON) -m octoray.demo --data Data --out $(BUILD)/demo $(DEMO_ARGS)
 
 # --verbose: the benchmarks' tables are the output wanted, pass or fail.
 bench: build

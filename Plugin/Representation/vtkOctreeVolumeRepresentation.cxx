@@ -25,6 +25,7 @@
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPiecewiseFunction.h"
 #include "vtkPVRenderView.h"
 #include "vtkRenderer.h"
 #include "vtkTable.h"
@@ -509,6 +510,59 @@ void vtkOctreeVolumeRepresentation::UpdateMapperParameters()
   // As ParaView's Volume representation: "Map Scalars" off (or
   // multi-component mapping) makes 3/4-component arrays direct colours.
   this->Property->SetIndependentComponents(this->MapScalars && !this->MultiComponentsMapping);
+  this->UpdatePreset();
+}
+
+//----------------------------------------------------------------------------
+// With a preset, the volume draws with PresetProperty: this->Property's
+// settings (shading, components, ...) and the preset's colour and opacity.
+void vtkOctreeVolumeRepresentation::UpdatePreset()
+{
+  if (this->Preset.empty())
+  {
+    this->Actor->SetProperty(this->Property);
+    this->Mapper->SetImageBackground(this->ImageBackground);
+    return;
+  }
+  if (this->PresetApplied != this->Preset || this->Property->GetMTime() > this->PresetPropertyTime)
+  {
+    vtkNew<vtkColorTransferFunction> color;
+    vtkNew<vtkPiecewiseFunction> opacity;
+    this->Presets->Apply(this->Preset.c_str(), color, opacity);
+    this->PresetProperty->DeepCopy(this->Property);
+    this->PresetProperty->SetColor(color);
+    this->PresetProperty->SetScalarOpacity(opacity);
+    this->PresetApplied = this->Preset;
+    this->PresetPropertyTime = this->Property->GetMTime();
+  }
+  this->Actor->SetProperty(this->PresetProperty);
+  this->Mapper->SetImageBackground(vtkOctreeVolumePresets::GetSurfaceThreshold(this->Preset.c_str()));
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::SetPreset(const char* name)
+{
+  std::string preset = name ? name : "";
+  if (preset == "none" || preset == "None")
+  {
+    preset.clear();
+  }
+  if (!preset.empty() && !vtkOctreeVolumePresets::HasPreset(preset.c_str()))
+  {
+    vtkErrorMacro("Unknown preset '" << preset << "'; known presets: "
+                                     << vtkOctreeVolumePresets::GetNamesAsString() << " (or none)");
+    preset.clear();
+  }
+  if (preset != this->Preset)
+  {
+    this->Preset = preset;
+    this->Modified();
+  }
+}
+
+vtkStringArray* vtkOctreeVolumeRepresentation::GetPresetNames()
+{
+  return this->Presets->GetNames();
 }
 
 //----------------------------------------------------------------------------
@@ -606,7 +660,8 @@ void vtkOctreeVolumeRepresentation::SetImageSampleDistance(double val)
 }
 void vtkOctreeVolumeRepresentation::SetImageBackground(double val)
 {
-  this->Mapper->SetImageBackground(val);
+  this->ImageBackground = val; // a preset overrides it (UpdatePreset)
+  this->Mapper->SetImageBackground(this->Preset.empty() ? val : this->Mapper->GetImageBackground());
 }
 void vtkOctreeVolumeRepresentation::SetFillBetweenSlices(bool val)
 {
@@ -619,4 +674,5 @@ void vtkOctreeVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Mapper: " << this->Mapper->GetClassName() << "\n";
   os << indent << "Cache: " << (this->Cache ? this->Cache->GetClassName() : "(none)") << "\n";
+  os << indent << "Preset: " << (this->Preset.empty() ? "none" : this->Preset) << "\n";
 }

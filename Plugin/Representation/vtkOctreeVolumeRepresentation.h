@@ -56,12 +56,16 @@
 #include "octorayViewsParaViewModule.h" // for export macro
 #include "vtkVolumeRepresentation.h"
 
-#include "vtkNew.h" // for vtkNew
+#include "vtkNew.h"                 // for vtkNew
+#include "vtkOctreeVolumePresets.h" // for vtkNew<vtkOctreeVolumePresets>
+#include "vtkVolumeProperty.h"      // for vtkNew<vtkVolumeProperty>
 
 #include <string> // for std::string
 
 class vtkDataSet;
 class vtkOctreeVolumeMapper;
+class vtkOctreeVolumePresets;
+class vtkStringArray;
 class vtkTrivialProducer;
 
 class OCTORAYVIEWSPARAVIEW_EXPORT vtkOctreeVolumeRepresentation : public vtkVolumeRepresentation
@@ -100,6 +104,21 @@ public:
   void SetImageSampleDistance(double);
   void SetImageBackground(double);
   void SetFillBetweenSlices(bool);
+  ///@}
+
+  ///@{
+  /**
+   * A CT transfer-function preset by name (vtkOctreeVolumePresets:
+   * "ct-bone", "ct-skin", "ct-muscle"), or "none" (or empty, the default)
+   * for ParaView's colour map and opacity function. A preset replaces them
+   * for this representation (the shading stays the panel's) and sets the
+   * mapper's ImageBackground to the preset's surface threshold, overriding
+   * the ImageBackground property. An unknown name is an error and leaves
+   * no preset. GetPresetNames lists the presets (the panel's choices).
+   */
+  void SetPreset(const char* name);
+  const char* GetPreset() { return this->Preset.c_str(); }
+  vtkStringArray* GetPresetNames();
   ///@}
 
   /**
@@ -160,6 +179,16 @@ protected:
   std::string ReportedType;
   bool BackendReported = false;
   bool OrderWarningIssued = false;
+
+  // The preset (SetPreset): its own property, whose settings follow
+  // this->Property and whose functions are the preset's.
+  void UpdatePreset();
+  std::string Preset;
+  double ImageBackground = 0.0;
+  vtkNew<vtkOctreeVolumePresets> Presets;
+  vtkNew<vtkVolumeProperty> PresetProperty;
+  vtkMTimeType PresetPropertyTime = 0;
+  std::string PresetApplied;
 
 private:
   vtkOctreeVolumeRepresentation(const vtkOctreeVolumeRepresentation&) = delete;

@@ -88,13 +88,73 @@ struct ImageOutput
   std::vector<float>& Scalar;
   std::vector<std::uint8_t>& Color8;
   std::vector<float>& ColorFloat;
+  std::vector<float>* Normal; // gradient normals (ImageGradientNormals), or null
 };
+
+// The normal of a one-component field at sample (r0, r1, r2) of the
+// (filled) lattice: the gradient by central differences (one-sided at the
+// border) at the source voxels around it, interpolated with the sample's
+// weights, through the direction matrix (row-major), negated and made unit
+// length: it points out of the denser material. (0, 0, 0) where flat.
+template <typename T>
+void GradientNormal(const T* data, int comps, const long long dims[3], const octoray::lattice::Axis axes[3],
+  const double spacing[3], const double* direction, const long long r[3], float normal[3])
+{
+  long long below[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    axes[a].Source(r[a], below[a], t[a]);
+  }
+  const long long stride[3] = { comps, comps * dims[0], comps * dims[0] * dims[1] };
+  double g[3] = { 0.0, 0.0, 0.0 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double weight = 1.0;
+    long long at[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool up = (corner >> a) & 1;
+      weight *= up ? t[a] : 1.0 - t[a];
+      at[a] = std::min(below[a] + (up ? 1 : 0), dims[a] - 1);
+    }
+    if (weight <= 0.0)
+    {
+      continue;
+    }
+    const long long id = at[0] * stride[0] + at[1] * stride[1] + at[2] * stride[2];
+    for (int a = 0; a < 3; ++a)
+    {
+      if (dims[a] < 2 || spacing[a] == 0.0)
+      {
+        continue;
+      }
+      const long long lo = at[a] > 0 ? id - stride[a] : id;
+      const long long hi = at[a] + 1 < dims[a] ? id + stride[a] : id;
+      const double steps = (at[a] > 0 && at[a] + 1 < dims[a]) ? 2.0 : 1.0;
+      g[a] += weight * (static_cast<double>(data[hi]) - static_cast<double>(data[lo])) / (steps * spacing[a]);
+    }
+  }
+  double world[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    world[row] = direction[3 * row] * g[0] + direction[3 * row + 1] * g[1] + direction[3 * row + 2] * g[2];
+  }
+  const double length = std::sqrt(world[0] * world[0] + world[1] * world[1] + world[2] * world[2]);
+  for (int a = 0; a < 3; ++a)
+  {
+    normal[a] = length > 0.0 ? static_cast<float>(-world[a] / length) : 0.0f;
+  }
+}
 
 template <typename T>
 void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
   const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, bool scalar,
-  ImageOutput out, const std::function<void(double)>& progress)
+  ImageOutput out, const std::function<void(double)>& progress, const double* spacing = nullptr,
+  const double* direction = nullptr)
 {
+  // Gradient normals: one-component scalars, and the caller asked for them.
+  const bool normals = out.Normal && data && scalar && !colours && comps == 1 && spacing && direction;
   const vtkIdType planes = static_cast<vtkIdType>(axes[2].Samples());
   auto above = [&](const double* v) {
     double value = comps > 0 ? v[0] : 1.0; // no scalars: the whole grid
@@ -135,6 +195,10 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
   {
     out.Scalar.resize(total);
   }
+  if (normals)
+  {
+    out.Normal->resize(3 * total);
+  }
   blocks(0.2, 0.5, [&](vtkIdType b, vtkIdType e) {
     std::vector<double> values(std::max(comps, 1));
     for (vtkIdType k = b; k < e; ++k)
@@ -165,6 +229,11 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
           else if (scalar)
           {
             out.Scalar[n] = static_cast<float>(v[0]);
+          }
+          if (normals)
+          {
+            const long long r[3] = { r0, r1, static_cast<long long>(k) };
+            GradientNormal(data, comps, dims, axes, spacing, direction, r, &(*out.Normal)[3 * n]);
           }
           ++n;
         });
@@ -207,6 +276,7 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   }
   r.ImageBackground = mapper->GetImageBackground();
   r.FillBetweenSlices = mapper->GetFillBetweenSlices();
+  r.ImageGradientNormals = mapper->GetImageGradientNormals();
   if (vtkPointSet::SafeDownCast(input))
   {
     vtkDataArray* lattice = input->GetFieldData()->GetArray(octoray::lattice::kFieldArrayName);
@@ -233,7 +303,8 @@ vtkOctreeInputHelper::Signature vtkOctreeInputHelper::Sign(const Request& r)
   auto* pointSet = vtkPointSet::SafeDownCast(r.Input);
   if (!pointSet)
   {
-    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.FillBetweenSlices ? "+fill" : "");
+    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.FillBetweenSlices ? "+fill" : "") +
+      (r.ImageGradientNormals ? "+gradient" : "");
   }
   s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals), Stamp(r.Lattice) };
   // An image's points are its grid: any change of the image is a rebuild.
@@ -410,7 +481,10 @@ void vtkOctreeInputHelper::ImageView(
     octoray::lattice::LatticeOf(axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
   const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
   const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
-  const ImageOutput out{ this->Xyz, this->Scalar, this->Color8, this->ColorFloat };
+  this->Normal.clear();
+  const ImageOutput out{ this->Xyz, this->Scalar, this->Color8, this->ColorFloat,
+    r.ImageGradientNormals ? &this->Normal : nullptr };
+  const double* direction = image->GetDirectionMatrix()->GetData();
   if (!scalars)
   {
     const double* none = nullptr;
@@ -421,7 +495,7 @@ void vtkOctreeInputHelper::ImageView(
     switch (scalars->GetDataType())
     {
       vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
-        lattice, r.ImageBackground, r.Colours, bytes, true, out, progress));
+        lattice, r.ImageBackground, r.Colours, bytes, true, out, progress, spacing, direction));
     }
   }
   else
@@ -432,7 +506,8 @@ void vtkOctreeInputHelper::ImageView(
     {
       scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
     }
-    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, true, out, progress);
+    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, true, out, progress,
+      spacing, direction);
   }
   view.count = this->Xyz.size() / 3;
   view.xyzDouble = this->Xyz.data();
@@ -440,6 +515,7 @@ void vtkOctreeInputHelper::ImageView(
   view.colorFloat = this->ColorFloat.empty() ? nullptr : this->ColorFloat.data();
   view.colorComponents = r.Colours ? 4 : 0;
   view.scalar = this->Scalar.empty() ? nullptr : this->Scalar.data();
+  view.normal = this->Normal.empty() ? nullptr : this->Normal.data();
 
   // The points' lattice and bounds, for the leaf grid.
   if (view.count > 0)

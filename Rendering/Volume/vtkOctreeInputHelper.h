@@ -59,6 +59,7 @@ public:
     bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
     double ImageBackground = 0.0;
     bool FillBetweenSlices = true; // image input: fill between slices (octorayLattice.h)
+    bool ImageGradientNormals = true; // image input: normals from the scalar gradient
     vtkDataArray* Lattice = nullptr; // point set input: the field-data array naming its lattice
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};

@@ -670,6 +670,12 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
 }
 
 //------------------------------------------------------------------------------
+int vtkOctreeVolumeMapper::GetOctreeDepth()
+{
+  return this->Internals->Input.HasOctree() ? this->Internals->BuiltDepth : 0;
+}
+
+//------------------------------------------------------------------------------
 double vtkOctreeVolumeMapper::GetLeafSize()
 {
   octoray::Engine* engine = this->Internals->Backend.Engine();
@@ -772,6 +778,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "ImageBackground: " << this->ImageBackground << "\n";
   os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
+  os << indent << "ImageGradientNormals: " << (this->ImageGradientNormals ? "on" : "off") << "\n";
   os << indent << "ReflectivityArrayName: "
      << (this->ReflectivityArrayName ? this->ReflectivityArrayName : "(none)") << "\n";
   os << indent << "RefractionArrayName: "

@@ -273,6 +273,20 @@ public:
 
   ///@{
   /**
+   * vtkImageData input with one-component scalars: give each point the
+   * normal of the scalar field, the negated gradient by central differences
+   * (interpolated like the values between slices), as VTK's volume mappers
+   * shade, so that shaded surfaces follow the tissue rather than the
+   * voxels' faces. On by default; off, the octree's occupancy gives the
+   * normals.
+   */
+  vtkSetMacro(ImageGradientNormals, bool);
+  vtkGetMacro(ImageGradientNormals, bool);
+  vtkBooleanMacro(ImageGradientNormals, bool);
+  ///@}
+
+  ///@{
+  /**
    * Names of the optional per-point arrays read for reflectivity (0..1, the
    * weight of the mirror ray) and index of refraction (0 = opaque).
    * Defaults: "Reflectivity" and "Refraction", as vtkParticleTextReader
@@ -334,6 +348,12 @@ public:
   double GetLeafSize();
 
   /**
+   * The leaf level of the current octree: LeafDepth, or the level chosen
+   * from the data when LeafDepth is 0 (0 before the first render).
+   */
+  int GetOctreeDepth();
+
+  /**
    * Number of points the current octree holds.
    */
   vtkIdType GetNumberOfOctreePoints();
@@ -368,6 +388,7 @@ protected:
   double ImageSampleDistance = 1.0;
   double ImageBackground = 0.0;
   bool FillBetweenSlices = true;
+  bool ImageGradientNormals = true;
   char* ReflectivityArrayName = nullptr;
   char* RefractionArrayName = nullptr;
   vtkIdType CudaMemoryBudget = 0;

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import vtk
 import octoray
 from vtk.util.numpy_support import vtk_to_numpy
@@ -125,3 +126,102 @@ def test_render_pcd(tmp_path):
     drawn = rgb[:, :3].max(axis=1) > 0
     assert drawn.sum() > 0.2 * w * h
     assert rgb[drawn, 0].mean() > 100 and rgb[drawn, 2].max() < 40
+
+
+# ---- Defaults: presets, colouring, normals.
+
+def drawn_pixels(rgb):
+    """Pixels that are not the background (the renderer's default black)."""
+    return rgb[:, :3].max(axis=1) > 0
+
+
+def test_preset_on_a_ct(tmp_path):
+    """--preset on a DICOM slice (CT_small, -896..1167 HU): the preset's
+    colours and its threshold; ct-skin (from -750 HU) draws more than
+    ct-bone (from 306 HU)."""
+    folder = os.path.join(DATA, "DICOM", "CT_small")
+    covered = {}
+    for preset in ("ct-bone", "ct-skin"):
+        out = tmp_path / (preset + ".png")
+        r = run(folder, "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", "phong",
+                "--preset", preset, "--elevation", "90")  # a single axial slice: seen from above
+        assert r.returncode == 0, r.stderr
+        assert "colour: preset %s" % preset in r.stdout
+        threshold = {"ct-bone": 306, "ct-skin": -750}[preset]
+        assert "threshold: %g " % threshold in r.stdout
+        rgb = read_png(str(out))[2].astype(int)
+        drawn = drawn_pixels(rgb)
+        covered[preset] = drawn.sum()
+        mean = rgb[drawn, :3].mean(axis=0)
+        assert mean[0] > mean[1] > mean[2], mean  # ivory / skin: red > green > blue
+    assert covered["ct-skin"] > 2 * covered["ct-bone"] > 0
+
+
+def test_unknown_preset_names_the_known_ones(tmp_path):
+    r = run(os.path.join(DATA, "DICOM", "CT_small"), "-o", str(tmp_path / "x.png"), "--preset", "ct-lung")
+    assert r.returncode == 2
+    for name in ("ct-lung", "ct-bone", "ct-skin", "ct-muscle"):
+        assert name in r.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def write_pcd(path, n=40, outlier=True):
+    """A binary PCD of a 40 x 40 grid with a bump (z), no colours, no
+    normals, and an intensity that is 0..50 except for one point at 1000."""
+    import struct
+    rows = []
+    for i in range(n * n):
+        x, y = (i % n) / (n - 1.0), (i // n) / (n - 1.0)
+        z = 0.3 * np.exp(-((x - 0.5) ** 2 + (y - 0.5) ** 2) / 0.05)
+        intensity = 1000.0 if (outlier and i == 0) else float(i % 51)
+        rows.append(struct.pack("<ffff", x, y, z, intensity))
+    path.write_bytes(("VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+                      "WIDTH %d\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA binary\n"
+                      % (n * n, n * n)).encode() + b"".join(rows))
+    return path
+
+
+def test_color_by(tmp_path):
+    pcd = write_pcd(tmp_path / "bump.pcd")
+    pictures = {}
+    for what, expect in (("auto", "Intensity through viridis over "), ("intensity", "Intensity through"),
+                         ("z", "Elevation through viridis")):
+        out = tmp_path / (what + ".png")
+        r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96", "--color-by", what,
+                "--elevation", "60")
+        assert r.returncode == 0, r.stderr
+        line = next(l for l in r.stdout.splitlines() if l.startswith("colour:"))
+        assert expect in line, line
+        pictures[what] = read_png(str(out))[2]
+        if what == "auto":
+            # The range comes from the 1st..99th percentile: the one point
+            # at 1000 does not stretch it.
+            lo, hi = (float(v) for v in line.split(" over ")[1].split(" ")[0].split(".."))
+            assert 0 <= lo < 5 and 45 < hi <= 50, line
+            assert "percentiles 1..99 of 0..1000" in line
+    assert (pictures["auto"] == pictures["intensity"]).all()
+    assert (pictures["z"] != pictures["intensity"]).any()
+
+    r = run(str(pcd), "-o", str(tmp_path / "x.png"), "--color-by", "colour_of_nothing")
+    assert r.returncode == 1
+    assert "colour_of_nothing" in r.stderr and "Intensity" in r.stderr  # names the arrays there are
+    r = run(str(pcd), "-o", str(tmp_path / "x.png"), "--color-by", "colors")
+    assert r.returncode == 1 and "no RGB colours" in r.stderr
+
+
+def test_normals(tmp_path):
+    """--mode phong estimates PCL normals for points without them (auto);
+    --normals none does not; flat modes do not need them."""
+    pcd = write_pcd(tmp_path / "bump.pcd", outlier=False)
+    pictures = {}
+    for mode, normals, expect in (("phong", "auto", True), ("phong", "none", False), ("surface", "auto", False),
+                                  ("surface", "pcl", True)):
+        out = tmp_path / ("%s-%s.png" % (mode, normals))
+        r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", mode,
+                "--normals", normals, "--elevation", "60")
+        assert r.returncode == 0, r.stderr
+        assert ("normals:" in r.stdout) == expect, r.stdout
+        assert ("normals" in r.stderr) == expect  # the progress line
+        pictures[(mode, normals)] = read_png(str(out))[2]
+    # PCL's normals shade the bump differently from the octree's occupancy.
+    assert (np.abs(pictures[("phong", "auto")].astype(int) - pictures[("phong", "none")].astype(int)) > 16).mean() > 0.01

@@ -2,28 +2,40 @@
 
     python3 -m octoray.render INPUT -o out.png [--backend auto|cuda|cpu]
         [--size 1920x1080] [--mode surface|phong|depthcue|composite|mip|minip|average|additive]
+        [--shadows] [--preset ct-bone|ct-skin|ct-muscle] [--threshold V]
+        [--color-by auto|colors|intensity|z|none|ARRAY] [--normals auto|pcl|none]
         [--azimuth DEG] [--elevation DEG] [--zoom F] [--parallel] [--depth N]
-        [--background LO HI] [--image] [--no-fill]
+        [--background LO HI] [--particles] [--no-fill]
 
 INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
-cloud (.pcd: ascii, binary or binary_compressed), a folder of
-image slices or DICOM files, or a printf pattern of slice names
-("ct_%03d.png", with --range FIRST LAST). A slice stack is drawn as the
-reader's particles, or with --image as the stack's volume (the reader's
-output 1, a vtkImageData; voxels above --background's HI are points); either
-way the space between slices is filled with interpolated points (--no-fill:
-not), so the stack draws as a closed volume. Reading and building show a
-progress bar on stderr; the backend, the number of points, the leaf size and
-the load, build and render times are printed on stdout.
+cloud (.pcd: ascii, binary or binary_compressed), a folder of image slices or
+DICOM files, or a printf pattern of slice names ("ct_%03d.png", with --range
+FIRST LAST). Slice stacks are drawn from the reader's image output (its
+volume, a vtkImageData; --particles: its particles): voxels above
+--threshold (default: the preset's, else 0) become the octree, with
+interpolated points between slices (--no-fill: not), so the stack draws as a
+closed volume, shaded by the CT's gradient. Reading, normals and building
+show a progress bar on stderr; the backend, the octree's points, depth and
+leaf size and the load, normals, build and render times are printed on
+stdout.
+
+Defaults: --preset applies a CT transfer function (Hounsfield units) and its
+threshold; points without RGB colours are coloured by their Intensity array,
+else by elevation z, through viridis over the 1st to 99th percentile;
+--mode phong estimates normals with PCL where the points have none; the
+camera faces a DICOM head from the front (patient anterior, head up) and a
+PCD scan from its sensor, --azimuth and --elevation turn it from there; a
+key light above-left of the camera casts the shadows (--shadows) and a
+headlight fills them.
 """
 import argparse
 import os
 import sys
-import time
 
 import vtk
 
 import octoray
+from octoray import scene
 
 MODES = {
     "surface": ("surface", False),
@@ -36,47 +48,8 @@ MODES = {
     "additive": ("additive", False),
 }
 
-
-class ProgressBar:
-    """A text progress bar on stderr, fed by an algorithm's ProgressEvent."""
-
-    def __init__(self, label):
-        self.label = label
-        self.shown = -1
-
-    def __call__(self, algorithm, event):
-        self.show(algorithm.GetProgress())
-
-    def show(self, fraction):
-        percent = int(100 * fraction)
-        if percent != self.shown:
-            self.shown = percent
-            bar = "#" * (percent // 4)
-            sys.stderr.write("\r%-8s [%-25s] %3d%%" % (self.label, bar, percent))
-            if percent >= 100:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
-
-
-def make_reader(path, args):
-    if os.path.isdir(path) or "%" in path:
-        reader = octoray.vtkSliceStackReader()
-        if os.path.isdir(path):
-            reader.SetDirectoryName(path)
-        else:
-            reader.SetFilePattern(path)
-            reader.SetFileNameRange(*args.range)
-        if args.background is not None:
-            reader.SetBackgroundRange(*args.background)
-        reader.SetFillBetweenSlices(not args.no_fill)
-        return reader
-    if path.lower().endswith((".pcd", ".pcd.gz")):
-        reader = octoray.vtkPCDReader()  # PCL's point cloud files
-    else:
-        reader = octoray.vtkParticleReader()
-    reader.SetFileName(path)
-    reader.SetOutputPointsPrecision(vtk.vtkAlgorithm.DOUBLE_PRECISION)
-    return reader
+# Kept for scripts that imported it from here.
+ProgressBar = scene.ProgressBar
 
 
 def parse_size(text):
@@ -89,55 +62,95 @@ def parse_size(text):
     return w, h
 
 
-def main(argv=None):
-    p = argparse.ArgumentParser(prog="python3 -m octoray.render", description=__doc__.splitlines()[0])
+def parser():
+    p = argparse.ArgumentParser(prog="python3 -m octoray.render", description=__doc__.splitlines()[0],
+                                epilog=__doc__.split("\n\n", 2)[2], formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("input")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.add_argument("--backend", choices=["auto", "cuda", "cpu"], default="auto")
     p.add_argument("--size", type=parse_size, default=(1920, 1080))
     p.add_argument("--mode", choices=sorted(MODES), default="surface")
+    p.add_argument("--shadows", action="store_true", help="shadow rays towards the lights (phong)")
+    p.add_argument("--preset", metavar="NAME",
+                   help="CT transfer function: %s" % ", ".join(octoray.preset_names()))
+    p.add_argument("--threshold", type=float, default=None, metavar="V",
+                   help="slice stacks: voxels at or below V are empty (default: the preset's, else 0)")
+    p.add_argument("--color-by", default="auto", metavar="WHAT",
+                   help="points: colors, intensity, z, none or an array name (auto: colors when the "
+                        "points have them, else Intensity, else z)")
+    p.add_argument("--normals", choices=["auto", "pcl", "none"], default="auto",
+                   help="auto: PCL normals for phong when the points have none")
     p.add_argument("--azimuth", type=float, default=0.0)
     p.add_argument("--elevation", type=float, default=0.0)
     p.add_argument("--zoom", type=float, default=1.0)
     p.add_argument("--depth", type=int, default=0, help="octree leaf level (0: automatic)")
     p.add_argument("--range", type=int, nargs=2, default=(0, 0), metavar=("FIRST", "LAST"))
     p.add_argument("--background", type=float, nargs=2, default=None, metavar=("LO", "HI"),
-                   help="slice intensities that are background")
+                   help="slice intensities that are background: as --threshold HI (--particles: the "
+                        "reader's BackgroundRange)")
     p.add_argument("--parallel", action="store_true", help="parallel projection")
     p.add_argument("--image", action="store_true",
-                   help="slice stacks: draw the stack's volume (a vtkImageData) instead of its particles")
+                   help="slice stacks: draw the stack's volume (a vtkImageData; the default)")
+    p.add_argument("--particles", action="store_true",
+                   help="slice stacks: draw the reader's particles instead of its volume")
     p.add_argument("--no-fill", action="store_true",
                    help="slice stacks: no points between slices (leaves as large as the slice spacing)")
+    return p
+
+
+def main(argv=None):
+    p = parser()
     args = p.parse_args(argv)
 
     if not (os.path.exists(args.input) or "%" in args.input):
         p.error("no such file or folder: %s" % args.input)
+    if args.preset is not None and not octoray.vtkOctreeVolumePresets.HasPreset(args.preset):
+        p.error("unknown preset %r; known presets: %s"
+                % (args.preset, octoray.vtkOctreeVolumePresets.GetNamesAsString()))
+    if not 0 <= args.depth <= 21:
+        p.error("--depth must be 0 (automatic) or 1..21, got %d" % args.depth)
+    blend, shade = MODES[args.mode]
 
     # ---- Load.
-    start = time.perf_counter()
-    reader = make_reader(args.input, args)
-    reader.AddObserver("ProgressEvent", ProgressBar("reading"))
-    reader.Update()
-    cloud = reader.GetOutput()
-    load = time.perf_counter() - start
-    if cloud is None or cloud.GetNumberOfPoints() == 0:
-        print("error: no points read from %s" % args.input, file=sys.stderr)
-        return 1
-    if args.image and not isinstance(reader, octoray.vtkSliceStackReader):
-        p.error("--image needs a slice stack (a folder or a pattern of slices)")
-    data = reader.GetImageOutput() if args.image else cloud
+    kind = scene.input_kind(args.input)
+    if (args.image or args.particles or args.no_fill) and kind != "slices":
+        p.error("--image, --particles and --no-fill need a slice stack (a folder or a pattern of slices)")
+    if args.image and args.particles:
+        p.error("--image and --particles exclude each other")
+    threshold = args.threshold
+    if args.background is not None and threshold is None:
+        threshold = args.background[1]
+    if args.preset is not None and threshold is None and blend == "surface":
+        threshold = octoray.vtkOctreeVolumePresets.GetSurfaceThreshold(args.preset)
 
-    # ---- Mapper and scene.
+    def configure(reader):
+        if kind != "slices":
+            return
+        reader.SetFillBetweenSlices(not args.no_fill)
+        if args.particles and args.background is not None:
+            reader.SetBackgroundRange(*args.background)
+        elif args.particles and threshold is not None:
+            reader.SetBackgroundRange(-1e300, threshold)
+
+    reader, data, load = scene.read(args.input, args.range, configure=configure)
+    if args.particles:
+        data = reader.GetOutput()
+    if data is None or data.GetNumberOfPoints() == 0:
+        print("error: nothing read from %s" % args.input, file=sys.stderr)
+        return 1
+    image = isinstance(data, vtk.vtkImageData)
+
+    # ---- Normals: PCL's where shading needs them and the points have none.
+    normals_seconds = None
+    if not image and (args.normals == "pcl" or (args.normals == "auto" and shade and not scene.has_normals(data))):
+        data, normals_seconds, invalid = scene.estimate_normals(data)
+
+    # ---- Mapper, colours and scene.
     mapper = {"auto": octoray.vtkOctreeVolumeMapper,
               "cuda": octoray.vtkCudaOctreeVolumeMapper,
               "cpu": octoray.vtkCPUOctreeVolumeMapper}[args.backend]()
-    mapper.SetInputData(data)
     mapper.SetLeafDepth(args.depth)
-    mapper.SetFillBetweenSlices(not args.no_fill)
-    if args.image and args.background is not None:
-        mapper.SetImageBackground(args.background[1])
-    mapper.AddObserver("ProgressEvent", ProgressBar("building"))
-    blend, shade = MODES[args.mode]
+    mapper.AddObserver("ProgressEvent", scene.ProgressBar("building"))
     {"surface": mapper.SetBlendModeToSurface,
      "composite": mapper.SetBlendModeToComposite,
      "mip": mapper.SetBlendModeToMaximumIntensity,
@@ -146,66 +159,93 @@ def main(argv=None):
      "additive": mapper.SetBlendModeToAdditive}[blend]()
     if args.mode == "depthcue":
         mapper.SetDepthCue(0.7)
+    mapper.SetShadows(args.shadows and shade)
+    mapper.SetFillBetweenSlices(not args.no_fill)
     prop = vtk.vtkVolumeProperty()
-    prop.SetShade(shade)
-    scalars = data.GetPointData().GetScalars()
-    if scalars is not None and scalars.GetNumberOfComponents() in (3, 4):
-        prop.IndependentComponentsOff()  # RGB(A) point colours
-    elif scalars is not None:
-        lo, hi = scalars.GetRange()
-        if args.image and args.background is not None:
-            lo = max(lo, args.background[1])  # the transfer function over the points' values
-        ctf = vtk.vtkColorTransferFunction()
-        ctf.AddRGBPoint(lo, 0.2, 0.2, 0.9)
-        ctf.AddRGBPoint(0.5 * (lo + hi), 0.9, 0.8, 0.3)
-        ctf.AddRGBPoint(hi, 1.0, 1.0, 1.0)
-        opacity = vtk.vtkPiecewiseFunction()
-        opacity.AddPoint(lo, 0.0 if blend != "surface" else 1.0)
-        opacity.AddPoint(hi, 1.0)
-        prop.SetColor(ctf)
-        prop.SetScalarOpacity(opacity)
+    colouring = None
+    if args.preset is not None:
+        scalars = data.GetPointData().GetScalars()
+        if scalars is None or scalars.GetNumberOfComponents() != 1:
+            print("error: --preset needs one-component scalars (a CT's Hounsfield units); %s has %s"
+                  % (args.input, "none" if scalars is None else "%d components" % scalars.GetNumberOfComponents()),
+                  file=sys.stderr)
+            return 1
+        octoray.apply_preset(args.preset, prop)
+        colouring = "preset %s" % args.preset
+    else:
+        try:
+            data, colouring = scene.color_by(data, mapper, prop, scene.choose_color_by(data, args.color_by))
+        except ValueError as e:
+            print("error: --color-by: %s" % e, file=sys.stderr)
+            return 1
+        scalars = data.GetPointData().GetScalars()
+        if kind == "slices" and scalars is not None and scalars.GetNumberOfComponents() == 1:
+            lo, hi = scalars.GetRange()
+            if image and threshold is not None:
+                lo = max(lo, min(threshold, hi))  # the transfer function over the drawn values
+            ctf = vtk.vtkColorTransferFunction()
+            ctf.AddRGBPoint(lo, 0.2, 0.2, 0.9)
+            ctf.AddRGBPoint(0.5 * (lo + hi), 0.9, 0.8, 0.3)
+            ctf.AddRGBPoint(hi, 1.0, 1.0, 1.0)
+            opacity = vtk.vtkPiecewiseFunction()
+            opacity.AddPoint(lo, 0.0 if blend != "surface" else 1.0)
+            opacity.AddPoint(hi, 1.0)
+            prop.SetColor(ctf)
+            prop.SetScalarOpacity(opacity)
+    if shade:
+        prop.ShadeOn()
+        if args.preset is None:
+            prop.SetAmbient(0.15)
+            prop.SetDiffuse(0.85)
+            prop.SetSpecular(0.15)
+            prop.SetSpecularPower(20)
+    if image:
+        mapper.SetImageBackground(threshold if threshold is not None else 0.0)
+    mapper.SetInputData(data)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(prop)
     ren = vtk.vtkRenderer()
     ren.AddVolume(volume)
+    if shade:
+        scene.add_lights(ren, key=0.85 if image else 0.55, fill=0.35 if image else 0.6)
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
     window.SetSize(*args.size)
     window.AddRenderer(ren)
-    ren.ResetCamera()
-    cam = ren.GetActiveCamera()
-    cam.Azimuth(args.azimuth)
-    cam.Elevation(args.elevation)
-    cam.OrthogonalizeViewUp()
-    cam.SetParallelProjection(args.parallel)
-    cam.Zoom(args.zoom)
-    ren.ResetCameraClippingRange()
+    front, up = scene.default_view(data, kind, reader)
+    bounds = scene.visible_bounds(data, mapper.GetImageBackground()) if image else data.GetBounds()
+    scene.look_at(ren, bounds, front, up, args.azimuth, args.elevation, args.zoom)
+    ren.GetActiveCamera().SetParallelProjection(args.parallel)
 
     # ---- Build and render: the first render builds the octree.
-    start = time.perf_counter()
-    window.Render()
-    first = time.perf_counter() - start
+    with scene.Timer() as first:
+        window.Render()
     build = mapper.GetLastBuildSeconds()
     if mapper.GetLastUsedBackend() < 0:
         print("error: nothing was drawn (see the messages above)", file=sys.stderr)
         return 1
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.ReadFrontBufferOff()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(args.output)
-    writer.SetInputConnection(grab.GetOutputPort())
-    writer.Write()
+    scene.write_png(scene.grab(window), args.output)
 
     print("backend: %s (%s)" % (mapper.GetLastUsedBackendName(), mapper.GetBackendDescription()))
-    print("points: %d%s" % (mapper.GetNumberOfOctreePoints(), " (of the image)" if args.image else ""))
+    if image:
+        d = data.GetDimensions()
+        print("input: %d voxels (%d x %d x %d)" % (data.GetNumberOfPoints(), d[0], d[1], d[2]))
+        print("threshold: %g (voxels at or below are empty)" % mapper.GetImageBackground())
+    else:
+        print("input: %d points" % data.GetNumberOfPoints())
+    print("points: %d (in the octree%s)" % (mapper.GetNumberOfOctreePoints(), ", of the image" if image else ""))
+    print("depth: %d%s" % (mapper.GetOctreeDepth(), " (automatic)" if args.depth == 0 else ""))
     print("leaf: %.6g" % mapper.GetLeafSize())
+    if colouring:
+        print("colour: %s" % colouring)
     print("load: %.3f s" % load)
+    if normals_seconds is not None:
+        print("normals: %.3f s (PCL, 16 neighbours)" % normals_seconds)
     print("build: %.3f s" % build)
     print("render: %.3f s (trace %.3f s, first frame with build %.3f s) at %dx%d"
           % (mapper.GetLastTraceSeconds() + mapper.GetLastDepthReadSeconds() + mapper.GetLastUploadSeconds()
-             + mapper.GetLastDrawSeconds(), mapper.GetLastTraceSeconds(), first, args.size[0], args.size[1]))
+             + mapper.GetLastDrawSeconds(), mapper.GetLastTraceSeconds(), first.seconds, args.size[0], args.size[1]))
     print("wrote %s" % args.output)
     return 0
 

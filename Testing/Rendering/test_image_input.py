@@ -1,0 +1,174 @@
+"""vtkOctreeVolumeMapper on vtkImageData, as the demo's CT uses it (label
+python, vtk; run under a display by ctest):
+
+- LeafDepth 0 chooses the depth from the spacing: the leaf is the finest
+  spacing, and the voxel centres are leaf centres;
+- with slices farther apart than the pixels the octree has no empty layers
+  between slices (FillBetweenSlices), and values are interpolated linearly
+  between slices;
+- with RootBounds around the voxel centres (what parallel ranks set) the
+  build succeeds;
+- gradient normals (ImageGradientNormals): a sphere's shading follows the
+  sphere (Lambert's law), not the voxels.
+"""
+import numpy as np
+import pytest
+import vtk
+from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+
+import octoray
+
+
+def image(values, spacing, origin=(0.0, 0.0, 0.0)):
+    """vtkImageData from a (nz, ny, nx) array."""
+    nz, ny, nx = values.shape
+    im = vtk.vtkImageData()
+    im.SetDimensions(nx, ny, nz)
+    im.SetSpacing(*spacing)
+    im.SetOrigin(*origin)
+    arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).ravel(), deep=1)
+    arr.SetName("Scalars")
+    im.GetPointData().SetScalars(arr)
+    return im
+
+
+def render(data, size=(64, 64), configure=None, camera=None, lights=None):
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(data)
+    if configure:
+        configure(mapper)
+    prop = vtk.vtkVolumeProperty()
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetProperty(prop)
+    ren = vtk.vtkRenderer()
+    ren.AddVolume(volume)
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(*size)
+    window.AddRenderer(ren)
+    if lights:
+        lights(ren, prop)
+    ren.ResetCamera()
+    if camera:
+        camera(ren.GetActiveCamera())
+        ren.ResetCameraClippingRange()
+    window.Render()
+    assert mapper.GetLastUsedBackend() == mapper.BACKEND_CPU
+    return mapper, window
+
+
+def leaves(mapper):
+    pd = vtk.vtkPolyData()
+    mapper.GetLeafVoxels(pd)
+    return vtk_to_numpy(pd.GetPoints().GetData()).astype(float), pd
+
+
+def test_depth_from_the_spacing_and_leaves_on_the_voxels():
+    # 10 x 10 x 10 voxels of 0.5: boxes 5 wide, depth ceil(log2(10)) = 4,
+    # the leaf the spacing, one leaf per voxel, at the voxel.
+    im = image(np.ones((10, 10, 10)), (0.5, 0.5, 0.5), origin=(3.0, -2.0, 100.0))
+    mapper, _ = render(im)
+    assert mapper.GetOctreeDepth() == 4
+    assert mapper.GetLeafSize() == pytest.approx(0.5, rel=1e-5)
+    assert mapper.GetNumberOfOctreePoints() == 1000
+    centres, _ = leaves(mapper)
+    assert len(centres) == 1000
+    # Every leaf centre is a voxel centre (to float precision).
+    grid = (centres - np.array([3.0, -2.0, 100.0])) / 0.5
+    assert np.abs(grid - np.round(grid)).max() < 1e-3
+    assert grid.min() > -1e-3 and grid.max() < 9 + 1e-3
+
+
+def test_no_empty_layers_between_slices():
+    # 8 x 8 voxels of 1, 4 slices 2.5 apart (z 0 .. 7.5): planes of points
+    # are filled in between, the leaf is the pixel (1), and every leaf layer
+    # from the first slice to the last holds points: 9 of them.
+    im = image(np.full((4, 8, 8), 100.0), (1.0, 1.0, 2.5))
+    mapper, _ = render(im, configure=lambda m: m.SetImageBackground(50.0))
+    assert mapper.GetLeafSize() == pytest.approx(1.0, rel=1e-5)
+    centres, _ = leaves(mapper)
+    layers = np.unique(np.round(centres[:, 2], 3))
+    assert len(layers) == 9, layers
+    assert np.allclose(np.diff(layers), 1.0, rtol=1e-4)
+    assert layers[0] == pytest.approx(0.0, abs=1e-3) and layers[-1] == pytest.approx(8.0, abs=1e-3)
+    assert len(centres) == 8 * 8 * 9
+
+
+def test_values_are_interpolated_between_slices():
+    # Two slices 4 apart, 0 and 100: the planes between them take the values
+    # in between (25, 50, 75), and only those above the background (40) are
+    # kept: the planes at z = 2, 3, 4 with 50, 75 and 100.
+    values = np.zeros((2, 4, 4))
+    values[1] = 100.0
+    im = image(values, (1.0, 1.0, 4.0))
+    mapper, _ = render(im, configure=lambda m: m.SetImageBackground(40.0))
+    centres, pd = leaves(mapper)
+    scalars = vtk_to_numpy(pd.GetPointData().GetArray("Scalars"))
+    assert sorted(np.unique(np.round(scalars, 3))) == [50.0, 75.0, 100.0]
+    assert sorted(np.unique(np.round(centres[:, 2], 3))) == [2.0, 3.0, 4.0]
+    assert len(centres) == 3 * 16
+
+
+def test_root_bounds_around_the_voxel_centres():
+    # What parallel ranks set (the data's bounds): the voxels' boxes reach
+    # past them, and their points must still lie inside the cube.
+    im = image(np.full((3, 6, 6), 10.0), (1.0, 1.0, 3.0))
+    b = im.GetBounds()
+    errors = []
+    mapper, _ = render(im, configure=lambda m: (m.SetRootBounds(b), m.SetImageBackground(1.0),
+                                                  m.AddObserver("ErrorEvent", lambda *a: errors.append(a))))
+    assert not errors
+    assert mapper.GetNumberOfOctreePoints() > 6 * 6 * 3
+
+
+def sphere(n=40, radius=15.0):
+    c = (n - 1) / 2.0
+    z, y, x = np.mgrid[0:n, 0:n, 0:n].astype(float)
+    d = np.sqrt((x - c) ** 2 + (y - c) ** 2 + (z - c) ** 2)
+    # A smooth edge (4 voxels wide), as a CT has: the iso-surface at 50 is the sphere.
+    return image(100.0 * np.clip((radius - d) / 4.0 + 0.5, 0.0, 1.0), (1.0, 1.0, 1.0)), c, radius
+
+
+def lambert_profile(gradient_normals):
+    """The sphere seen down -z with a headlight, flat white, no ambient:
+    brightness against the analytic cos of the angle to the viewer."""
+    im, c, radius = sphere()
+
+    def lights(ren, prop):
+        prop.ShadeOn()
+        prop.SetAmbient(0.0)
+        prop.SetDiffuse(1.0)
+        prop.SetSpecular(0.0)
+        ctf = vtk.vtkColorTransferFunction()
+        ctf.AddRGBPoint(0, 1, 1, 1)
+        ctf.AddRGBPoint(100, 1, 1, 1)
+        prop.SetColor(ctf)
+
+    def camera(cam):
+        cam.ParallelProjectionOn()
+        cam.SetParallelScale(radius * 1.1)
+
+    mapper, window = render(im, size=(120, 120), lights=lights, camera=camera,
+                            configure=lambda m: (m.SetImageBackground(50.0),
+                                                 m.SetImageGradientNormals(gradient_normals)))
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(window)
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    rgb = vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars()).reshape(120, 120, -1)[:, :, 0] / 255.0
+    # Pixel centres in data units (the parallel scale is half the height).
+    u = (np.arange(120) + 0.5) / 120 * 2 * radius * 1.1 - radius * 1.1
+    xx, yy = np.meshgrid(u, u)
+    r = np.sqrt(xx ** 2 + yy ** 2) / radius
+    inside = r < 0.9
+    expected = np.sqrt(1 - r[inside] ** 2)
+    return np.corrcoef(rgb[inside], expected)[0, 1], np.abs(rgb[inside] - expected).mean()
+
+
+def test_gradient_normals_follow_the_sphere():
+    correlation, error = lambert_profile(True)
+    assert correlation > 0.97 and error < 0.04, (correlation, error)
+    # Off, the normals come from the octree's occupancy: blockier.
+    off_correlation, off_error = lambert_profile(False)
+    assert off_error > 2 * error, (off_error, error)
