@@ -36,6 +36,9 @@ packages=(
   # reliability (issue 8): the ASan+UBSan build and the libFuzzer targets
   # (clang with its sanitizer and fuzzer runtimes; OpenMP for clang)
   clang-14 libclang-rt-14-dev libomp-14-dev
+  # what CMake finds beside clang and records in build-asan's cache (llvm-ar,
+  # llvm-ranlib, ld.lld): named, so a fresh machine configures the same way
+  llvm-14 lld-14
   # reader benchmarks compare against pandas (pyarrow engine when present)
   python3-pandas
   # independent reference values for the DICOM tests
