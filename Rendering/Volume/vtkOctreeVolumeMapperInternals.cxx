@@ -1,0 +1,401 @@
+#include "vtkOctreeVolumeMapperInternals.h"
+
+#include "vtkCamera.h"
+#include "vtkDataSet.h"
+#include "vtkMath.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkPropCollection.h"
+#include "vtkRenderer.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include <octoray/DepthSignature.h>
+#include <octoray/Engine.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <vector>
+
+namespace
+{
+double Now()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}
+
+//------------------------------------------------------------------------------
+// Every engine call goes through here: a failure goes to the backend, which
+// replaces a failed CUDA engine by a CPU one (Retry) or gives up (Stop).
+template <typename Call>
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Run(const char* what, Call&& call)
+{
+  try
+  {
+    call();
+    return Step::Done;
+  }
+  catch (const std::exception& e)
+  {
+    return this->Report(this->Backend.Failed(what, e.what()));
+  }
+}
+
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Report(
+  vtkOctreeBackend::Status status)
+{
+  switch (status)
+  {
+    case vtkOctreeBackend::Status::Ready:
+      return Step::Done;
+    case vtkOctreeBackend::Status::SwitchedToCPU:
+      vtkWarningWithObjectMacro(this->Self, << this->Backend.Message());
+      this->Input.Forget();
+      return Step::Retry;
+    default:
+      vtkErrorWithObjectMacro(this->Self, << this->Backend.Message());
+      this->Input.Forget();
+      return Step::Stop;
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Acquire()
+{
+  const Step step = this->Report(this->Backend.Acquire(this->Self->RequestedBackend, this->Self->CudaDevice));
+  if (step == Step::Done && this->Backend.Kind() == BACKEND_CUDA && this->Self->CudaMemoryBudget > 0)
+  {
+    this->Backend.Engine()->SetMemoryBudget(static_cast<std::size_t>(this->Self->CudaMemoryBudget));
+  }
+  return step;
+}
+
+//------------------------------------------------------------------------------
+// The frame: engine, octree, picture; a CUDA failure in any of them starts
+// it again on the CPU.
+void vtkOctreeVolumeMapper::vtkInternals::RenderOctree(
+  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window, vtkDataSet* input)
+{
+  for (int attempt = 0; attempt < 2; ++attempt)
+  {
+    Step step = this->Acquire();
+    if (step == Step::Done)
+    {
+      step = this->PrepareOctree(input, vol->GetProperty());
+    }
+    if (step == Step::Done)
+    {
+      step = this->Trace(ren, vol, window);
+    }
+    if (step == Step::Stop)
+    {
+      return;
+    }
+    if (step == Step::Done)
+    {
+      break;
+    }
+  }
+  const double t0 = Now();
+  if (!this->Compositor.Draw(window))
+  {
+    vtkErrorWithObjectMacro(this->Self, "Could not compile the composite shader.");
+  }
+  this->Self->LastDrawSeconds = Now() - t0;
+}
+
+//------------------------------------------------------------------------------
+// Builds, updates or keeps the octree.
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::PrepareOctree(
+  vtkDataSet* input, vtkVolumeProperty* property)
+{
+  const vtkOctreeInputHelper::Request request =
+    vtkOctreeInputHelper::MakeRequest(input, this->Self, property, this->Backend.Generation());
+  if (request.CellScalars && !this->CellScalarsWarned)
+  {
+    this->CellScalarsWarned = true;
+    vtkWarningWithObjectMacro(this->Self, "Cell scalars are not supported; the points are drawn without them.");
+  }
+  switch (this->Input.Compare(request))
+  {
+    case vtkOctreeInputHelper::Change::None:
+      return Step::Done;
+    case vtkOctreeInputHelper::Change::Positions:
+    {
+      // Only the positions moved (a point set animated in place).
+      const double start = Now();
+      const octoray::PositionsView moved = this->Input.Positions(request);
+      const Step step = this->Run("update", [&] { this->Backend.Engine()->Update(moved); });
+      if (step == Step::Done)
+      {
+        this->Input.Remember(request);
+        ++this->OctreeVersion;
+        ++this->Self->NumberOfUpdates;
+        this->Self->LastBuildSeconds = Now() - start;
+      }
+      return step;
+    }
+    default:
+      return this->Build(request);
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Build(
+  const vtkOctreeInputHelper::Request& request)
+{
+  const double start = Now();
+  vtkOctreeVolumeMapper* self = this->Self;
+  self->UpdateProgress(0.0);
+  this->Input.Forget();
+  const octoray::PointCloudView view =
+    this->Input.PointCloud(request, [self](double progress) { self->UpdateProgress(progress); });
+  if (view.count == 0)
+  {
+    vtkWarningWithObjectMacro(self, "Every voxel of the image is at or below the background "
+        << request.ImageBackground << "; nothing to draw.");
+    return Step::Stop;
+  }
+  self->UpdateProgress(0.5);
+  octoray::BuildOptions options;
+  options.depth = request.LeafDepth;
+  const bool rootBounds = vtkMath::AreBoundsInitialized(request.RootBounds.data());
+  if (rootBounds)
+  {
+    // The caller's cube (e.g. global bounds over parallel ranks): the same
+    // voxel grid on every rank.
+    const double* b = request.RootBounds.data();
+    const double lo[3] = { b[0], b[2], b[4] }, hi[3] = { b[1], b[3], b[5] };
+    options.fixedCube = true;
+    options.cube = octoray::RootCube::FromBounds(lo, hi);
+  }
+  // Points on a lattice (an image, the slice-stack reader's particles) with
+  // the depth left automatic: leaves as large as the lattice's largest step
+  // and aligned with it, so that the volume has no gap (octorayLattice.h),
+  // in a cube around the caller's bounds where there are some (then the
+  // same on every rank).
+  octoray::lattice::Lattice lattice;
+  double bounds[6];
+  if (request.LeafDepth == 0 && this->Input.PointLattice(lattice, bounds))
+  {
+    if (rootBounds)
+    {
+      std::copy(request.RootBounds.begin(), request.RootBounds.end(), bounds);
+    }
+    const octoray::lattice::LeafGrid grid = octoray::lattice::ChooseLeafGrid(lattice, bounds, octoray::kMaxLevel);
+    if (grid.Valid)
+    {
+      options.depth = grid.Depth;
+      options.fixedCube = true;
+      std::copy(grid.Origin, grid.Origin + 3, options.cube.origin);
+      options.cube.size = grid.Size;
+    }
+  }
+  octoray::BuildStats stats;
+  const Step step = this->Run("build", [&] { stats = this->Backend.Engine()->Build(view, options); });
+  if (step == Step::Done)
+  {
+    // The leaf grid, for GetVoxelBounds.
+    this->BuiltCube = stats.cube;
+    this->BuiltDepth = stats.depth;
+    this->BuiltFor = request.Input;
+    this->BuiltMTime = request.Input->GetMTime();
+    this->Input.Remember(request);
+    ++this->OctreeVersion;
+    ++self->NumberOfBuilds;
+    self->LastBuildSeconds = Now() - start;
+  }
+  self->UpdateProgress(1.0);
+  return step;
+}
+
+//------------------------------------------------------------------------------
+// What the frame asks of the engine, from the renderer, the volume and the
+// mapper's settings.
+octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
+  vtkRenderer* ren, vtkVolume* vol, int width, int height)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  vtkVolumeProperty* property = vol->GetProperty();
+  octoray::RenderSettings s;
+  const int step = std::max(1, static_cast<int>(std::lround(self->ImageSampleDistance)));
+  s.width = (width + step - 1) / step;
+  s.height = (height + step - 1) / step;
+  vtkOctreeRenderSettings::SetCamera(ren->GetActiveCamera(), ren->GetTiledAspectRatio(), vol->GetMatrix(), s);
+  s.blend = vtkOctreeRenderSettings::Blend(self->BlendMode);
+  vtkOctreeRenderSettings::SetShading(property, self->DepthCue, s);
+  s.shadows = self->Shadows;
+  s.maxBounces = self->MaximumBounces;
+  s.lodPixels = static_cast<float>(self->LODPixelThreshold);
+  if (vtkOctreeRenderSettings::SetLights(ren->GetLights(), vol->GetMatrix(), s) > 0)
+  {
+    vtkWarningWithObjectMacro(self, "The octree engine takes at most 8 lights; the others are ignored.");
+  }
+  // Transfer function on the scalars (unless the points carry colours).
+  if (this->Input.HasScalar())
+  {
+    vtkOctreeRenderSettings::SetTransfer(property, this->Input.ScalarRange(), s);
+  }
+  return s;
+}
+
+//------------------------------------------------------------------------------
+// Whether anything may have written depth in the viewport before the
+// volumes are drawn: another visible 3D prop with opaque geometry (actors,
+// and other volumes, which this mapper draws with depth), or a depth buffer
+// the renderer keeps from the layer below. When nothing can, the depth read
+// (a round trip through OpenGL) is skipped and rays run to the far plane.
+static bool MayHaveOpaqueDepth(vtkRenderer* ren, vtkVolume* vol)
+{
+  if (ren->GetPreserveDepthBuffer())
+  {
+    return true;
+  }
+  vtkCollectionSimpleIterator it;
+  vtkPropCollection* props = ren->GetViewProps();
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    if (prop != vol && prop->GetVisibility() && vtkProp3D::SafeDownCast(prop) && prop->HasOpaqueGeometry())
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+//------------------------------------------------------------------------------
+// Traces the picture when anything that shapes it changed since the last one.
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Trace(
+  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  if (width <= 0 || height <= 0)
+  {
+    return Step::Stop;
+  }
+  octoray::RenderSettings s = this->FrameSettings(ren, vol, width, height);
+  std::uint64_t depthSignature = 0;
+  self->LastDepthReadSeconds = 0.0;
+  if (MayHaveOpaqueDepth(ren, vol))
+  {
+    const Step step = this->OpaqueDepth(window, x0, y0, width, height, s, depthSignature);
+    if (step != Step::Done)
+    {
+      return step;
+    }
+  }
+  const vtkOctreeRenderSettings::TraceKey key = vtkOctreeRenderSettings::TraceKey::Of(
+    s, self->GetMTime(), vol->GetProperty()->GetMTime(), this->OctreeVersion, depthSignature);
+  if (key == this->LastTrace && this->Compositor.HasPicture())
+  {
+    return Step::Done;
+  }
+  const Step traced = this->Deliver(window, s);
+  if (traced == Step::Done)
+  {
+    ++self->NumberOfTraces;
+    this->LastTrace = key;
+  }
+  return traced;
+}
+
+//------------------------------------------------------------------------------
+// The depth of what VTK drew in the viewport, where rays must stop, and its
+// signature (what the last trace is compared by). On CUDA with interop it
+// stays on the GPU (vtkOctreeCompositor::ReadDepthToDevice), where the trace
+// reads it; otherwise it is read back to the host (and sampled at the traced
+// pixels when one ray serves several).
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::OpaqueDepth(
+  vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height, octoray::RenderSettings& s,
+  std::uint64_t& signature)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  const double t0 = Now();
+  const int step = std::max(1, static_cast<int>(std::lround(self->ImageSampleDistance)));
+  if (step == 1 && this->UsesInterop())
+  {
+    std::string why;
+    s.deviceDepthBuffer =
+      this->Compositor.ReadDepthToDevice(window, x0, y0, width, height, this->Backend.CudaDevice(), why);
+    if (!s.deviceDepthBuffer)
+    {
+      this->InteropFailed(why);
+    }
+    else
+    {
+      const Step summed = this->Run("depth signature", [&] {
+        signature = this->Backend.Engine()->DeviceDepthSignature(
+          s.deviceDepthBuffer, static_cast<std::size_t>(width) * height);
+      });
+      self->LastDepthReadSeconds = Now() - t0;
+      return summed;
+    }
+  }
+  std::vector<float> depth;
+  if (!this->Compositor.ReadDepth(window, x0, y0, width, height, depth))
+  {
+    vtkWarningWithObjectMacro(self, "Could not read the depth of the opaque geometry; the octree is drawn without it.");
+  }
+  s.depthBuffer = vtkOctreeRenderSettings::SampleDepth(depth, width, height, step, s.width, s.height);
+  signature = octoray::DepthSignature(s.depthBuffer.data(), s.depthBuffer.size());
+  self->LastDepthReadSeconds = Now() - t0;
+  return Step::Done;
+}
+
+//------------------------------------------------------------------------------
+bool vtkOctreeVolumeMapper::vtkInternals::UsesInterop() const
+{
+  return this->Backend.Kind() == BACKEND_CUDA && this->Self->UseCudaGLInterop && !this->InteropUnusable;
+}
+
+void vtkOctreeVolumeMapper::vtkInternals::InteropFailed(const std::string& why)
+{
+  vtkWarningWithObjectMacro(
+    this->Self, "CUDA-OpenGL interop cannot serve this window (" << why << "); the picture goes through host memory");
+  this->InteropUnusable = true;
+}
+
+//------------------------------------------------------------------------------
+// Traces and puts the picture into the compositor's textures: on CUDA
+// straight from device memory where interop serves this window, otherwise
+// through host memory.
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Deliver(
+  vtkOpenGLRenderWindow* window, octoray::RenderSettings& s)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  octoray::Engine* engine = this->Backend.Engine();
+  s.copyToHost = !this->UsesInterop();
+  octoray::RenderStats stats;
+  Step step = this->Run("render", [&] { stats = engine->Render(s, this->Image); });
+  if (step != Step::Done)
+  {
+    return step;
+  }
+  double t0 = Now();
+  std::string why;
+  if (!s.copyToHost && !this->Compositor.SetPictureFromDevice(window, engine->LastDeviceImage(), why))
+  {
+    this->InteropFailed(why);
+    s.copyToHost = true;
+    step = this->Run("render", [&] { stats = engine->Render(s, this->Image); });
+    if (step != Step::Done)
+    {
+      return step;
+    }
+    t0 = Now();
+  }
+  if (s.copyToHost)
+  {
+    this->Compositor.SetPictureFromHost(window, this->Image);
+  }
+  self->LastUploadSeconds = Now() - t0;
+  self->LastTraceSeconds = stats.seconds + stats.copySeconds;
+  this->Transfer = s.copyToHost ? TRANSFER_HOST : TRANSFER_DEVICE;
+  return Step::Done;
+}
+

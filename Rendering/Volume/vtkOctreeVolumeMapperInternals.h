@@ -1,0 +1,87 @@
+/**
+ * @class   vtkOctreeVolumeMapper::vtkInternals
+ * @brief   the work of vtkOctreeVolumeMapper::Render(): the engine, the
+ *          octree, the frame and the compositor
+ *
+ * A private part of vtkOctreeVolumeMapper (not wrapped, not installed). A
+ * frame is three steps, each of which may end in a CUDA failure that hands
+ * the engine to the CPU (vtkOctreeBackend): acquire the engine, build or
+ * update the octree when the input changed (vtkOctreeInputHelper), trace
+ * when anything that shapes the picture changed (vtkOctreeRenderSettings)
+ * and put the picture into the compositor's textures (vtkOctreeCompositor),
+ * which then draws it.
+ */
+#ifndef vtkOctreeVolumeMapperInternals_h
+#define vtkOctreeVolumeMapperInternals_h
+
+#include "vtkOctreeBackend.h"
+#include "vtkOctreeCompositor.h"
+#include "vtkOctreeInputHelper.h"
+#include "vtkOctreeRenderSettings.h"
+#include "vtkOctreeVolumeMapper.h"
+
+#include <octoray/Render.h>
+#include <octoray/RootCube.h>
+
+#include <cstdint>
+#include <string>
+
+class vtkOpenGLRenderWindow;
+class vtkRenderer;
+class vtkVolume;
+class vtkVolumeProperty;
+
+class vtkOctreeVolumeMapper::vtkInternals
+{
+public:
+  // How one step of a frame ended. A CUDA failure switches the engine to
+  // the CPU; the frame then starts again there, once.
+  enum class Step
+  {
+    Done,
+    Retry,
+    Stop
+  };
+
+  explicit vtkInternals(vtkOctreeVolumeMapper* self)
+    : Self(self)
+  {
+  }
+
+  void RenderOctree(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window, vtkDataSet* input);
+  Step Acquire();
+  Step PrepareOctree(vtkDataSet* input, vtkVolumeProperty* property);
+  Step Build(const vtkOctreeInputHelper::Request& request);
+  Step Trace(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window);
+  octoray::RenderSettings FrameSettings(vtkRenderer* ren, vtkVolume* vol, int width, int height);
+  Step OpaqueDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
+    octoray::RenderSettings& settings, std::uint64_t& signature);
+  bool UsesInterop() const;
+  void InteropFailed(const std::string& why);
+  Step Deliver(vtkOpenGLRenderWindow* window, octoray::RenderSettings& settings);
+  template <typename Call>
+  Step Run(const char* what, Call&& call);
+  Step Report(vtkOctreeBackend::Status status);
+
+  vtkOctreeVolumeMapper* Self;
+  vtkOctreeBackend Backend;
+  vtkOctreeInputHelper Input;
+  vtkOctreeCompositor Compositor;
+  unsigned long OctreeVersion = 0; // bumped by every build and update
+  // The leaf size of the last build and the input it was built for
+  // (GetVoxelBounds).
+  octoray::RootCube BuiltCube;
+  int BuiltDepth = 0;
+  vtkDataSet* BuiltFor = nullptr;
+  vtkMTimeType BuiltMTime = 0;
+  bool CellScalarsWarned = false;
+  bool InteropUnusable = false; // said once; the host path from then on
+
+  // The last picture and what it was traced from.
+  octoray::Image Image;
+  vtkOctreeRenderSettings::TraceKey LastTrace;
+  int Transfer = TRANSFER_NONE;
+};
+
+#endif
+// VTK-HeaderTest-Exclude: vtkOctreeVolumeMapperInternals.h
