@@ -24,7 +24,8 @@
 #include "vtkPoints.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
-#include "vtkPVLODVolume.h"
+#include "vtkOctreeLODVolume.h"
+#include "octorayParallelPieces.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPVRenderView.h"
 #include "vtkRenderer.h"
@@ -36,183 +37,8 @@
 #include <algorithm> // for std::copy
 #include <string>
 
-#include <dlfcn.h>
-
-namespace
-{
-//----------------------------------------------------------------------------
-// The volume of the representation: ParaView's vtkPVLODVolume, except
-//
-// - that it lets vtkOctreeVolumeMapper draw without scalars.
-//   vtkPVLODVolume::CanRender skips any vtkVolumeMapper whose input has no
-//   scalar array selected ("volume mappers are notorious for segfaulting when
-//   the scalar array is missing"); the octree mapper is not: without scalars
-//   it draws the points' own colours or white, and with an empty input it
-//   draws nothing. So "Solid Color" (e.g. PLY points with normals only)
-//   draws, and a rank with an empty piece is simply empty;
-// - that its bounds hold the voxels, not only the points
-//   (vtkOctreeVolumeMapper::GetVoxelBounds: out to the leaf grid): IceT crops each
-//   rank's picture to the screen rectangle of the renderer's prop bounds
-//   (vtkIceTCompositePass: ComputeVisiblePropBounds, icetBoundingVertices),
-//   and the voxels around the outermost points reach past the points' bounds
-//   by up to a leaf, so with the points' bounds the parallel picture lost
-//   the edge voxels' outer halves. (The view's camera reset also takes the
-//   props' bounds: it frames the voxels, up to a leaf wider than the
-//   points.)
-class vtkOctreeLODVolume : public vtkPVLODVolume
-{
-public:
-  static vtkOctreeLODVolume* New();
-  vtkTypeMacro(vtkOctreeLODVolume, vtkPVLODVolume);
-
-  int RenderOpaqueGeometry(vtkViewport* vp) override
-  {
-    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderOpaqueGeometry)
-                               : this->Superclass::RenderOpaqueGeometry(vp);
-  }
-  int RenderTranslucentPolygonalGeometry(vtkViewport* vp) override
-  {
-    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderTranslucentPolygonalGeometry)
-                               : this->Superclass::RenderTranslucentPolygonalGeometry(vp);
-  }
-  int RenderVolumetricGeometry(vtkViewport* vp) override
-  {
-    return this->DrawsOctree() ? this->Draw(vp, &vtkLODProp3D::RenderVolumetricGeometry)
-                               : this->Superclass::RenderVolumetricGeometry(vp);
-  }
-
-  double* GetBounds() override
-  {
-    const int lod = this->SelectLOD();
-    auto* mapper =
-      lod >= 0 ? vtkOctreeVolumeMapper::SafeDownCast(this->LODProp->GetLODMapper(lod)) : nullptr;
-    if (!mapper)
-    {
-      return this->Superclass::GetBounds();
-    }
-    double cube[6];
-    mapper->GetVoxelBounds(cube);
-    vtkMath::UninitializeBounds(this->Bounds);
-    if (!vtkMath::AreBoundsInitialized(cube))
-    {
-      return this->Bounds;
-    }
-    // The corners through the volume's matrix (position, scale, ...).
-    vtkBoundingBox box;
-    vtkMatrix4x4* matrix = this->GetMatrix();
-    for (int corner = 0; corner < 8; ++corner)
-    {
-      double p[4] = { cube[corner & 1], cube[2 + ((corner >> 1) & 1)],
-        cube[4 + ((corner >> 2) & 1)], 1.0 };
-      matrix->MultiplyPoint(p, p);
-      box.AddPoint(p[0] / p[3], p[1] / p[3], p[2] / p[3]);
-    }
-    box.GetBounds(this->Bounds);
-    return this->Bounds;
-  }
-
-protected:
-  vtkOctreeLODVolume() = default;
-  ~vtkOctreeLODVolume() override = default;
-
-private:
-  vtkOctreeLODVolume(const vtkOctreeLODVolume&) = delete;
-  void operator=(const vtkOctreeLODVolume&) = delete;
-
-  // The LOD chosen for this frame (by SetAllocatedRenderTime) is the octree.
-  bool DrawsOctree()
-  {
-    const int lod = this->LODProp->GetSelectedLODID();
-    return lod >= 0 && vtkOctreeVolumeMapper::SafeDownCast(this->LODProp->GetLODMapper(lod));
-  }
-  // As vtkPVLODVolume's passes, less CanRender.
-  int Draw(vtkViewport* vp, int (vtkLODProp3D::*pass)(vtkViewport*))
-  {
-    const int drawn = (this->LODProp->*pass)(vp);
-    this->EstimatedRenderTime = this->LODProp->GetEstimatedRenderTime();
-    return drawn;
-  }
-};
-vtkStandardNewMacro(vtkOctreeLODVolume);
-
-//----------------------------------------------------------------------------
-// The points of a point set as a vtkUnstructuredGrid with one vertex cell per
-// point, the piece the view redistributes before ordered compositing
-// (vtkOrderedCompositeDistributor, a vtkRedistributeDataSetFilter with the
-// view's k-d tree cuts):
-// - the filter moves cells, so points that no cell uses (a point cloud
-//   without vertex cells) would be lost, and the points of a mesh's faces
-//   would be duplicated along the cuts; with one vertex per point every
-//   point goes to exactly one rank;
-// - an unstructured grid, not polydata: the distributor turns redistributed
-//   polydata back into polydata with vtkDataSetSurfaceFilter, which
-//   dereferences the points of its input, and a rank that receives no cell
-//   gets a grid without points (ParaView 5.11 then crashes with SIGSEGV in
-//   vtkDataSetSurfaceFilter::UnstructuredGridExecuteInternal); an
-//   unstructured grid is passed on as it is.
-// Point data and field data are shallow copies; the octree uses neither
-// cells nor cell data.
-vtkSmartPointer<vtkUnstructuredGrid> PointCloudPiece(vtkPointSet* input)
-{
-  auto cloud = vtkSmartPointer<vtkUnstructuredGrid>::New();
-  if (input->GetPoints())
-  {
-    cloud->SetPoints(input->GetPoints());
-  }
-  else
-  {
-    vtkNew<vtkPoints> none;
-    cloud->SetPoints(none);
-  }
-  const vtkIdType n = input->GetNumberOfPoints();
-  vtkNew<vtkIdTypeArray> offsets;
-  vtkNew<vtkIdTypeArray> connectivity;
-  offsets->SetNumberOfValues(n + 1);
-  connectivity->SetNumberOfValues(n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    offsets->SetValue(i, i);
-    connectivity->SetValue(i, i);
-  }
-  offsets->SetValue(n, n);
-  vtkNew<vtkCellArray> verts;
-  verts->SetData(offsets, connectivity);
-  cloud->SetCells(VTK_VERTEX, verts);
-  cloud->GetPointData()->ShallowCopy(input->GetPointData());
-  cloud->GetFieldData()->ShallowCopy(input->GetFieldData());
-  return cloud;
-}
-}
 
 vtkStandardNewMacro(vtkOctreeVolumeRepresentation);
-
-namespace
-{
-// ParaView 5.11's ranks exchange data as XML whose binary part VTK 9.2's
-// parser leaves to expat to skip; a libexpat that defers reparsing (expat
-// 2.6, and Debian 12's libexpat1 2.5.0-1+deb12u2 and later) does not, and
-// every exchange fails. Plugin/ExpatCompat, preloaded, turns the deferral off
-// and says so by a symbol. Returns the preload's path when it is needed and
-// missing, else an empty string.
-std::string MissingExpatCompat()
-{
-  if (!dlsym(RTLD_DEFAULT, "XML_SetReparseDeferralEnabled") ||
-    dlsym(RTLD_DEFAULT, "octoray_expat_reparse_deferral_off"))
-  {
-    return std::string();
-  }
-  // Beside the plugin's build: lib/paraview-5.11/plugins/Octoray/Octoray.so.
-  Dl_info self;
-  std::string dir = dladdr(reinterpret_cast<void*>(&MissingExpatCompat), &self) && self.dli_fname
-    ? self.dli_fname
-    : "lib/paraview-5.11/plugins/Octoray/Octoray.so";
-  for (int up = 0; up < 4 && dir.find('/') != std::string::npos; ++up)
-  {
-    dir.erase(dir.rfind('/'));
-  }
-  return dir + "/liboctorayExpatCompat.so";
-}
-}
 
 // A warning said by the first rank only: every rank runs the representation
 // with the same settings and data types, and the first rank's messages are
@@ -319,7 +145,7 @@ int vtkOctreeVolumeRepresentation::RequestData(
       if (pointSet && ranks > 1 && this->IsTranslucentBlendMode())
       {
         // The view will redistribute the piece for ordered compositing.
-        this->Cache = PointCloudPiece(pointSet);
+        this->Cache = octoray::PointCloudPiece(pointSet);
       }
       else
       {
@@ -434,7 +260,7 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
           << " ranks the points are redistributed into disjoint pieces and blended in order; "
              "each piece has its own octree, so voxels along the cuts may differ from a "
              "one-rank picture. The surface modes composite exactly.");
-        const std::string compat = MissingExpatCompat();
+        const std::string compat = octoray::MissingExpatCompat();
         if (!compat.empty())
         {
           vtkWarningOnFirstRankMacro("Octree Volume: this libexpat defers reparsing (Debian 12's "
