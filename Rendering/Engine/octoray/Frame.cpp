@@ -85,8 +85,10 @@ double Distance(const double a[3], const double b[3])
 }
 }
 
-FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool secondaryRays)
+FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
 {
+  const RootCube& cube = tree.cube;
+  const bool secondaryRays = tree.reflectivity != nullptr || tree.refraction != nullptr;
   if (s.width <= 0 || s.height <= 0)
   {
     throw Error("octoray: the viewport must be at least 1x1, got " + std::to_string(s.width) + "x" +
