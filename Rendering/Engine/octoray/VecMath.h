@@ -99,11 +99,11 @@ OCTORAY_HD Vec3d ToDouble(const Vec3f& v)
   return Vec3d{ static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z) };
 }
 
-// v limited to [0, 1]; NaN stays NaN (callers that must not see one test
-// for it: TransferIndex).
+// v limited to [0, 1], NaN taken as 0: no NaN reaches a colour, a depth or a
+// table index through a clamp.
 template <typename T>
 OCTORAY_HD T Clamp01(T v)
 {
-  return v < T(0) ? T(0) : (v > T(1) ? T(1) : v);
+  return !(v > T(0)) ? T(0) : (v > T(1) ? T(1) : v);
 }
 }
