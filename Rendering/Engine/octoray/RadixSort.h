@@ -1,5 +1,5 @@
-// CPU least-significant-digit radix sort of (key, index) pairs on the low
-// `bits` bits of the keys, multi-threaded, stable.
+// CPU least-significant-digit radix sort of (key, index) pairs whose keys
+// are below 2^bits, multi-threaded, stable.
 #pragma once
 
 #include <cstddef>
