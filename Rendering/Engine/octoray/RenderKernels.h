@@ -505,83 +505,87 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
   return false;
 }
 
-// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+// A pixel's primary ray, with its start in double (for window depths) and
+// the level of detail along it.
+struct CameraRay
+{
+  Ray ray;
+  double tBase; // where the ray entered the root cube, from the near plane
+  Vec3d origin, direction;
+  LevelOfDetail lod;
+
+  // Window depth of the point at distance t along the ray.
+  OCTORAY_HD float DepthAt(const FrameConstants& f, float t) const
+  {
+    return WindowDepth(f, origin + double(t) * direction);
+  }
+};
+
+// A volume blend mode: what the ray collects through every voxel it meets.
+OCTORAY_HD void BlendPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
+  float& depth)
+{
+  BlendVisitor blend;
+  blend.f = &f;
+  blend.tree = &tree;
+  Traverse(tree, pixel.ray, pixel.lod, blend);
+  if (!blend.any)
+  {
+    return;
+  }
+  if (f.blend == BlendMode::Composite)
+  {
+    for (int k = 0; k < 4; ++k)
+    {
+      rgba[k] = blend.rgba[k];
+    }
+  }
+  else
+  {
+    float v = blend.value;
+    if (f.blend == BlendMode::Average)
+    {
+      v = blend.length > 0.0f ? blend.value / blend.length : 0.0f;
+    }
+    const Rgba c = ProjectedColor(f, v);
+    rgba[0] = c.r * c.a, rgba[1] = c.g * c.a, rgba[2] = c.b * c.a, rgba[3] = c.a;
+  }
+  depth = pixel.DepthAt(f, blend.firstT);
+}
+
+// A surface, first hit only.
 template <typename F>
-OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+OCTORAY_HD void FirstHitPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
   float& depth, std::size_t& secondaryRays)
 {
-  rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
-  depth = 1.0f;
-  Ray ray;
-  double tBase;
-  Vec3d origin, direction;
-  if (!PrimaryRay(f, x, y, ray, tBase, origin, direction))
+  FirstHitVisitor first;
+  Traverse(tree, pixel.ray, pixel.lod, first);
+  if (first.found)
   {
-    return;
+    const float tHit = first.hit.tEnter > pixel.ray.tMin ? first.hit.tEnter : pixel.ray.tMin;
+    depth = pixel.DepthAt(f, tHit);
+    const float tFromNear = static_cast<float>(pixel.tBase) + tHit;
+    const Vec3f rgb = ShadeSurface<F>(f, tree, pixel.ray, first.hit, tFromNear, pixel.lod, secondaryRays);
+    rgba[0] = rgb.x, rgba[1] = rgb.y, rgba[2] = rgb.z, rgba[3] = 1.0f;
   }
-  LevelOfDetail lod;
-  lod.pixels = f.lodPixels;
-  lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(tBase);
-  lod.footprintSlope = f.footprintSlope;
+}
 
-  if constexpr (F::kVolume)
-  {
-    BlendVisitor blend;
-    blend.f = &f;
-    blend.tree = &tree;
-    Traverse(tree, ray, lod, blend);
-    if (!blend.any)
-    {
-      return;
-    }
-    Rgba c;
-    if (f.blend == BlendMode::Composite)
-    {
-      for (int k = 0; k < 4; ++k)
-      {
-        rgba[k] = blend.rgba[k];
-      }
-    }
-    else
-    {
-      float v = blend.value;
-      if (f.blend == BlendMode::Average)
-      {
-        v = blend.length > 0.0f ? blend.value / blend.length : 0.0f;
-      }
-      c = ProjectedColor(f, v);
-      rgba[0] = c.r * c.a, rgba[1] = c.g * c.a, rgba[2] = c.b * c.a, rgba[3] = c.a;
-    }
-    depth = WindowDepth(f, origin + double(blend.firstT) * direction);
-    return;
-  }
-
-  if constexpr (!F::kSecondary)
-  {
-    // Surface, first hit only.
-    FirstHitVisitor first;
-    Traverse(tree, ray, lod, first);
-    if (first.found)
-    {
-      const float tHit = first.hit.tEnter > ray.tMin ? first.hit.tEnter : ray.tMin;
-      depth = WindowDepth(f, origin + double(tHit) * direction);
-      const Vec3f rgb = ShadeSurface<F>(f, tree, ray, first.hit, static_cast<float>(tBase) + tHit, lod, secondaryRays);
-      rgba[0] = rgb.x, rgba[1] = rgb.y, rgba[2] = rgb.z, rgba[3] = 1.0f;
-    }
-    return;
-  }
-  // Surface: the first voxel, then the mirror and refracted rays it spawns,
-  // each carrying its weight in the pixel, until the bounce limit.
+// A surface: the first voxel, then the mirror and refracted rays it spawns,
+// each carrying its weight in the pixel, until the bounce limit.
+template <typename F>
+OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
   PendingRay pending[kMaxPendingRays];
   int top = 0;
-  pending[top++] = PendingRay{ ray, Vec3f{ 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(tBase) };
+  pending[top++] = PendingRay{ pixel.ray, Vec3f{ 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(pixel.tBase) };
   bool primary = true;
   Vec3f color{ 0.0f, 0.0f, 0.0f };
   while (top > 0)
   {
     const PendingRay path = pending[--top];
     FirstHitVisitor first;
-    Traverse(tree, path.ray, lod, first);
+    Traverse(tree, path.ray, pixel.lod, first);
     if (!first.found)
     {
       primary = false;
@@ -591,11 +595,11 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     const float tHit = hit.tEnter > path.ray.tMin ? hit.tEnter : path.ray.tMin;
     if (primary)
     {
-      depth = WindowDepth(f, origin + double(tHit) * direction);
+      depth = pixel.DepthAt(f, tHit);
       rgba[3] = 1.0f;
       primary = false;
     }
-    const Vec3f rgb = ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, lod, secondaryRays);
+    const Vec3f rgb = ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, pixel.lod, secondaryRays);
     const bool canBounce = path.bounces < f.maxBounces;
     const float reflectivity = Clamp01(canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f);
     const float ior = canBounce && tree.refraction ? tree.refraction[hit.node] : 0.0f;
@@ -632,6 +636,35 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     }
   }
   rgba[0] = color.x, rgba[1] = color.y, rgba[2] = color.z;
+}
+
+// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+template <typename F>
+OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
+  rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
+  depth = 1.0f;
+  CameraRay pixel;
+  if (!PrimaryRay(f, x, y, pixel.ray, pixel.tBase, pixel.origin, pixel.direction))
+  {
+    return;
+  }
+  pixel.lod.pixels = f.lodPixels;
+  pixel.lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(pixel.tBase);
+  pixel.lod.footprintSlope = f.footprintSlope;
+  if constexpr (F::kVolume)
+  {
+    BlendPixel(f, tree, pixel, rgba, depth);
+  }
+  else if constexpr (F::kSecondary)
+  {
+    TracedPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
+  }
+  else
+  {
+    FirstHitPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
+  }
 }
 
 template <typename Fn>
