@@ -356,20 +356,13 @@ TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
     gpu->CopyToHost(b);
     ExpectSameOctree(b, a, true);
   };
+  // Every point twice (with other attributes), so that moving a copy onto
+  // another point's place empties no leaf and creates none: the in-place path.
   Cloud c = GaussianClusters(30000, 25);
-  // Every point twice, so that moving a copy onto another point's place
-  // empties no leaf and creates none: the in-place path.
   const std::size_t n = c.Size();
-  for (std::size_t i = 0; i < 3 * n; ++i)
-  {
-    c.xyz.push_back(c.xyz[i]);
-  }
-  const Cloud extra = GaussianClusters(n, 26);
-  c.rgb.insert(c.rgb.end(), extra.rgb.begin(), extra.rgb.end());
-  c.scalar.insert(c.scalar.end(), extra.scalar.begin(), extra.scalar.end());
-  c.reflectivity.insert(c.reflectivity.end(), extra.reflectivity.begin(), extra.reflectivity.end());
-  c.refraction.insert(c.refraction.end(), extra.refraction.begin(), extra.refraction.end());
-  c.normal.insert(c.normal.end(), extra.normal.begin(), extra.normal.end());
+  Cloud twins = GaussianClusters(n, 26);
+  twins.xyz = c.xyz;
+  c.Append(twins);
   for (int depth : { 0, 9 })
   {
     BuildOptions options;

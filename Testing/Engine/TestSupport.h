@@ -36,6 +36,17 @@ struct Cloud
     normal.insert(normal.end(), { unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f });
   }
 
+  // Appends the points of `other`, every array.
+  void Append(const Cloud& other)
+  {
+    xyz.insert(xyz.end(), other.xyz.begin(), other.xyz.end());
+    rgb.insert(rgb.end(), other.rgb.begin(), other.rgb.end());
+    scalar.insert(scalar.end(), other.scalar.begin(), other.scalar.end());
+    reflectivity.insert(reflectivity.end(), other.reflectivity.begin(), other.reflectivity.end());
+    refraction.insert(refraction.end(), other.refraction.begin(), other.refraction.end());
+    normal.insert(normal.end(), other.normal.begin(), other.normal.end());
+  }
+
   PointCloudView View() const
   {
     PointCloudView v;
