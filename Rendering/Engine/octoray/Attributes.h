@@ -41,7 +41,8 @@ namespace octoray
   X(scalar, Scalar, float, CopiedInput, "scalars")                                                                   \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
-  X(normal, Normal, Vec3f, UnitNormalInput, "normals")
+  X(normal, Normal, Vec3f, UnitNormalInput, "normals")                                                              \
+  X(age, Age, float, CopiedInput, "ages")
 
 struct CopiedInput;
 struct ColorInput;
