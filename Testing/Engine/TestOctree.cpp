@@ -211,8 +211,8 @@ TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
   }
   const std::vector<std::string> expected = { "node keys", "node child masks", "node first children", "node parents",
     "node point counts", "node colours", "node scalars", "node reflectivities", "node refraction indices",
-    "node normals", "node ages", "point positions", "point colours", "point scalars", "point reflectivities",
-    "point refraction indices", "point normals", "point ages", "point keys", "sort buffers" };
+    "node normals", "point positions", "point colours", "point scalars", "point reflectivities",
+    "point refraction indices", "point normals", "point keys", "sort buffers" };
   EXPECT_EQ(labels, expected);
 }
 

@@ -19,7 +19,7 @@ struct Cloud
 {
   std::vector<double> xyz;
   std::vector<std::uint8_t> rgb;
-  std::vector<float> scalar, reflectivity, refraction, normal, age;
+  std::vector<float> scalar, reflectivity, refraction, normal;
 
   std::size_t Size() const { return xyz.size() / 3; }
 
@@ -34,7 +34,6 @@ struct Cloud
     reflectivity.push_back(unit(rng));
     refraction.push_back(unit(rng) < 0.5f ? 0.0f : 1.0f + unit(rng));
     normal.insert(normal.end(), { unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f });
-    age.push_back(unit(rng));
   }
 
   // Appends the points of `other`, every array.
@@ -46,7 +45,6 @@ struct Cloud
     reflectivity.insert(reflectivity.end(), other.reflectivity.begin(), other.reflectivity.end());
     refraction.insert(refraction.end(), other.refraction.begin(), other.refraction.end());
     normal.insert(normal.end(), other.normal.begin(), other.normal.end());
-    age.insert(age.end(), other.age.begin(), other.age.end());
   }
 
   PointCloudView View() const
@@ -60,7 +58,6 @@ struct Cloud
     v.reflectivity = reflectivity.data();
     v.refraction = refraction.data();
     v.normal = normal.data();
-    v.age = age.data();
     return v;
   }
 };

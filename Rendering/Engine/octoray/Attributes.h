@@ -41,8 +41,7 @@ namespace octoray
   X(scalar, Scalar, float, CopiedInput, "scalars")                                                                   \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
-  X(normal, Normal, Vec3f, UnitNormalInput, "normals")                                                              \
-  X(age, Age, float, CopiedInput, "ages")
+  X(normal, Normal, Vec3f, UnitNormalInput, "normals")
 
 struct CopiedInput;
 struct ColorInput;

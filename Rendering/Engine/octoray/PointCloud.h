@@ -43,7 +43,6 @@ struct PointCloudView
   const float* reflectivity = nullptr; // 0..1, the weight of the mirror ray
   const float* refraction = nullptr;   // index of refraction; 0 = opaque
   const float* normal = nullptr;       // 3 values per point, need not be unit length
-  const float* age = nullptr;
 
   // AttributeBits of the attributes given.
   unsigned Attributes() const;
