@@ -19,7 +19,23 @@ namespace
 {
 // Sizes on both sides of the thresholds where loops start splitting.
 const std::size_t kSizes[] = { 0, 1, 5, kParallelForMinItems + 3, kParallelPassMinItems + 17 };
-const int kThreads[] = { 1, 2, 3 };
+
+// check(n, device) for every size on devices of 1, 2 and 3 threads: the
+// results must not depend on how the work is split.
+template <typename Check>
+void OnEverySplit(Check&& check)
+{
+  for (std::size_t n : kSizes)
+  {
+    for (int threads : { 1, 2, 3 })
+    {
+      SCOPED_TRACE("n " + std::to_string(n) + ", threads " + std::to_string(threads));
+      CpuDevice d;
+      d.threads = threads;
+      check(n, d);
+    }
+  }
+}
 
 std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint64_t seed)
 {
@@ -35,73 +51,59 @@ std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint64_t see
 
 TEST(CpuDevice, ForEachReduceAndHistogramCoverEveryItemOnce)
 {
-  for (std::size_t n : kSizes)
-  {
-    for (int threads : kThreads)
+  OnEverySplit([](std::size_t n, CpuDevice& d) {
+    std::vector<int> seen(n, 0);
+    int* out = seen.data();
+    d.ForEach("test", n, OCTORAY_LAMBDA(std::size_t i) { out[i] += 1; });
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+
+    const std::uint64_t sum = d.Reduce(
+      n, std::uint64_t(0), OCTORAY_LAMBDA(std::size_t i) { return std::uint64_t(i * i); },
+      OCTORAY_LAMBDA(std::uint64_t a, std::uint64_t b) { return a + b; });
+    std::uint64_t expected = 0;
+    for (std::size_t i = 0; i < n; ++i)
     {
-      SCOPED_TRACE("n " + std::to_string(n) + ", threads " + std::to_string(threads));
-      CpuDevice d;
-      d.threads = threads;
-      std::vector<int> seen(n, 0);
-      int* out = seen.data();
-      d.ForEach("test", n, OCTORAY_LAMBDA(std::size_t i) { out[i] += 1; });
-      EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+      expected += i * i;
+    }
+    EXPECT_EQ(sum, expected);
 
-      const std::uint64_t sum = d.Reduce(
-        n, std::uint64_t(0), OCTORAY_LAMBDA(std::size_t i) { return std::uint64_t(i * i); },
-        OCTORAY_LAMBDA(std::uint64_t a, std::uint64_t b) { return a + b; });
-      std::uint64_t expected = 0;
-      for (std::size_t i = 0; i < n; ++i)
+    std::uint64_t counts[7] = { 5, 0, 0, 0, 0, 0, 0 }; // added to, not replaced
+    d.Histogram<7>("test", n, OCTORAY_LAMBDA(std::size_t i) {
+      return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
+    }, counts);
+    std::uint64_t reference[7] = { 5, 0, 0, 0, 0, 0, 0 };
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      ++reference[i % 3];
+      if (i % 2 == 0)
       {
-        expected += i * i;
-      }
-      EXPECT_EQ(sum, expected);
-
-      std::uint64_t counts[7] = { 5, 0, 0, 0, 0, 0, 0 }; // added to, not replaced
-      d.Histogram<7>("test", n, OCTORAY_LAMBDA(std::size_t i) {
-        return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
-      }, counts);
-      std::uint64_t reference[7] = { 5, 0, 0, 0, 0, 0, 0 };
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        ++reference[i % 3];
-        if (i % 2 == 0)
-        {
-          ++reference[3 + i % 4];
-        }
-      }
-      for (int b = 0; b < 7; ++b)
-      {
-        EXPECT_EQ(counts[b], reference[b]) << "bin " << b;
+        ++reference[3 + i % 4];
       }
     }
-  }
+    for (int b = 0; b < 7; ++b)
+    {
+      EXPECT_EQ(counts[b], reference[b]) << "bin " << b;
+    }
+  });
 }
 
 TEST(CpuDevice, SelectKeepsOrderAndCounts)
 {
-  for (std::size_t n : kSizes)
-  {
-    for (int threads : kThreads)
+  OnEverySplit([](std::size_t n, CpuDevice& d) {
+    std::vector<std::uint32_t> out(n + 1, 0xDEADBEEFu);
+    std::uint64_t count = 12345;
+    d.Select(n, OCTORAY_LAMBDA(std::size_t i) { return (i * 7919) % 5 < 2; }, out.data(), &count);
+    std::vector<std::uint32_t> expected;
+    for (std::size_t i = 0; i < n; ++i)
     {
-      SCOPED_TRACE("n " + std::to_string(n) + ", threads " + std::to_string(threads));
-      CpuDevice d;
-      d.threads = threads;
-      std::vector<std::uint32_t> out(n + 1, 0xDEADBEEFu);
-      std::uint64_t count = 12345;
-      d.Select(n, OCTORAY_LAMBDA(std::size_t i) { return (i * 7919) % 5 < 2; }, out.data(), &count);
-      std::vector<std::uint32_t> expected;
-      for (std::size_t i = 0; i < n; ++i)
+      if ((i * 7919) % 5 < 2)
       {
-        if ((i * 7919) % 5 < 2)
-        {
-          expected.push_back(static_cast<std::uint32_t>(i));
-        }
+        expected.push_back(static_cast<std::uint32_t>(i));
       }
-      ASSERT_EQ(count, expected.size());
-      EXPECT_TRUE(std::equal(expected.begin(), expected.end(), out.begin()));
     }
-  }
+    ASSERT_EQ(count, expected.size());
+    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), out.begin()));
+  });
 }
 
 // Stable, for both key widths and keys below 2^bits (the passes cover
@@ -109,36 +111,29 @@ TEST(CpuDevice, SelectKeepsOrderAndCounts)
 template <typename Key>
 void ExpectStableSort(int bits)
 {
-  for (std::size_t n : kSizes)
-  {
-    for (int threads : kThreads)
+  SCOPED_TRACE("bits " + std::to_string(bits));
+  OnEverySplit([bits](std::size_t n, CpuDevice& d) {
+    const std::vector<std::uint64_t> random = RandomKeys(n, bits, n + d.threads);
+    std::vector<Key> k0(random.begin(), random.end()), k1(n);
+    std::vector<std::uint32_t> v0(n), v1(n);
+    std::iota(v0.begin(), v0.end(), 0u);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> reference;
+    for (std::size_t i = 0; i < n; ++i)
     {
-      SCOPED_TRACE("n " + std::to_string(n) + ", threads " + std::to_string(threads) + ", bits " +
-        std::to_string(bits));
-      CpuDevice d;
-      d.threads = threads;
-      const std::vector<std::uint64_t> random = RandomKeys(n, bits, n + threads);
-      std::vector<Key> k0(random.begin(), random.end()), k1(n);
-      std::vector<std::uint32_t> v0(n), v1(n);
-      std::iota(v0.begin(), v0.end(), 0u);
-      std::vector<std::pair<std::uint64_t, std::uint32_t>> reference;
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        reference.emplace_back(k0[i], static_cast<std::uint32_t>(i));
-      }
-      std::stable_sort(reference.begin(), reference.end(),
-        [](const auto& a, const auto& b) { return a.first < b.first; });
-      Key* keys[2] = { k0.data(), k1.data() };
-      std::uint32_t* values[2] = { v0.data(), v1.data() };
-      const int result = d.SortPairs(keys, values, n, bits, "test");
-      ASSERT_TRUE(result == 0 || result == 1);
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        ASSERT_EQ(values[result][i], reference[i].second) << "position " << i;
-        ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
-      }
+      reference.emplace_back(k0[i], static_cast<std::uint32_t>(i));
     }
-  }
+    std::stable_sort(reference.begin(), reference.end(),
+      [](const auto& a, const auto& b) { return a.first < b.first; });
+    Key* keys[2] = { k0.data(), k1.data() };
+    std::uint32_t* values[2] = { v0.data(), v1.data() };
+    const int result = d.SortPairs(keys, values, n, bits, "test");
+    ASSERT_TRUE(result == 0 || result == 1);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      ASSERT_EQ(values[result][i], reference[i].second) << "position " << i;
+      ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
+    }
+  });
 }
 
 TEST(CpuDevice, SortPairsIsStable)

@@ -112,6 +112,14 @@ enum TopologyIndex : int
 #undef OCTORAY_ENUMERATE
 };
 
+// Of(arrays): the member of that name in any structure declared from these lists.
+#define OCTORAY_ARRAY_OF(member)                                                                                      \
+  template <typename Arrays>                                                                                         \
+  OCTORAY_HD static auto& Of(Arrays& arrays)                                                                         \
+  {                                                                                                                  \
+    return arrays.member;                                                                                            \
+  }
+
 #define OCTORAY_DESCRIBE_TOPOLOGY(member, Name, Type_, label)                                                        \
   template <>                                                                                                        \
   struct TopologyArray<kTopology##Name>                                                                              \
@@ -119,11 +127,7 @@ enum TopologyIndex : int
     using Type = Type_;                                                                                              \
     static constexpr unsigned kBit = 0;                                                                              \
     static constexpr const char* kLabel = label;                                                                     \
-    template <typename Arrays>                                                                                       \
-    OCTORAY_HD static auto& Of(Arrays& arrays)                                                                       \
-    {                                                                                                                \
-      return arrays.member;                                                                                          \
-    }                                                                                                                \
+    OCTORAY_ARRAY_OF(member)                                                                                         \
   };
 OCTORAY_NODE_TOPOLOGY(OCTORAY_DESCRIBE_TOPOLOGY)
 #undef OCTORAY_DESCRIBE_TOPOLOGY
@@ -137,14 +141,11 @@ OCTORAY_NODE_TOPOLOGY(OCTORAY_DESCRIBE_TOPOLOGY)
     static constexpr unsigned kBit = kHas##Name;                                                                     \
     static constexpr int kSlot = kSlot##Name;                                                                        \
     static constexpr const char* kLabel = label;                                                                     \
-    template <typename Arrays>                                                                                       \
-    OCTORAY_HD static auto& Of(Arrays& arrays)                                                                       \
-    {                                                                                                                \
-      return arrays.member;                                                                                          \
-    }                                                                                                                \
+    OCTORAY_ARRAY_OF(member)                                                                                         \
   };
 OCTORAY_ATTRIBUTES(OCTORAY_DESCRIBE_ATTRIBUTE)
 #undef OCTORAY_DESCRIBE_ATTRIBUTE
+#undef OCTORAY_ARRAY_OF
 
 // fn(descriptor) for each attribute, in the list's order. Also called from
 // host-only code with host-only functions: nvcc is told not to check those

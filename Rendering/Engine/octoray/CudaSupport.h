@@ -1,5 +1,5 @@
-// Checked CUDA calls and device buffers that count against a memory budget.
-// Only compiled by nvcc (CudaEngine.cu and the CUDA renderer).
+// Checked CUDA calls, named kernel launches, and device buffers that count
+// against a memory budget. Only compiled by nvcc (CudaDevice.h, CudaEngine.cu).
 #pragma once
 
 #include "FaultInjection.h"

@@ -5,7 +5,6 @@
 
 #include "Attributes.h"
 #include "Config.h"
-#include "RootCube.h"
 
 #include <cmath>
 
