@@ -14,6 +14,15 @@
 #define OCTORAY_DEVICE_CODE 0
 #endif
 
+// The traversal's innermost steps: inlined on the host as every OCTORAY_HD
+// function is on the device; GCC's heuristics would otherwise call them
+// once per child box.
+#if defined(__CUDACC__)
+#define OCTORAY_HD_INLINE OCTORAY_HD
+#else
+#define OCTORAY_HD_INLINE inline __attribute__((always_inline))
+#endif
+
 // The body of a loop that a backend runs per element (Device::ForEach and
 // the other primitives of OctreeDriver.h), as pbrt-v4's PBRT_CPU_GPU_LAMBDA:
 // it captures by value, because under nvcc it is copied to the GPU (an

@@ -44,7 +44,7 @@ OCTORAY_HD void SetDirection(Ray& ray, const Vec3f& d)
 // Entry and exit of the ray through the box [lo, lo + size); the axis of the
 // entry face (-1 if the ray starts inside on every axis). False on a miss,
 // and when any value is NaN.
-OCTORAY_HD bool IntersectBox(const Ray& ray, const Vec3f& lo, float size, float& tEnter, float& tExit, int& axis)
+OCTORAY_HD_INLINE bool IntersectBox(const Ray& ray, const Vec3f& lo, float size, float& tEnter, float& tExit, int& axis)
 {
   tEnter = -INFINITY;
   tExit = INFINITY;

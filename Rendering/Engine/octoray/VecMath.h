@@ -13,6 +13,7 @@
 #include "Config.h"
 
 #include <cmath>
+#include <type_traits>
 
 namespace octoray
 {
@@ -21,21 +22,11 @@ struct Vec3
 {
   T x, y, z;
 
-  // Written as branches, not (&x)[a], so that reading a component never
-  // takes the vector's address.
-  OCTORAY_HD T operator[](int a) const { return a == 0 ? x : (a == 1 ? y : z); }
-  OCTORAY_HD T& operator[](int a)
-  {
-    if (a == 0)
-    {
-      return x;
-    }
-    if (a == 1)
-    {
-      return y;
-    }
-    return z;
-  }
+  // The components as the array they are laid out as (checked below), as
+  // the loops over axes indexed their arrays: the same code on both
+  // compilers (branches on `a` kept GCC from inlining the slab test).
+  OCTORAY_HD T operator[](int a) const { return (&x)[a]; }
+  OCTORAY_HD T& operator[](int a) { return (&x)[a]; }
 
   // The scalar operands are of T, not deduced, so a float scalar scales a
   // Vec3d in double as the scalar code did (float * double is double).
@@ -55,6 +46,8 @@ struct Vec3
 
 using Vec3f = Vec3<float>;
 using Vec3d = Vec3<double>;
+static_assert(std::is_standard_layout<Vec3f>::value && sizeof(Vec3f) == 3 * sizeof(float), "x, y, z as an array");
+static_assert(std::is_standard_layout<Vec3d>::value && sizeof(Vec3d) == 3 * sizeof(double), "x, y, z as an array");
 
 template <typename T>
 OCTORAY_HD T Dot(const Vec3<T>& a, const Vec3<T>& b)
