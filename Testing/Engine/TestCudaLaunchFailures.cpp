@@ -77,12 +77,7 @@ std::vector<float> Picture(Engine& engine)
 Cloud Doubled(const Cloud& c)
 {
   Cloud d = c;
-  d.xyz.insert(d.xyz.end(), c.xyz.begin(), c.xyz.end());
-  d.rgb.insert(d.rgb.end(), c.rgb.begin(), c.rgb.end());
-  d.scalar.insert(d.scalar.end(), c.scalar.begin(), c.scalar.end());
-  d.reflectivity.insert(d.reflectivity.end(), c.reflectivity.begin(), c.reflectivity.end());
-  d.refraction.insert(d.refraction.end(), c.refraction.begin(), c.refraction.end());
-  d.normal.insert(d.normal.end(), c.normal.begin(), c.normal.end());
+  d.Append(c);
   return d;
 }
 

@@ -165,6 +165,57 @@ TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
   EXPECT_LT(m.Total(), ((1ull << 33) - 1) / 7 * 8 / 100);
 }
 
+// With a fixed root cube, a point outside it is refused before anything is
+// replaced, by name and with its coordinates as given, on every backend.
+TEST_P(OctreeBuild, APointOutsideAFixedCubeIsNamed)
+{
+  Cloud c = UniformCloud(1000, 23, 0.1, 0.9);
+  BuildOptions options;
+  options.depth = 5;
+  options.fixedCube = true;
+  options.cube.size = 1.0;
+  engine->Build(c.View(), options);
+  HostOctree before;
+  engine->CopyToHost(before);
+
+  c.xyz[3 * 700] = 1.5;
+  c.xyz[3 * 700 + 1] = 0.25;
+  c.xyz[3 * 700 + 2] = -0.5;
+  c.xyz[3 * 900 + 2] = 2.0;
+  try
+  {
+    engine->Build(c.View(), options);
+    FAIL() << "no error for a point outside the fixed cube";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_STREQ(e.what(), "octoray: point 700 (1.5, 0.25, -0.5) lies outside the root cube");
+  }
+  HostOctree after;
+  engine->CopyToHost(after);
+  ExpectSameOctree(after, before, true);
+}
+
+// The memory report's labels, which the benchmark report reads: one line
+// per array the engine holds, in this order.
+TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
+{
+  const Cloud c = UniformCloud(5000, 24);
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(c.View(), options);
+  std::vector<std::string> labels;
+  for (const auto& a : engine->Memory().arrays)
+  {
+    labels.push_back(a.first);
+  }
+  const std::vector<std::string> expected = { "node keys", "node child masks", "node first children", "node parents",
+    "node point counts", "node colours", "node scalars", "node reflectivities", "node refraction indices",
+    "node normals", "point positions", "point colours", "point scalars", "point reflectivities",
+    "point refraction indices", "point normals", "point keys", "sort buffers" };
+  EXPECT_EQ(labels, expected);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, OctreeBuild, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
 
 // Out of device memory: a clear error naming what did not fit, the previous
@@ -284,4 +335,66 @@ TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
   }
   EXPECT_GT(failures, 5); // several allocation sites were hit on the way
   EXPECT_EQ(successes, 1);
+}
+
+// The CUDA octree equals the CPU one bit for bit, after a build (fixed and
+// automatic depth) and after each update path: both run the same steps in
+// the same order (OctreeDriver.h), and CUDA rounds like the CPU.
+TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
+{
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    GTEST_SKIP() << "CUDA backend not usable here: " << why;
+  }
+  auto cpu = CreateEngine(Backend::CPU);
+  auto gpu = CreateEngine(Backend::CUDA);
+  auto expectSame = [&](const char* what) {
+    SCOPED_TRACE(what);
+    HostOctree a, b;
+    cpu->CopyToHost(a);
+    gpu->CopyToHost(b);
+    ExpectSameOctree(b, a, true);
+  };
+  // Every point twice (with other attributes), so that moving a copy onto
+  // another point's place empties no leaf and creates none: the in-place path.
+  Cloud c = GaussianClusters(30000, 25);
+  const std::size_t n = c.Size();
+  Cloud twins = GaussianClusters(n, 26);
+  twins.xyz = c.xyz;
+  c.Append(twins);
+  for (int depth : { 0, 9 })
+  {
+    BuildOptions options;
+    options.depth = depth;
+    cpu->Build(c.View(), options);
+    gpu->Build(c.View(), options);
+    expectSame(depth ? "build at depth 9" : "build at an automatic depth");
+  }
+
+  auto update = [&](const std::vector<std::uint32_t>& indices, const std::vector<double>& to,
+                  UpdateStats::Path path, const char* what) {
+    PositionsView moved;
+    moved.count = indices.size();
+    moved.indices = indices.data();
+    moved.xyzDouble = to.data();
+    EXPECT_EQ(cpu->Update(moved).path, path) << what;
+    EXPECT_EQ(gpu->Update(moved).path, path) << what;
+    expectSame(what);
+  };
+  std::vector<std::uint32_t> indices;
+  std::vector<double> to;
+  for (std::uint32_t k = 0; k < 500; ++k)
+  {
+    indices.push_back(static_cast<std::uint32_t>(n) + k * 37);
+    const std::size_t target = (k * 53 + 11) % n;
+    to.insert(to.end(), c.xyz.begin() + 3 * target, c.xyz.begin() + 3 * target + 3);
+  }
+  update(indices, to, UpdateStats::Path::InPlace, "in-place update");
+  for (double& v : to)
+  {
+    v *= 0.5;
+  }
+  update(indices, to, UpdateStats::Path::Relevel, "re-sorting update");
+  update({ 3 }, { 100.0, -100.0, 3.0 }, UpdateStats::Path::NewCube, "update to a new cube");
 }

@@ -36,6 +36,17 @@ struct Cloud
     normal.insert(normal.end(), { unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f });
   }
 
+  // Appends the points of `other`, every array.
+  void Append(const Cloud& other)
+  {
+    xyz.insert(xyz.end(), other.xyz.begin(), other.xyz.end());
+    rgb.insert(rgb.end(), other.rgb.begin(), other.rgb.end());
+    scalar.insert(scalar.end(), other.scalar.begin(), other.scalar.end());
+    reflectivity.insert(reflectivity.end(), other.reflectivity.begin(), other.reflectivity.end());
+    refraction.insert(refraction.end(), other.refraction.begin(), other.refraction.end());
+    normal.insert(normal.end(), other.normal.begin(), other.normal.end());
+  }
+
   PointCloudView View() const
   {
     PointCloudView v;
@@ -227,6 +238,47 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
       ++n;
     }
   }
+}
+
+// Two octrees with the same topology and the same means: exactly (two
+// backends' builds of the same points), or within float rounding (means an
+// update adjusted by deltas against fresh ones: scalars, which span 100,
+// within 2e-4, every other slot within 1e-5). Every node array of
+// Attributes.h is compared.
+inline void ExpectSameOctree(const HostOctree& a, const HostOctree& b, bool exact = false)
+{
+  ASSERT_EQ(a.depth, b.depth);
+  ASSERT_EQ(a.levelBegin, b.levelBegin);
+  ASSERT_EQ(a.attributes, b.attributes);
+  ForEachNodeArray([&](auto array) {
+    using A = decltype(array);
+    const auto& x = A::Of(a);
+    const auto& y = A::Of(b);
+    if (::testing::Test::HasFatalFailure())
+    {
+      return;
+    }
+    ASSERT_EQ(x.size(), y.size()) << "node " << A::kLabel;
+    if constexpr (A::kBit == 0)
+    {
+      ASSERT_EQ(x, y) << "node " << A::kLabel;
+    }
+    else
+    {
+      using Value = AttributeValue<typename A::Type>;
+      for (std::size_t n = 0; n < x.size(); ++n)
+      {
+        float u[Value::kSlots], v[Value::kSlots];
+        Value::ToSlots(x[n], u);
+        Value::ToSlots(y[n], v);
+        for (int k = 0; k < Value::kSlots; ++k)
+        {
+          const float tol = exact ? 0.0f : (A::kSlot + k == kSlotScalar ? 2e-4f : 1e-5f);
+          ASSERT_NEAR(u[k], v[k], tol) << "node " << A::kLabel << " slot " << k << " of node " << n;
+        }
+      }
+    }
+  });
 }
 
 // Builds c at `depth` (0: automatic) and checks the octree and the build

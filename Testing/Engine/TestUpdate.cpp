@@ -9,34 +9,6 @@ using OctreeUpdate = BackendTest;
 
 namespace
 {
-void ExpectSameOctree(const HostOctree& a, const HostOctree& b)
-{
-  ASSERT_EQ(a.depth, b.depth);
-  ASSERT_EQ(a.levelBegin, b.levelBegin);
-  ASSERT_EQ(a.key, b.key);
-  ASSERT_EQ(a.childMask, b.childMask);
-  ASSERT_EQ(a.firstChild, b.firstChild);
-  ASSERT_EQ(a.parent, b.parent);
-  ASSERT_EQ(a.pointCount, b.pointCount);
-  ASSERT_EQ(a.color.size(), b.color.size());
-  // Means adjusted by deltas differ from fresh ones by float rounding only.
-  for (std::size_t n = 0; n < a.color.size(); ++n)
-  {
-    ASSERT_NEAR(a.color[n].r, b.color[n].r, 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.color[n].g, b.color[n].g, 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.color[n].b, b.color[n].b, 1e-5f) << "node " << n;
-  }
-  for (std::size_t n = 0; n < a.scalar.size(); ++n)
-  {
-    ASSERT_NEAR(a.scalar[n], b.scalar[n], 2e-4f) << "node " << n;
-    ASSERT_NEAR(a.reflectivity[n], b.reflectivity[n], 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.refraction[n], b.refraction[n], 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.normal[n].x, b.normal[n].x, 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.normal[n].y, b.normal[n].y, 1e-5f) << "node " << n;
-    ASSERT_NEAR(a.normal[n].z, b.normal[n].z, 1e-5f) << "node " << n;
-  }
-}
-
 struct Fixture
 {
   Cloud cloud;

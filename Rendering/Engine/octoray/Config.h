@@ -14,6 +14,25 @@
 #define OCTORAY_DEVICE_CODE 0
 #endif
 
+// The traversal's innermost steps: inlined on the host as every OCTORAY_HD
+// function is on the device; GCC's heuristics would otherwise call them
+// once per child box.
+#if defined(__CUDACC__)
+#define OCTORAY_HD_INLINE OCTORAY_HD
+#else
+#define OCTORAY_HD_INLINE inline __attribute__((always_inline))
+#endif
+
+// The body of a loop that a backend runs per element (Device::ForEach and
+// the other primitives of OctreeDriver.h), as pbrt-v4's PBRT_CPU_GPU_LAMBDA:
+// it captures by value, because under nvcc it is copied to the GPU (an
+// extended lambda: the CUDA build passes --extended-lambda).
+#if defined(__CUDACC__)
+#define OCTORAY_LAMBDA(...) [=] __host__ __device__(__VA_ARGS__)
+#else
+#define OCTORAY_LAMBDA(...) [=](__VA_ARGS__)
+#endif
+
 namespace octoray
 {
 // Deepest level of the octree: 21 bits per axis fill a 63-bit Morton key.

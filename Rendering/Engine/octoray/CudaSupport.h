@@ -1,5 +1,5 @@
-// Checked CUDA calls and device buffers that count against a memory budget.
-// Only compiled by nvcc (CudaEngine.cu and the CUDA renderer).
+// Checked CUDA calls, named kernel launches, and device buffers that count
+// against a memory budget. Only compiled by nvcc (CudaDevice.h, CudaEngine.cu).
 #pragma once
 
 #include "FaultInjection.h"
@@ -37,14 +37,15 @@ inline dim3 LaunchGrid(const char* kernel, dim3 grid)
   return TakeInjectedLaunchFailure(kernel) ? dim3(0, 1, 1) : grid;
 }
 
-// Launches a (non-template) kernel and checks the launch, so that every
-// failure names the kernel it came from.
-#define OCTORAY_LAUNCH(kernel, grid, block, ...)                                                                       \
-  do                                                                                                                   \
-  {                                                                                                                    \
-    kernel<<<::octoray::LaunchGrid(#kernel, grid), block>>>(__VA_ARGS__);                                              \
-    ::octoray::CudaCheckLaunch(#kernel);                                                                               \
-  } while (0)
+// Every kernel launch of the engine: under the name that its failure
+// reports and that a test can refuse (the name of a __global__ function, or
+// of the loop CudaDevice::ForEach runs), checked at once.
+template <typename... Parameters, typename... Arguments>
+void Launch(const char* name, void (*kernel)(Parameters...), dim3 grid, dim3 block, Arguments&&... arguments)
+{
+  kernel<<<LaunchGrid(name, grid), block>>>(std::forward<Arguments>(arguments)...);
+  CudaCheckLaunch(name);
+}
 
 // Makes an engine's device current for the scope of one of its calls and
 // restores the caller's afterwards, so that engines on different devices

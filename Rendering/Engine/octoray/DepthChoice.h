@@ -29,38 +29,51 @@ OCTORAY_HD int SharedLevels(std::uint64_t a, std::uint64_t b)
   return kMaxLevel - 1 - highest / 3;
 }
 
-// Histogram bins for sorted key i of n: `newNodeBin` (0..21) is the level
-// shared with the previous key, -1 for i == 0 (not counted); `aloneBin`
-// (-1..21) the deeper of the levels shared with either neighbour.
-OCTORAY_HD void DepthHistogramBins(const std::uint64_t* sortedKeys, std::size_t n, std::size_t i, int& newNodeBin,
-  int& aloneBin)
+constexpr int kDepthHistogramBins = kMaxLevel + 2; // levels -1..21
+
+// Up to two histogram entries of one item; -1: none.
+struct BinPair
 {
-  const int withPrev = i > 0 ? SharedLevels(sortedKeys[i - 1], sortedKeys[i]) : -1;
-  const int withNext = i + 1 < n ? SharedLevels(sortedKeys[i], sortedKeys[i + 1]) : -1;
-  newNodeBin = withPrev;
-  aloneBin = withPrev > withNext ? withPrev : withNext;
+  int first, second;
+};
+
+// Where sorted key i of n counts in the two histograms, newNode (entries
+// 0..kDepthHistogramBins-1) and alone (the next kDepthHistogramBins):
+// newNode's bin is the level shared with the previous key (not counted for
+// i == 0), alone's the deeper of the levels shared with either neighbour
+// (-1 when there is none). Bin b is entry b + 1. Keys are full-depth after
+// << toFull (leaf keys of a fixed depth are shifted up).
+OCTORAY_HD BinPair DepthHistogramEntries(const std::uint64_t* sortedKeys, std::size_t n, std::size_t i, int toFull)
+{
+  const std::uint64_t key = sortedKeys[i] << toFull;
+  const int withPrev = i > 0 ? SharedLevels(sortedKeys[i - 1] << toFull, key) : -1;
+  const int withNext = i + 1 < n ? SharedLevels(key, sortedKeys[i + 1] << toFull) : -1;
+  return BinPair{ i > 0 ? withPrev + 1 : -1, kDepthHistogramBins + (withPrev > withNext ? withPrev : withNext) + 1 };
 }
 
-constexpr int kDepthHistogramBins = kMaxLevel + 2; // levels -1..21
+// Nodes at `level` (0..21) from the newNode histogram: the first key starts
+// one, and so does every key that shares fewer than `level` levels with its
+// predecessor.
+inline std::uint64_t NodesAtLevel(const std::uint64_t newNode[kDepthHistogramBins], int level)
+{
+  std::uint64_t nodes = 1;
+  for (int b = 0; b < level; ++b)
+  {
+    nodes += newNode[b + 1];
+  }
+  return nodes;
+}
 
 // newNode[b + 1] and alone[b + 1] count keys per bin b in -1..21.
 inline int ChooseDepthFromHistograms(const std::uint64_t newNode[kDepthHistogramBins],
   const std::uint64_t alone[kDepthHistogramBins])
 {
-  auto distinctAt = [&](int level) {
-    std::uint64_t d = 1; // the first key
-    for (int b = 0; b < level; ++b)
-    {
-      d += newNode[b + 1];
-    }
-    return d;
-  };
-  const std::uint64_t distinctAtMax = distinctAt(kMaxLevel);
+  const std::uint64_t distinctAtMax = NodesAtLevel(newNode, kMaxLevel);
   std::uint64_t singletons = alone[0]; // bin -1: a lone point
   for (int level = 1; level <= kMaxLevel; ++level)
   {
     singletons += alone[level]; // bin level-1
-    const std::uint64_t distinct = distinctAt(level);
+    const std::uint64_t distinct = NodesAtLevel(newNode, level);
     if (2 * singletons >= distinct || distinct == distinctAtMax)
     {
       return level;

@@ -1,6 +1,8 @@
 // The engine: one octree built from points on one backend. Both backends
-// run the same per-point and per-node functions (OctreeKernels.h); they
-// differ only in where memory lives and how loops are launched.
+// run the same build and update (OctreeDriver.h, over CpuDevice.h or
+// CudaDevice.h) and the same per-point, per-node and per-pixel functions
+// (OctreeKernels.h, RenderKernels.h); they differ only in where memory
+// lives and how loops are launched.
 #pragma once
 
 #include "Octree.h"

@@ -78,15 +78,12 @@ void Multiply(const double a[16], const double b[16], double out[16])
     }
   }
 }
-
-double Distance(const double a[3], const double b[3])
-{
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-}
 }
 
-FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool secondaryRays)
+FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
 {
+  const RootCube& cube = tree.cube;
+  const bool secondaryRays = tree.reflectivity != nullptr || tree.refraction != nullptr;
   if (s.width <= 0 || s.height <= 0)
   {
     throw Error("octoray: the viewport must be at least 1x1, got " + std::to_string(s.width) + "x" +
@@ -139,19 +136,12 @@ FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool sec
   {
     const Light& l = s.lights[i];
     UnitLight& u = f.lights[i];
+    const Vec3d position{ l.position[0], l.position[1], l.position[2] };
+    const Vec3d origin{ cube.origin[0], cube.origin[1], cube.origin[2] };
+    const double len = Length(position);
     u.directional = l.position[3] == 0.0;
-    double len = 0.0;
-    for (int a = 0; a < 3; ++a)
-    {
-      len += l.position[a] * l.position[a];
-    }
-    len = std::sqrt(len);
-    for (int a = 0; a < 3; ++a)
-    {
-      u.position[a] = static_cast<float>(u.directional ? l.position[a] / (len > 0 ? len : 1.0)
-                                                       : (l.position[a] - cube.origin[a]) / cube.size);
-      u.color[a] = l.color[a] * l.intensity;
-    }
+    u.position = ToFloat(u.directional ? position / (len > 0 ? len : 1.0) : (position - origin) / cube.size);
+    u.color = Vec3f{ l.color[0], l.color[1], l.color[2] } * l.intensity;
   }
 
   // Pixel footprint at the near and far planes through the image centre,
@@ -159,14 +149,13 @@ FrameConstants MakeFrame(const RenderSettings& s, const RootCube& cube, bool sec
   const int cx = s.width / 2, cy = s.height / 2;
   auto ndcX = [&](int x) { return 2.0 * (x + 0.5) / s.width - 1.0; };
   auto ndcY = [&](int y) { return 2.0 * (y + 0.5) / s.height - 1.0; };
-  double n0[3], n1[3], f0[3], f1[3];
-  Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), -1.0, n0);
-  Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), -1.0, n1);
-  Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), 1.0, f0);
-  Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), 1.0, f1);
-  const double length = Distance(n0, f0);
-  f.footprint0 = static_cast<float>(Distance(n0, n1));
-  f.footprintSlope = static_cast<float>((Distance(f0, f1) - Distance(n0, n1)) / (length > 0 ? length : 1.0));
+  const Vec3d n0 = Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), -1.0);
+  const Vec3d n1 = Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), -1.0);
+  const Vec3d f0 = Unproject(f.unitFromNdc, ndcX(cx), ndcY(cy), 1.0);
+  const Vec3d f1 = Unproject(f.unitFromNdc, ndcX(cx + 1), ndcY(cy), 1.0);
+  const double length = Length(n0 - f0);
+  f.footprint0 = static_cast<float>(Length(n0 - n1));
+  f.footprintSlope = static_cast<float>((Length(f0 - f1) - Length(n0 - n1)) / (length > 0 ? length : 1.0));
   double nearest = INFINITY, farthest = 0.0;
   for (int corner = 0; corner < 8; ++corner)
   {

@@ -11,9 +11,9 @@ namespace octoray
 // singular camera matrix, a depth buffer of the wrong size, too many lights).
 // Table and depth-buffer pointers are the host vectors of `settings`; a
 // device backend replaces them with device copies.
-// `secondaryRays`: whether any node reflects or refracts; without, the
-// frame casts no mirror or refracted rays whatever the bounce limit.
-FrameConstants MakeFrame(const RenderSettings& settings, const RootCube& cube, bool secondaryRays);
+// A tree whose nodes neither reflect nor refract gets a frame that casts no
+// mirror or refracted rays, whatever the bounce limit.
+FrameConstants MakeFrame(const RenderSettings& settings, const OctreeView& tree);
 
 // Inverse of a row-major 4x4 matrix; false when it is singular.
 bool Invert4x4(const double m[16], double inverse[16]);

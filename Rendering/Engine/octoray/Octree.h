@@ -5,6 +5,7 @@
 // topology arrays).
 #pragma once
 
+#include "Attributes.h"
 #include "Config.h"
 #include "Morton.h"
 #include "RootCube.h"
@@ -38,17 +39,10 @@ struct OctreeView
   std::uint32_t levelBegin[kMaxLevel + 2] = {};  // nodes of level l: [levelBegin[l], levelBegin[l+1])
   unsigned attributes = 0;                       // AttributeBits present
   RootCube cube;
-
-  std::uint64_t* key = nullptr;        // level-local key: 3*level bits
-  std::uint8_t* childMask = nullptr;   // bit o set: child in octant o exists
-  std::uint32_t* firstChild = nullptr; // global index of the first child; kInvalidIndex for leaves
-  std::uint32_t* parent = nullptr;     // kInvalidIndex for the root
-  std::uint32_t* pointCount = nullptr;
-  Rgba* color = nullptr;               // averaged colour
-  float* scalar = nullptr;
-  float* reflectivity = nullptr;
-  float* refraction = nullptr;
-  Vec3f* normal = nullptr;             // averaged, normalised; zero where normals cancel
+#define OCTORAY_POINTER(member, Name, Type, ...) Type* member = nullptr;
+  OCTORAY_NODE_TOPOLOGY(OCTORAY_POINTER)
+  OCTORAY_ATTRIBUTES(OCTORAY_POINTER)
+#undef OCTORAY_POINTER
 
   OCTORAY_HD std::uint32_t LevelSize(int level) const
   {
@@ -76,23 +70,58 @@ struct OctreeView
   }
 };
 
-// The octree in host memory (what tests and the VTK layer inspect).
-struct HostOctree
+// The first element of a vector or buffer (HostBuffer, DeviceBuffer), or
+// null where it holds none: what views point at.
+template <typename T>
+T* DataOrNull(std::vector<T>& v)
+{
+  return v.empty() ? nullptr : v.data();
+}
+template <typename T>
+const T* DataOrNull(const std::vector<T>& v)
+{
+  return v.empty() ? nullptr : v.data();
+}
+template <typename Buffer>
+auto DataOrNull(const Buffer& b) -> decltype(b.Get())
+{
+  return b.Empty() ? nullptr : b.Get();
+}
+
+// A view of node arrays (NodeArrays of any buffer) with the layout of an
+// octree of `depth` and those levels.
+template <typename Arrays>
+OctreeView MakeOctreeView(Arrays& arrays, int depth, const std::uint32_t* levelBegin, std::size_t levels,
+  unsigned attributes, const RootCube& cube)
+{
+  OctreeView v;
+  v.depth = depth;
+  for (std::size_t l = 0; l < levels && l < kMaxLevel + 2; ++l)
+  {
+    v.levelBegin[l] = levelBegin[l];
+  }
+  v.attributes = attributes;
+  v.cube = cube;
+  ForEachNodeArray([&](auto a) {
+    using A = decltype(a);
+    A::Of(v) = const_cast<typename A::Type*>(DataOrNull(A::Of(arrays)));
+  });
+  v.nodeCount = v.key ? static_cast<std::uint32_t>(v.levelBegin[depth + 1]) : 0;
+  return v;
+}
+
+template <typename T>
+using HostVector = std::vector<T>;
+
+// The octree in host memory (what tests and the VTK layer inspect): one
+// vector per node array (Attributes.h), named as there: key, childMask,
+// firstChild, parent, pointCount, color, scalar, ...
+struct HostOctree : NodeArrays<HostVector>
 {
   int depth = 0;
   std::vector<std::uint32_t> levelBegin;
   unsigned attributes = 0;
   RootCube cube;
-  std::vector<std::uint64_t> key;
-  std::vector<std::uint8_t> childMask;
-  std::vector<std::uint32_t> firstChild;
-  std::vector<std::uint32_t> parent;
-  std::vector<std::uint32_t> pointCount;
-  std::vector<Rgba> color;
-  std::vector<float> scalar;
-  std::vector<float> reflectivity;
-  std::vector<float> refraction;
-  std::vector<Vec3f> normal;
 
   std::size_t NodeCount() const { return key.size(); }
   // Resizes every array for `nodes` nodes (attribute arrays only if present).

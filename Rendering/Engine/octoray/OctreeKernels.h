@@ -1,79 +1,105 @@
 // Per-point and per-node steps of the octree build and update, written once
-// for both backends: the CPU backend calls them inside a parallel-for, the
-// CUDA backend from __global__ kernels. Every node attribute is the plain
-// mean over the points beneath it, so an inner node's value is the
-// count-weighted mean of its children's and updates can adjust it by deltas.
+// for both backends: the driver (OctreeDriver.h) runs them inside the loops
+// of a device, which are threads on the CPU and kernels on CUDA. Every node
+// attribute is the plain mean over the points beneath it, so an inner node's
+// value is the count-weighted mean of its children's and updates can adjust
+// it by deltas.
 #pragma once
 
 #include "Octree.h"
 #include "PointArrays.h"
 
+#include <limits>
+
 namespace octoray
 {
+// What a search for the first failing index finds when nothing fails.
+constexpr std::uint64_t kNoIndex = ~std::uint64_t(0);
+
+// Loops run their iterations concurrently on both backends; results that
+// iterations share go through these.
+OCTORAY_HD void AtomicMin(std::uint64_t* target, std::uint64_t value)
+{
+#if defined(__CUDA_ARCH__)
+  static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit atomics");
+  atomicMin(reinterpret_cast<unsigned long long*>(target), static_cast<unsigned long long>(value));
+#else
+  std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+  while (value < seen && !__atomic_compare_exchange_n(target, &seen, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+  {
+  }
+#endif
+}
+
+OCTORAY_HD void AtomicRaise(std::uint64_t* flag)
+{
+#if defined(__CUDA_ARCH__)
+  *reinterpret_cast<volatile unsigned long long*>(flag) = 1ull;
+#else
+  __atomic_store_n(flag, std::uint64_t(1), __ATOMIC_RELAXED);
+#endif
+}
+
+// Bounds of positions, and the first non-finite one (kNoIndex: none).
+struct Bounds
+{
+  Vec3d lo, hi;
+  std::uint64_t firstBad;
+};
+
+OCTORAY_HD Bounds EmptyBounds()
+{
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  return Bounds{ Vec3d{ inf, inf, inf }, Vec3d{ -inf, -inf, -inf }, kNoIndex };
+}
+
+OCTORAY_HD Bounds PointBounds(const PointArraysView& pts, std::size_t i)
+{
+  const Vec3d p = pts.Position(i);
+  if (!IsFinitePoint(p))
+  {
+    Bounds b = EmptyBounds();
+    b.firstBad = i;
+    return b;
+  }
+  return Bounds{ p, p, kNoIndex };
+}
+
+OCTORAY_HD Bounds MergeBounds(const Bounds& x, const Bounds& y)
+{
+  return Bounds{ Min(x.lo, y.lo), Max(x.hi, y.hi), x.firstBad < y.firstBad ? x.firstBad : y.firstBad };
+}
+
 // Reads a node's attribute vector (present attributes only).
 OCTORAY_HD void LoadNodeAttributes(const OctreeView& t, std::uint32_t n, float v[kSlotCount])
 {
-  if (t.color)
-  {
-    v[kSlotR] = t.color[n].r;
-    v[kSlotG] = t.color[n].g;
-    v[kSlotB] = t.color[n].b;
-    v[kSlotA] = t.color[n].a;
-  }
-  if (t.scalar)
-  {
-    v[kSlotScalar] = t.scalar[n];
-  }
-  if (t.reflectivity)
-  {
-    v[kSlotReflectivity] = t.reflectivity[n];
-  }
-  if (t.refraction)
-  {
-    v[kSlotRefraction] = t.refraction[n];
-  }
-  if (t.normal)
-  {
-    v[kSlotNx] = t.normal[n].x;
-    v[kSlotNy] = t.normal[n].y;
-    v[kSlotNz] = t.normal[n].z;
-  }
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    if (A::Of(t))
+    {
+      AttributeValue<typename A::Type>::ToSlots(A::Of(t)[n], v + A::kSlot);
+    }
+  });
 }
 
 // Writes sum / count into the node's present attributes.
 OCTORAY_HD void StoreNodeMeans(const OctreeView& t, std::uint32_t n, const double sum[kSlotCount], double count)
 {
   const double inv = count > 0.0 ? 1.0 / count : 0.0;
-  if (t.color)
-  {
-    t.color[n] = Rgba{ static_cast<float>(sum[kSlotR] * inv), static_cast<float>(sum[kSlotG] * inv),
-      static_cast<float>(sum[kSlotB] * inv), static_cast<float>(sum[kSlotA] * inv) };
-  }
-  if (t.scalar)
-  {
-    t.scalar[n] = static_cast<float>(sum[kSlotScalar] * inv);
-  }
-  if (t.reflectivity)
-  {
-    t.reflectivity[n] = static_cast<float>(sum[kSlotReflectivity] * inv);
-  }
-  if (t.refraction)
-  {
-    t.refraction[n] = static_cast<float>(sum[kSlotRefraction] * inv);
-  }
-  if (t.normal)
-  {
-    t.normal[n] = Vec3f{ static_cast<float>(sum[kSlotNx] * inv), static_cast<float>(sum[kSlotNy] * inv),
-      static_cast<float>(sum[kSlotNz] * inv) };
-  }
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    if (A::Of(t))
+    {
+      A::Of(t)[n] = AttributeValue<typename A::Type>::Mean(sum + A::kSlot, inv);
+    }
+  });
 }
 
 // Point i's full-depth key; false if it is not finite or lies outside the cube.
 OCTORAY_HD bool ComputePointKey(const PointArraysView& pts, const RootCube& cube, std::size_t i, std::uint64_t& key)
 {
-  double p[3];
-  pts.Position(i, p);
-  return cube.FullKey(p[0], p[1], p[2], key);
+  const Vec3d p = pts.Position(i);
+  return cube.FullKey(p.x, p.y, p.z, key);
 }
 
 // Leaf `node` holds the sorted points [begin, end): key, topology and means.
@@ -108,6 +134,10 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
 {
   t.key[node] = levelKey;
   t.firstChild[node] = c0;
+  if (node == 0)
+  {
+    t.parent[0] = kInvalidIndex; // the root: no node links it as a child
+  }
   unsigned mask = 0;
   std::uint32_t count = 0;
   double sum[kSlotCount] = {};
@@ -135,28 +165,81 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   }
 }
 
-// In-place update: node n gains dCount points whose attributes add up to
-// dSum (negative for points that left). False if the node would be emptied,
-// which changes the topology and needs the re-sort path instead.
-OCTORAY_HD bool ApplyNodeDelta(const OctreeView& t, std::uint32_t n, long long dCount, const double dSum[kSlotCount])
+// In-place update: a point that changed leaf leaves every node on its old
+// leaf's path to the root and joins every node on its new leaf's. Records
+// (node, 2 * point + joins), depth + 1 per path, the old path first, stored
+// from `first` on; grouped by node (a stable sort) they give each touched
+// node's changes in a fixed order. False, with records that name no node,
+// when the new leaf does not exist: the topology changes.
+OCTORAY_HD bool WritePathRecords(const OctreeView& t, std::uint32_t point, std::uint64_t fromLeaf,
+  std::uint64_t toLeaf, std::size_t first, std::uint32_t* recordNode, std::uint32_t* recordPoint)
 {
-  const long long count = static_cast<long long>(t.pointCount[n]) + dCount;
-  if (count <= 0)
+  const std::size_t pathLength = static_cast<std::size_t>(t.depth) + 1;
+  bool found = true;
+  for (int joins = 0; joins < 2; ++joins)
   {
-    return false;
+    std::uint32_t node = t.Find(t.depth, joins ? toLeaf : fromLeaf);
+    found = found && node != kInvalidIndex;
+    const std::size_t base = first + joins * pathLength;
+    for (std::size_t step = 0; step < pathLength; ++step)
+    {
+      recordNode[base + step] = node;
+      recordPoint[base + step] = 2u * point + static_cast<std::uint32_t>(joins);
+      node = node == kInvalidIndex ? kInvalidIndex : t.parent[node];
+    }
   }
+  return found;
+}
+
+// The net change in point count of the node of the sorted records [begin, end).
+OCTORAY_HD long long RecordedCountChange(const std::uint32_t* recordPoint, std::uint32_t begin, std::uint32_t end)
+{
+  long long dCount = 0;
+  for (std::uint32_t j = begin; j < end; ++j)
+  {
+    dCount += (recordPoint[j] & 1u) ? 1 : -1;
+  }
+  return dCount;
+}
+
+// Whether the node of the records [begin, end) would be emptied (which
+// changes the topology and needs the re-sort path instead).
+OCTORAY_HD bool WouldEmpty(const OctreeView& t, const std::uint32_t* recordNode, const std::uint32_t* recordPoint,
+  std::uint32_t begin, std::uint32_t end)
+{
+  const std::uint32_t n = recordNode[begin];
+  return n != kInvalidIndex &&
+    static_cast<long long>(t.pointCount[n]) + RecordedCountChange(recordPoint, begin, end) <= 0;
+}
+
+// Adjusts the count and means of the node of the records [begin, end) by the
+// points that left and joined it.
+OCTORAY_HD void ApplyRecords(const OctreeView& t, const PointArraysView& pts, const std::uint32_t* recordNode,
+  const std::uint32_t* recordPoint, std::uint32_t begin, std::uint32_t end)
+{
+  const std::uint32_t n = recordNode[begin];
+  const long long count = static_cast<long long>(t.pointCount[n]) + RecordedCountChange(recordPoint, begin, end);
   if (t.attributes)
   {
+    double sum[kSlotCount] = {};
     float v[kSlotCount] = {};
-    LoadNodeAttributes(t, n, v);
-    double sum[kSlotCount];
-    for (int k = 0; k < kSlotCount; ++k)
+    for (std::uint32_t j = begin; j < end; ++j)
     {
-      sum[k] = static_cast<double>(v[k]) * t.pointCount[n] + dSum[k];
+      const bool joins = recordPoint[j] & 1u;
+      pts.Attributes(recordPoint[j] >> 1, v);
+      for (int s = 0; s < kSlotCount; ++s)
+      {
+        sum[s] += joins ? v[s] : -v[s];
+      }
+    }
+    float mean[kSlotCount] = {};
+    LoadNodeAttributes(t, n, mean);
+    for (int s = 0; s < kSlotCount; ++s)
+    {
+      sum[s] = static_cast<double>(mean[s]) * t.pointCount[n] + sum[s];
     }
     StoreNodeMeans(t, n, sum, static_cast<double>(count));
   }
   t.pointCount[n] = static_cast<std::uint32_t>(count);
-  return true;
 }
 }

@@ -11,6 +11,14 @@
 
 namespace octoray
 {
+// A loop of fewer items runs on the calling thread: starting a thread costs
+// about 20 us, more than such a loop.
+constexpr std::size_t kParallelForMinItems = 4096;
+// A pass that keeps a partial result per thread (a radix histogram, a count
+// of selected items) splits only above this: each thread's partial result
+// costs its own setup and merge.
+constexpr std::size_t kParallelPassMinItems = 65536;
+
 inline int DefaultThreadCount()
 {
   const unsigned n = std::thread::hardware_concurrency();
@@ -66,8 +74,7 @@ void ParallelChunks(std::size_t n, int chunks, Fn&& fn)
 template <typename Fn>
 void ParallelFor(std::size_t n, int threads, Fn&& fn)
 {
-  // Small loops are not worth a thread start (~20 us each).
-  if (n < 4096)
+  if (n < kParallelForMinItems)
   {
     threads = 1;
   }

@@ -3,49 +3,44 @@
 // full-depth Morton key. Kept so that updates and rebuilds need no input.
 #pragma once
 
+#include "Attributes.h"
 #include "Config.h"
-#include "RootCube.h"
-#include "Types.h"
 
 #include <cmath>
 
 namespace octoray
 {
-// Slots of the attribute vector every node averages. Only the slots of
-// attributes present in the input are read or written.
-enum AttributeSlot : int
+// The point arrays a backend holds, each a Buffer<its type>.
+template <template <typename> class Buffer>
+struct PointArrays
 {
-  kSlotR = 0,
-  kSlotG,
-  kSlotB,
-  kSlotA,
-  kSlotScalar,
-  kSlotReflectivity,
-  kSlotRefraction,
-  kSlotNx,
-  kSlotNy,
-  kSlotNz,
-  kSlotCount
+  Buffer<float> xyzFloat; // exactly one of the two, 3 values per point
+  Buffer<double> xyzDouble;
+  // Colours given as 8-bit stay 8-bit (RGBA, a quarter of float RGBA's
+  // bytes); the attribute `color` holds those given as float.
+  Buffer<std::uint8_t> color8;
+#define OCTORAY_MEMBER(member, Name, Type, ...) Buffer<Type> member;
+  OCTORAY_ATTRIBUTES(OCTORAY_MEMBER)
+#undef OCTORAY_MEMBER
+  Buffer<std::uint64_t> key; // full-depth key of each point
 };
 
+// Plain pointers into PointArrays (or into a caller's positions): null
+// where an array is absent.
 struct PointArraysView
 {
   std::size_t count = 0;
   const float* xyzFloat = nullptr;
   const double* xyzDouble = nullptr;
   const std::uint8_t* color8 = nullptr; // RGBA, 4 bytes a point
-  const Rgba* colorFloat = nullptr;
-  const float* scalar = nullptr;
-  const float* reflectivity = nullptr;
-  const float* refraction = nullptr;
-  const Vec3f* normal = nullptr;        // unit length, or zero where the input's was zero
+#define OCTORAY_POINTER(member, Name, Type, ...) const Type* member = nullptr;
+  OCTORAY_ATTRIBUTES(OCTORAY_POINTER)
+#undef OCTORAY_POINTER
 
-  OCTORAY_HD void Position(std::size_t i, double p[3]) const
+  OCTORAY_HD Vec3d Position(std::size_t i) const
   {
-    for (int a = 0; a < 3; ++a)
-    {
-      p[a] = xyzDouble ? xyzDouble[3 * i + a] : static_cast<double>(xyzFloat[3 * i + a]);
-    }
+    return xyzDouble ? Vec3d{ xyzDouble[3 * i], xyzDouble[3 * i + 1], xyzDouble[3 * i + 2] }
+                     : Vec3d{ xyzFloat[3 * i], xyzFloat[3 * i + 1], xyzFloat[3 * i + 2] };
   }
 
   // The point's attribute vector (slots of absent attributes are left alone).
@@ -55,42 +50,23 @@ struct PointArraysView
     {
       for (int c = 0; c < 4; ++c)
       {
-        v[kSlotR + c] = color8[4 * i + c] * (1.0f / 255.0f);
+        v[kSlotColor + c] = color8[4 * i + c] * (1.0f / 255.0f);
       }
     }
-    else if (colorFloat)
-    {
-      const Rgba c = colorFloat[i];
-      v[kSlotR] = c.r;
-      v[kSlotG] = c.g;
-      v[kSlotB] = c.b;
-      v[kSlotA] = c.a;
-    }
-    if (scalar)
-    {
-      v[kSlotScalar] = scalar[i];
-    }
-    if (reflectivity)
-    {
-      v[kSlotReflectivity] = reflectivity[i];
-    }
-    if (refraction)
-    {
-      v[kSlotRefraction] = refraction[i];
-    }
-    if (normal)
-    {
-      v[kSlotNx] = normal[i].x;
-      v[kSlotNy] = normal[i].y;
-      v[kSlotNz] = normal[i].z;
-    }
+    ForEachAttribute([&](auto a) {
+      using A = decltype(a);
+      if (A::Of(*this))
+      {
+        AttributeValue<typename A::Type>::ToSlots(A::Of(*this)[i], v + A::kSlot);
+      }
+    });
   }
 };
 
 // True when all three coordinates are finite.
-OCTORAY_HD bool IsFinitePoint(const double p[3])
+OCTORAY_HD bool IsFinitePoint(const Vec3d& p)
 {
-  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
 }
 
 // Unit normal of a caller's normal; zero stays zero (it carries no direction).

@@ -2,10 +2,31 @@
 // the caller's arrays (nothing is copied until Build).
 #pragma once
 
-#include "Types.h"
+#include "Attributes.h"
 
 namespace octoray
 {
+struct PointCloudView;
+
+// How an attribute (Attributes.h) arrives in a PointCloudView: whether a
+// cloud has it. How each becomes the engine's copy: OctreeDriver.h.
+struct CopiedInput // one value per point, in the member of the attribute's name
+{
+  template <typename A>
+  static bool Present(const PointCloudView& points)
+  {
+    return A::Of(points) != nullptr;
+  }
+};
+struct UnitNormalInput : CopiedInput // 3 floats per point, of any length
+{
+};
+struct ColorInput // color8 or colorFloat, of colorComponents each
+{
+  template <typename A>
+  static bool Present(const PointCloudView& points);
+};
+
 struct PointCloudView
 {
   std::size_t count = 0;
@@ -23,22 +44,31 @@ struct PointCloudView
   const float* refraction = nullptr;   // index of refraction; 0 = opaque
   const float* normal = nullptr;       // 3 values per point, need not be unit length
 
-  unsigned Attributes() const
-  {
-    unsigned bits = 0;
-    bits |= (color8 || colorFloat) ? kHasColor : 0u;
-    bits |= scalar ? kHasScalar : 0u;
-    bits |= reflectivity ? kHasReflectivity : 0u;
-    bits |= refraction ? kHasRefraction : 0u;
-    bits |= normal ? kHasNormal : 0u;
-    return bits;
-  }
+  // AttributeBits of the attributes given.
+  unsigned Attributes() const;
 
   double Coordinate(std::size_t i, int axis) const
   {
     return xyzDouble ? xyzDouble[3 * i + axis] : static_cast<double>(xyzFloat[3 * i + axis]);
   }
+  Vec3d Position(std::size_t i) const { return Vec3d{ Coordinate(i, 0), Coordinate(i, 1), Coordinate(i, 2) }; }
 };
+
+template <typename A>
+bool ColorInput::Present(const PointCloudView& points)
+{
+  return points.color8 != nullptr || points.colorFloat != nullptr;
+}
+
+inline unsigned PointCloudView::Attributes() const
+{
+  unsigned bits = 0;
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    bits |= A::Input::template Present<A>(*this) ? A::kBit : 0u;
+  });
+  return bits;
+}
 
 // New positions for an update: for all points (indices == nullptr, count ==
 // the octree's point count) or for the points listed in indices.
@@ -48,5 +78,12 @@ struct PositionsView
   const float* xyzFloat = nullptr;
   const double* xyzDouble = nullptr;
   const std::uint32_t* indices = nullptr;
+
+  // The new position of the k-th point given.
+  Vec3d Position(std::size_t k) const
+  {
+    return xyzDouble ? Vec3d{ xyzDouble[3 * k], xyzDouble[3 * k + 1], xyzDouble[3 * k + 2] }
+                     : Vec3d{ xyzFloat[3 * k], xyzFloat[3 * k + 1], xyzFloat[3 * k + 2] };
+  }
 };
 }

@@ -34,22 +34,15 @@ struct QuantisationError
   std::size_t points = 0;
 };
 
-inline double PointCoordinate(const PointCloudView& points, std::size_t i, int axis)
-{
-  return points.xyzDouble ? points.xyzDouble[3 * i + axis] : double(points.xyzFloat[3 * i + axis]);
-}
-
 // The centre of the voxel of `levelKey` (a level-local Morton key) at
 // `level`, in data coordinates.
-inline void VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey, double centre[3])
+inline Vec3d VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey)
 {
   std::uint32_t cell[3];
   DecodeMorton(levelKey, cell[0], cell[1], cell[2]);
   const double side = cube.size / std::ldexp(1.0, level);
-  for (int a = 0; a < 3; ++a)
-  {
-    centre[a] = cube.origin[a] + (cell[a] + 0.5) * side;
-  }
+  const Vec3d origin{ cube.origin[0], cube.origin[1], cube.origin[2] };
+  return origin + Vec3d{ cell[0] + 0.5, cell[1] + 0.5, cell[2] + 0.5 } * side;
 }
 
 // The leaf of point i, found by walking the tree from the root; its node
@@ -57,8 +50,8 @@ inline void VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey,
 inline std::uint32_t LeafOf(const HostOctree& tree, const PointCloudView& points, std::size_t i)
 {
   std::uint64_t full = 0;
-  if (!tree.cube.FullKey(PointCoordinate(points, i, 0), PointCoordinate(points, i, 1), PointCoordinate(points, i, 2),
-        full))
+  const Vec3d p = points.Position(i);
+  if (!tree.cube.FullKey(p.x, p.y, p.z, full))
   {
     throw std::runtime_error("point " + std::to_string(i) + " lies outside the engine's root cube");
   }
@@ -89,15 +82,7 @@ inline QuantisationError MeasureQuantisation(const HostOctree& tree, const Point
   for (std::size_t i = 0; i < points.count; ++i)
   {
     const std::uint32_t leaf = LeafOf(tree, points, i);
-    double centre[3];
-    VoxelCentre(tree.cube, tree.depth, tree.key[leaf], centre);
-    double d2 = 0.0;
-    for (int a = 0; a < 3; ++a)
-    {
-      const double d = PointCoordinate(points, i, a) - centre[a];
-      d2 += d * d;
-    }
-    const double d = std::sqrt(d2);
+    const double d = Length(points.Position(i) - VoxelCentre(tree.cube, tree.depth, tree.key[leaf]));
     q.max = std::max(q.max, d);
     sum += d;
   }

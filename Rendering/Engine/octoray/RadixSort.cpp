@@ -3,17 +3,18 @@
 #include "Parallel.h"
 
 #include <algorithm>
-#include <cstring>
 #include <utility>
+#include <vector>
 
 namespace octoray
 {
-void RadixSortPairs(std::uint64_t* keys, std::uint32_t* values, std::size_t n, int bits, int threads,
-  std::vector<std::uint64_t>& scratchKeys, std::vector<std::uint32_t>& scratchValues)
+template <typename Key>
+int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, int threads, Key* scratchKeys,
+  std::uint32_t* scratchValues)
 {
   if (n < 2 || bits <= 0)
   {
-    return;
+    return 0;
   }
   // 11-bit digits keep a pass's histogram (2048 counters per thread) in L1
   // while needing only 6 passes for 63-bit keys; the digit width is evened
@@ -23,14 +24,12 @@ void RadixSortPairs(std::uint64_t* keys, std::uint32_t* values, std::size_t n, i
   const std::size_t buckets = std::size_t(1) << digitBits;
   const std::uint64_t digitMask = buckets - 1;
 
-  scratchKeys.resize(n);
-  scratchValues.resize(n);
-  std::uint64_t* srcK = keys;
+  Key* srcK = keys;
   std::uint32_t* srcV = values;
-  std::uint64_t* dstK = scratchKeys.data();
-  std::uint32_t* dstV = scratchValues.data();
+  Key* dstK = scratchKeys;
+  std::uint32_t* dstV = scratchValues;
 
-  const int chunks = n < 65536 ? 1 : threads;
+  const int chunks = n < kParallelPassMinItems ? 1 : threads;
   std::vector<std::size_t> histogram(static_cast<std::size_t>(chunks) * buckets);
 
   for (int pass = 0; pass < passes; ++pass)
@@ -89,10 +88,11 @@ void RadixSortPairs(std::uint64_t* keys, std::uint32_t* values, std::size_t n, i
     std::swap(srcK, dstK);
     std::swap(srcV, dstV);
   }
-  if (srcK != keys)
-  {
-    std::memcpy(keys, srcK, n * sizeof(std::uint64_t));
-    std::memcpy(values, srcV, n * sizeof(std::uint32_t));
-  }
+  return srcK == keys ? 0 : 1;
 }
+
+template int RadixSortPairs<std::uint64_t>(std::uint64_t*, std::uint32_t*, std::size_t, int, int, std::uint64_t*,
+  std::uint32_t*);
+template int RadixSortPairs<std::uint32_t>(std::uint32_t*, std::uint32_t*, std::size_t, int, int, std::uint32_t*,
+  std::uint32_t*);
 }

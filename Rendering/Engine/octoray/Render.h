@@ -68,8 +68,7 @@ struct RenderSettings
   // read in place instead of depthBuffer. Not for the CPU backend.
   const float* deviceDepthBuffer = nullptr;
   // CUDA: copy the picture to the host Image. Off, it stays in device memory
-  // (CudaEngine::DeviceImageRgba/DeviceImageDepth) for a caller that draws it
-  // from there.
+  // (Engine::LastDeviceImage) for a caller that draws it from there.
   bool copyToHost = true;
   // Colour as float (Image::rgba) or 8-bit (Image::rgba8, a quarter of the
   // bytes to copy and upload): the caller's choice.
@@ -97,11 +96,17 @@ struct DeviceImage
   const float* depth = nullptr;
 };
 
-// A premultiplied channel in [0,1] as a byte, rounded to nearest.
-inline std::uint8_t ChannelToByte(float v)
+// A premultiplied channel in [0,1] as a byte, rounded to nearest; the same
+// byte on host and device (the device's multiply and add are spelled out
+// so that no build can fuse them).
+OCTORAY_HD std::uint8_t ChannelToByte(float v)
 {
-  v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+  v = Clamp01(v);
+#if defined(__CUDA_ARCH__)
+  return static_cast<std::uint8_t>(__fadd_rn(__fmul_rn(v, 255.0f), 0.5f));
+#else
   return static_cast<std::uint8_t>(v * 255.0f + 0.5f);
+#endif
 }
 
 struct RenderStats

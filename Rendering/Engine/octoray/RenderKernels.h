@@ -12,9 +12,9 @@ constexpr int kMaxLights = 8;
 
 struct UnitLight
 {
-  float position[3]; // unit-cube position, or direction towards the light
+  Vec3f position; // unit-cube position, or direction towards the light
   bool directional;
-  float color[3];    // colour x intensity
+  Vec3f color;    // colour x intensity
 };
 
 // Everything a frame's rays share, in the unit cube; passed by value.
@@ -64,58 +64,48 @@ OCTORAY_HD void Transform(const double m[16], const double in[4], double out[4])
   }
 }
 
-OCTORAY_HD void Unproject(const double m[16], double x, double y, double z, double p[3])
+OCTORAY_HD Vec3d Unproject(const double m[16], double x, double y, double z)
 {
   const double ndc[4] = { x, y, z, 1.0 };
   double h[4];
   Transform(m, ndc, h);
-  for (int a = 0; a < 3; ++a)
-  {
-    p[a] = h[a] / h[3];
-  }
+  return Vec3d{ h[0] / h[3], h[1] / h[3], h[2] / h[3] };
 }
 
 // Window depth (OpenGL convention, [0,1]) of a unit-cube point.
-OCTORAY_HD float WindowDepth(const FrameConstants& f, const double p[3])
+OCTORAY_HD float WindowDepth(const FrameConstants& f, const Vec3d& p)
 {
-  const double in[4] = { p[0], p[1], p[2], 1.0 };
+  const double in[4] = { p.x, p.y, p.z, 1.0 };
   double clip[4];
   Transform(f.ndcFromUnit, in, clip);
-  const double z = 0.5 * clip[2] / clip[3] + 0.5;
-  return static_cast<float>(z < 0.0 ? 0.0 : (z > 1.0 ? 1.0 : z));
+  return static_cast<float>(Clamp01(0.5 * clip[2] / clip[3] + 0.5));
 }
 
 // A pixel's primary ray, its origin moved to where it enters the root cube
 // (computed in double). `tBase` is that entry's distance from the near plane.
 // False when the ray misses the cube, or the clipping range or opaque
 // geometry ends it before.
-OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase, double origin[3],
-  double direction[3])
+OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase, Vec3d& origin,
+  Vec3d& direction)
 {
   const double nx = 2.0 * (x + 0.5) / f.width - 1.0;
   const double ny = 2.0 * (y + 0.5) / f.height - 1.0;
-  double nearPoint[3], farPoint[3];
-  Unproject(f.unitFromNdc, nx, ny, -1.0, nearPoint);
-  Unproject(f.unitFromNdc, nx, ny, 1.0, farPoint);
-  double d[3] = { farPoint[0] - nearPoint[0], farPoint[1] - nearPoint[1], farPoint[2] - nearPoint[2] };
-  const double length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  const Vec3d nearPoint = Unproject(f.unitFromNdc, nx, ny, -1.0);
+  const Vec3d farPoint = Unproject(f.unitFromNdc, nx, ny, 1.0);
+  Vec3d d = farPoint - nearPoint;
+  const double length = Length(d);
   if (!(length > 0.0))
   {
     return false;
   }
-  for (int a = 0; a < 3; ++a)
-  {
-    d[a] /= length;
-  }
+  d /= length;
   double tEnd = length;
   if (f.depthBuffer)
   {
     const float w = f.depthBuffer[static_cast<std::size_t>(y) * f.width + x];
     if (w < 1.0f)
     {
-      double opaque[3];
-      Unproject(f.unitFromNdc, nx, ny, 2.0 * w - 1.0, opaque);
-      tEnd = (opaque[0] - nearPoint[0]) * d[0] + (opaque[1] - nearPoint[1]) * d[1] + (opaque[2] - nearPoint[2]) * d[2];
+      tEnd = Dot(Unproject(f.unitFromNdc, nx, ny, 2.0 * w - 1.0) - nearPoint, d);
     }
   }
   // The root cube's slab interval, in double.
@@ -146,14 +136,10 @@ OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, doub
     return false;
   }
   tBase = t0;
-  for (int a = 0; a < 3; ++a)
-  {
-    origin[a] = nearPoint[a] + t0 * d[a];
-    direction[a] = d[a];
-    ray.origin[a] = static_cast<float>(origin[a]);
-  }
-  const float df[3] = { static_cast<float>(d[0]), static_cast<float>(d[1]), static_cast<float>(d[2]) };
-  SetDirection(ray, df);
+  origin = nearPoint + t0 * d;
+  direction = d;
+  ray.origin = ToFloat(origin);
+  SetDirection(ray, ToFloat(d));
   ray.tMin = 0.0f;
   ray.tMax = static_cast<float>(t1 - t0);
   return true;
@@ -192,18 +178,17 @@ OCTORAY_HD float PortablePow(float b, float e)
   return ldexpf(p, static_cast<int>(whole));
 }
 
-OCTORAY_HD float Dot(const float a[3], const float b[3])
+// The transfer function's colour and opacity of a scalar: the range mapped
+// onto the table, rounded to the nearest entry, clamped to the ends.
+OCTORAY_HD Rgba TransferLookup(const FrameConstants& f, float value)
 {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const float u = Clamp01((value - f.transferRange[0]) / (f.transferRange[1] - f.transferRange[0]));
+  return f.transfer[static_cast<int>(u * (f.transferSize - 1) + 0.5f)];
 }
 
-OCTORAY_HD void Normalize(float v[3])
+OCTORAY_HD Vec3f RgbOf(const Rgba& c)
 {
-  const float len = sqrtf(Dot(v, v));
-  if (len > 0.0f)
-  {
-    v[0] /= len, v[1] /= len, v[2] /= len;
-  }
+  return Vec3f{ c.r, c.g, c.b };
 }
 
 // Colour and opacity of a node: through the transfer function when the
@@ -212,15 +197,7 @@ OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::
 {
   if (f.transfer && tree.scalar)
   {
-    const float s = tree.scalar[node];
-    float u = (s - f.transferRange[0]) / (f.transferRange[1] - f.transferRange[0]);
-    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-    if (!(u == u))
-    {
-      u = 0.0f;
-    }
-    int i = static_cast<int>(u * (f.transferSize - 1) + 0.5f);
-    return f.transfer[i];
+    return TransferLookup(f, tree.scalar[node]);
   }
   if (tree.color)
   {
@@ -233,20 +210,16 @@ OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::
 // the data has them; otherwise the occupancy gradient of the six neighbours
 // at the hit's level (it follows the shape, not the voxel's blocky faces);
 // the entry face where the gradient vanishes (e.g. inside a solid block).
-OCTORAY_HD void SurfaceNormal(const OctreeView& tree, const Ray& ray, const NodeHit& hit, float n[3])
+OCTORAY_HD Vec3f SurfaceNormal(const OctreeView& tree, const Ray& ray, const NodeHit& hit)
 {
-  n[0] = n[1] = n[2] = 0.0f;
-  if (tree.normal)
-  {
-    const Vec3f v = tree.normal[hit.node];
-    n[0] = v.x, n[1] = v.y, n[2] = v.z;
-  }
+  Vec3f n = tree.normal ? tree.normal[hit.node] : Vec3f{ 0.0f, 0.0f, 0.0f };
   if (Dot(n, n) < 1e-6f)
   {
-    n[0] = n[1] = n[2] = 0.0f;
+    const float half = 0.5f * hit.size;
+    const Vec3f centre = hit.lo + Vec3f{ half, half, half };
     for (int a = 0; a < 3; ++a)
     {
-      float p[3] = { hit.lo[0] + 0.5f * hit.size, hit.lo[1] + 0.5f * hit.size, hit.lo[2] + 0.5f * hit.size };
+      Vec3f p = centre;
       p[a] -= hit.size;
       const float below = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
       p[a] += 2.0f * hit.size;
@@ -256,76 +229,60 @@ OCTORAY_HD void SurfaceNormal(const OctreeView& tree, const Ray& ray, const Node
   }
   if (Dot(n, n) < 1e-6f)
   {
-    n[0] = n[1] = n[2] = 0.0f;
+    n = Vec3f{ 0.0f, 0.0f, 0.0f };
     const int axis = hit.axis >= 0 ? hit.axis : 2;
     n[axis] = ray.direction[axis] > 0.0f ? -1.0f : 1.0f;
   }
-  Normalize(n);
-  if (Dot(n, ray.direction) > 0.0f)
-  {
-    n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
-  }
+  n = Normalize(n);
+  return Dot(n, ray.direction) > 0.0f ? -n : n;
 }
 
 // The point where the ray enters the hit voxel, nudged back out of it along
 // the entry face so that secondary rays do not start inside the voxel.
-OCTORAY_HD void EntryPoint(const Ray& ray, const NodeHit& hit, float p[3])
+OCTORAY_HD Vec3f EntryPoint(const Ray& ray, const NodeHit& hit)
 {
   const float t = hit.tEnter > ray.tMin ? hit.tEnter : ray.tMin;
-  for (int a = 0; a < 3; ++a)
-  {
-    p[a] = ray.origin[a] + t * ray.direction[a];
-  }
+  Vec3f p = ray.origin + t * ray.direction;
   if (hit.axis >= 0)
   {
     p[hit.axis] += (ray.direction[hit.axis] > 0.0f ? -1.0f : 1.0f) * 1e-3f * hit.size;
   }
+  return p;
 }
 
-// Lit colour of a surface hit (before reflection).
+// Lit colour of a surface hit (before reflection): depth cue, or Phong
+// (ambient + diffuse + specular) from every light that sees the hit.
 template <typename F>
-OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit,
-  float tFromNear, const LevelOfDetail& lod, float rgb[3], std::size_t& secondaryRays)
+OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit,
+  float tFromNear, const LevelOfDetail& lod, std::size_t& secondaryRays)
 {
-  const Rgba base = NodeColor(f, tree, hit.node);
-  rgb[0] = base.r, rgb[1] = base.g, rgb[2] = base.b;
+  const Vec3f albedo = RgbOf(NodeColor(f, tree, hit.node));
   if (f.shade == ShadeMode::DepthCue)
   {
-    float u = (tFromNear - f.cueNear) / (f.cueFar - f.cueNear);
-    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-    const float k = 1.0f - f.depthCue * u;
-    rgb[0] *= k, rgb[1] *= k, rgb[2] *= k;
-    return;
+    const float u = Clamp01((tFromNear - f.cueNear) / (f.cueFar - f.cueNear));
+    return albedo * (1.0f - f.depthCue * u);
   }
   if constexpr (!F::kLit)
   {
-    return;
+    return albedo;
   }
-  float n[3];
-  SurfaceNormal(tree, ray, hit, n);
-  float p[3];
-  EntryPoint(ray, hit, p);
-  const float view[3] = { -ray.direction[0], -ray.direction[1], -ray.direction[2] };
-  float lit[3] = { f.ambient * base.r, f.ambient * base.g, f.ambient * base.b };
+  const Vec3f n = SurfaceNormal(tree, ray, hit);
+  const Vec3f p = EntryPoint(ray, hit);
+  const Vec3f view = -ray.direction;
+  Vec3f lit = f.ambient * albedo;
   const int lights = f.lightCount > 0 ? f.lightCount : 1;
   for (int i = 0; i < lights; ++i)
   {
-    float l[3], color[3] = { 1.0f, 1.0f, 1.0f };
+    Vec3f l = view; // the headlight
+    Vec3f color{ 1.0f, 1.0f, 1.0f };
     float distance = INFINITY;
-    if (f.lightCount == 0)
-    {
-      l[0] = view[0], l[1] = view[1], l[2] = view[2]; // headlight
-    }
-    else
+    if (f.lightCount > 0)
     {
       const UnitLight& light = f.lights[i];
-      for (int a = 0; a < 3; ++a)
-      {
-        l[a] = light.directional ? light.position[a] : light.position[a] - p[a];
-        color[a] = light.color[a];
-      }
-      distance = light.directional ? INFINITY : sqrtf(Dot(l, l));
-      Normalize(l);
+      l = light.directional ? light.position : light.position - p;
+      color = light.color;
+      distance = light.directional ? INFINITY : Length(l);
+      l = Normalize(l);
     }
     const float nl = Dot(n, l);
     if (nl <= 0.0f)
@@ -335,10 +292,7 @@ OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, co
     if constexpr (F::kShadows)
     {
       Ray shadow;
-      for (int a = 0; a < 3; ++a)
-      {
-        shadow.origin[a] = p[a];
-      }
+      shadow.origin = p;
       SetDirection(shadow, l);
       shadow.tMin = 0.0f;
       shadow.tMax = distance;
@@ -350,15 +304,12 @@ OCTORAY_HD void ShadeSurface(const FrameConstants& f, const OctreeView& tree, co
         continue;
       }
     }
-    const float r[3] = { 2.0f * nl * n[0] - l[0], 2.0f * nl * n[1] - l[1], 2.0f * nl * n[2] - l[2] };
+    const Vec3f r = 2.0f * nl * n - l; // l mirrored about n
     const float rv = Dot(r, view);
     const float spec = rv > 0.0f ? f.specular * PortablePow(rv, f.specularPower) : 0.0f;
-    for (int a = 0; a < 3; ++a)
-    {
-      lit[a] += color[a] * (f.diffuse * nl * (&base.r)[a] + spec);
-    }
+    lit += color * (f.diffuse * nl * albedo + Vec3f{ spec, spec, spec });
   }
-  rgb[0] = lit[0], rgb[1] = lit[1], rgb[2] = lit[2];
+  return lit;
 }
 
 // Accumulates the volume blend modes over the voxels a ray passes.
@@ -387,7 +338,7 @@ struct BlendVisitor
       {
         const Rgba c = NodeColor(*f, *tree, hit.node);
         // Opacity is given per unit distance; correct it for this length.
-        const float alpha = 1.0f - PortablePow(1.0f - fminf(fmaxf(c.a, 0.0f), 1.0f), dt / f->opacityUnitDistance);
+        const float alpha = 1.0f - PortablePow(1.0f - Clamp01(c.a), dt / f->opacityUnitDistance);
         const float w = (1.0f - rgba[3]) * alpha;
         rgba[0] += w * c.r, rgba[1] += w * c.g, rgba[2] += w * c.b, rgba[3] += w;
         any = true;
@@ -423,15 +374,9 @@ OCTORAY_HD Rgba ProjectedColor(const FrameConstants& f, float value)
 {
   if (f.transfer)
   {
-    float u = (value - f.transferRange[0]) / (f.transferRange[1] - f.transferRange[0]);
-    u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-    if (!(u == u))
-    {
-      u = 0.0f;
-    }
-    return f.transfer[static_cast<int>(u * (f.transferSize - 1) + 0.5f)];
+    return TransferLookup(f, value);
   }
-  const float v = value < 0.0f ? 0.0f : (value > 1.0f ? 1.0f : value);
+  const float v = Clamp01(value);
   return Rgba{ v, v, v, 1.0f };
 }
 
@@ -439,7 +384,7 @@ OCTORAY_HD Rgba ProjectedColor(const FrameConstants& f, float value)
 struct PendingRay
 {
   Ray ray;
-  float weight[3];
+  Vec3f weight;
   int bounces;
   float tFromNear;
 };
@@ -448,18 +393,14 @@ constexpr int kMaxPendingRays = 8;
 // Voxels a refracted ray may cross inside one medium before it is dropped.
 constexpr int kMaxMediumSteps = 1 << 12;
 
-OCTORAY_HD void Reflect(const float d[3], const float n[3], float r[3])
+OCTORAY_HD Vec3f Reflect(const Vec3f& d, const Vec3f& n)
 {
-  const float dn = Dot(d, n);
-  for (int a = 0; a < 3; ++a)
-  {
-    r[a] = d[a] - 2.0f * dn * n[a];
-  }
+  return d - 2.0f * Dot(d, n) * n;
 }
 
 // Snell's law: d enters through a surface with normal n (facing against d)
 // from index n1 into n2, eta = n1 / n2. False on total internal reflection.
-OCTORAY_HD bool Refract(const float d[3], const float n[3], float eta, float t[3])
+OCTORAY_HD bool Refract(const Vec3f& d, const Vec3f& n, float eta, Vec3f& t)
 {
   const float cosIn = -Dot(d, n);
   const float sin2Out = eta * eta * (1.0f - cosIn * cosIn);
@@ -468,21 +409,14 @@ OCTORAY_HD bool Refract(const float d[3], const float n[3], float eta, float t[3
     return false;
   }
   const float cosOut = sqrtf(1.0f - sin2Out);
-  for (int a = 0; a < 3; ++a)
-  {
-    t[a] = eta * d[a] + (eta * cosIn - cosOut) * n[a];
-  }
-  Normalize(t);
+  t = Normalize(eta * d + (eta * cosIn - cosOut) * n);
   return true;
 }
 
 // A secondary ray from p; tMin skips the surface it starts on.
-OCTORAY_HD void StartRay(Ray& ray, const float p[3], const float d[3], float tMin)
+OCTORAY_HD void StartRay(Ray& ray, const Vec3f& p, const Vec3f& d, float tMin)
 {
-  for (int a = 0; a < 3; ++a)
-  {
-    ray.origin[a] = p[a];
-  }
+  ray.origin = p;
   SetDirection(ray, d);
   ray.tMin = tMin;
   ray.tMax = INFINITY;
@@ -494,20 +428,16 @@ OCTORAY_HD void StartRay(Ray& ray, const float p[3], const float d[3], float tMi
 // leaves through a face, where it refracts back into air. The emerging ray
 // goes into `out` (its weight and bounces set by the caller; each internal
 // reflection costs a bounce). False when the bounces run out inside.
-OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const NodeHit& hit, const float n[3],
+OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const NodeHit& hit, const Vec3f& n,
   float ior, int maxBounces, PendingRay& out)
 {
-  float d[3];
+  Vec3f d;
   if (!Refract(in.direction, n, 1.0f / ior, d))
   {
     return false; // an index below 1 seen at a grazing angle: all reflected
   }
   const float tEnter = hit.tEnter > in.tMin ? hit.tEnter : in.tMin;
-  float p[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    p[a] = in.origin[a] + tEnter * in.direction[a];
-  }
+  Vec3f p = in.origin + tEnter * in.direction;
   const int level = hit.level;
   const std::uint32_t cells = 1u << level;
   const float size = hit.size;
@@ -539,10 +469,7 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
       return false;
     }
     tExit = tExit > 0.0f ? tExit : 0.0f;
-    for (int a = 0; a < 3; ++a)
-    {
-      p[a] += tExit * d[a];
-    }
+    p += tExit * d;
     p[axis] = (static_cast<float>(cell[axis]) + (d[axis] > 0.0f ? 1.0f : 0.0f)) * size; // exactly on the face
     const int stepDir = d[axis] > 0.0f ? 1 : -1;
     const long long next = static_cast<long long>(cell[axis]) + stepDir;
@@ -560,9 +487,9 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
       continue;
     }
     // At the medium's boundary: out into air, or totally reflected inside.
-    float inward[3] = { 0.0f, 0.0f, 0.0f };
+    Vec3f inward{ 0.0f, 0.0f, 0.0f };
     inward[axis] = -static_cast<float>(stepDir);
-    float outDir[3];
+    Vec3f outDir;
     if (Refract(d, inward, ior, outDir))
     {
       StartRay(out.ray, p, outDir, 1e-4f * size);
@@ -578,85 +505,87 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
   return false;
 }
 
-// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+// A pixel's primary ray, with its start in double (for window depths) and
+// the level of detail along it.
+struct CameraRay
+{
+  Ray ray;
+  double tBase; // where the ray entered the root cube, from the near plane
+  Vec3d origin, direction;
+  LevelOfDetail lod;
+
+  // Window depth of the point at distance t along the ray.
+  OCTORAY_HD float DepthAt(const FrameConstants& f, float t) const
+  {
+    return WindowDepth(f, origin + double(t) * direction);
+  }
+};
+
+// A volume blend mode: what the ray collects through every voxel it meets.
+OCTORAY_HD void BlendPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
+  float& depth)
+{
+  BlendVisitor blend;
+  blend.f = &f;
+  blend.tree = &tree;
+  Traverse(tree, pixel.ray, pixel.lod, blend);
+  if (!blend.any)
+  {
+    return;
+  }
+  if (f.blend == BlendMode::Composite)
+  {
+    for (int k = 0; k < 4; ++k)
+    {
+      rgba[k] = blend.rgba[k];
+    }
+  }
+  else
+  {
+    float v = blend.value;
+    if (f.blend == BlendMode::Average)
+    {
+      v = blend.length > 0.0f ? blend.value / blend.length : 0.0f;
+    }
+    const Rgba c = ProjectedColor(f, v);
+    rgba[0] = c.r * c.a, rgba[1] = c.g * c.a, rgba[2] = c.b * c.a, rgba[3] = c.a;
+  }
+  depth = pixel.DepthAt(f, blend.firstT);
+}
+
+// A surface, first hit only.
 template <typename F>
-OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+OCTORAY_HD void FirstHitPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
   float& depth, std::size_t& secondaryRays)
 {
-  rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
-  depth = 1.0f;
-  Ray ray;
-  double tBase, origin[3], direction[3];
-  if (!PrimaryRay(f, x, y, ray, tBase, origin, direction))
+  FirstHitVisitor first;
+  Traverse(tree, pixel.ray, pixel.lod, first);
+  if (first.found)
   {
-    return;
+    const float tHit = first.hit.tEnter > pixel.ray.tMin ? first.hit.tEnter : pixel.ray.tMin;
+    depth = pixel.DepthAt(f, tHit);
+    const float tFromNear = static_cast<float>(pixel.tBase) + tHit;
+    const Vec3f rgb = ShadeSurface<F>(f, tree, pixel.ray, first.hit, tFromNear, pixel.lod, secondaryRays);
+    rgba[0] = rgb.x, rgba[1] = rgb.y, rgba[2] = rgb.z, rgba[3] = 1.0f;
   }
-  LevelOfDetail lod;
-  lod.pixels = f.lodPixels;
-  lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(tBase);
-  lod.footprintSlope = f.footprintSlope;
+}
 
-  if constexpr (F::kVolume)
-  {
-    BlendVisitor blend;
-    blend.f = &f;
-    blend.tree = &tree;
-    Traverse(tree, ray, lod, blend);
-    if (!blend.any)
-    {
-      return;
-    }
-    Rgba c;
-    if (f.blend == BlendMode::Composite)
-    {
-      for (int k = 0; k < 4; ++k)
-      {
-        rgba[k] = blend.rgba[k];
-      }
-    }
-    else
-    {
-      float v = blend.value;
-      if (f.blend == BlendMode::Average)
-      {
-        v = blend.length > 0.0f ? blend.value / blend.length : 0.0f;
-      }
-      c = ProjectedColor(f, v);
-      rgba[0] = c.r * c.a, rgba[1] = c.g * c.a, rgba[2] = c.b * c.a, rgba[3] = c.a;
-    }
-    const double p[3] = { origin[0] + blend.firstT * direction[0], origin[1] + blend.firstT * direction[1],
-      origin[2] + blend.firstT * direction[2] };
-    depth = WindowDepth(f, p);
-    return;
-  }
-
-  if constexpr (!F::kSecondary)
-  {
-    // Surface, first hit only.
-    FirstHitVisitor first;
-    Traverse(tree, ray, lod, first);
-    if (first.found)
-    {
-      const float tHit = first.hit.tEnter > ray.tMin ? first.hit.tEnter : ray.tMin;
-      const double p[3] = { origin[0] + tHit * direction[0], origin[1] + tHit * direction[1],
-        origin[2] + tHit * direction[2] };
-      depth = WindowDepth(f, p);
-      ShadeSurface<F>(f, tree, ray, first.hit, static_cast<float>(tBase) + tHit, lod, rgba, secondaryRays);
-      rgba[3] = 1.0f;
-    }
-    return;
-  }
-  // Surface: the first voxel, then the mirror and refracted rays it spawns,
-  // each carrying its weight in the pixel, until the bounce limit.
+// A surface: the first voxel, then the mirror and refracted rays it spawns,
+// each carrying its weight in the pixel, until the bounce limit.
+template <typename F>
+OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
   PendingRay pending[kMaxPendingRays];
   int top = 0;
-  pending[top++] = PendingRay{ ray, { 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(tBase) };
+  pending[top++] = PendingRay{ pixel.ray, Vec3f{ 1.0f, 1.0f, 1.0f }, 0, static_cast<float>(pixel.tBase) };
   bool primary = true;
+  Vec3f color{ 0.0f, 0.0f, 0.0f };
   while (top > 0)
   {
     const PendingRay path = pending[--top];
     FirstHitVisitor first;
-    Traverse(tree, path.ray, lod, first);
+    Traverse(tree, path.ray, pixel.lod, first);
     if (!first.found)
     {
       primary = false;
@@ -666,42 +595,28 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     const float tHit = hit.tEnter > path.ray.tMin ? hit.tEnter : path.ray.tMin;
     if (primary)
     {
-      const double p[3] = { origin[0] + tHit * direction[0], origin[1] + tHit * direction[1],
-        origin[2] + tHit * direction[2] };
-      depth = WindowDepth(f, p);
+      depth = pixel.DepthAt(f, tHit);
       rgba[3] = 1.0f;
       primary = false;
     }
-    float rgb[3];
-    ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, lod, rgb, secondaryRays);
+    const Vec3f rgb = ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, pixel.lod, secondaryRays);
     const bool canBounce = path.bounces < f.maxBounces;
-    float reflectivity = canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f;
-    reflectivity = reflectivity < 0.0f ? 0.0f : (reflectivity > 1.0f ? 1.0f : reflectivity);
+    const float reflectivity = Clamp01(canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f);
     const float ior = canBounce && tree.refraction ? tree.refraction[hit.node] : 0.0f;
     // A refracting voxel is clear: it tints what is seen through it instead
     // of showing its own lit colour.
     const float opaque = (1.0f - reflectivity) * (ior > 0.0f ? 0.0f : 1.0f);
-    for (int a = 0; a < 3; ++a)
-    {
-      rgba[a] += path.weight[a] * opaque * rgb[a];
-    }
+    color += path.weight * opaque * rgb;
     if (!(reflectivity > 0.0f || ior > 0.0f))
     {
       continue;
     }
-    float n[3];
-    SurfaceNormal(tree, path.ray, hit, n);
+    const Vec3f n = SurfaceNormal(tree, path.ray, hit);
     if (reflectivity > 0.0f && top < kMaxPendingRays)
     {
       PendingRay mirror;
-      float p[3], r[3];
-      EntryPoint(path.ray, hit, p);
-      Reflect(path.ray.direction, n, r);
-      StartRay(mirror.ray, p, r, 0.0f);
-      for (int a = 0; a < 3; ++a)
-      {
-        mirror.weight[a] = path.weight[a] * reflectivity;
-      }
+      StartRay(mirror.ray, EntryPoint(path.ray, hit), Reflect(path.ray.direction, n), 0.0f);
+      mirror.weight = path.weight * reflectivity;
       mirror.bounces = path.bounces + 1;
       mirror.tFromNear = path.tFromNear + tHit;
       pending[top++] = mirror;
@@ -709,12 +624,8 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
     }
     if (ior > 0.0f && top < kMaxPendingRays)
     {
-      const Rgba tint = NodeColor(f, tree, hit.node);
       PendingRay through;
-      for (int a = 0; a < 3; ++a)
-      {
-        through.weight[a] = path.weight[a] * (1.0f - reflectivity) * (&tint.r)[a];
-      }
+      through.weight = path.weight * (1.0f - reflectivity) * RgbOf(NodeColor(f, tree, hit.node));
       through.bounces = path.bounces + 1;
       through.tFromNear = path.tFromNear + tHit;
       if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
@@ -723,6 +634,36 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
         ++secondaryRays;
       }
     }
+  }
+  rgba[0] = color.x, rgba[1] = color.y, rgba[2] = color.z;
+}
+
+// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+template <typename F>
+OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
+  rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
+  depth = 1.0f;
+  CameraRay pixel;
+  if (!PrimaryRay(f, x, y, pixel.ray, pixel.tBase, pixel.origin, pixel.direction))
+  {
+    return;
+  }
+  pixel.lod.pixels = f.lodPixels;
+  pixel.lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(pixel.tBase);
+  pixel.lod.footprintSlope = f.footprintSlope;
+  if constexpr (F::kVolume)
+  {
+    BlendPixel(f, tree, pixel, rgba, depth);
+  }
+  else if constexpr (F::kSecondary)
+  {
+    TracedPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
+  }
+  else
+  {
+    FirstHitPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include "Config.h"
 #include "Morton.h"
+#include "VecMath.h"
 
 namespace octoray
 {
@@ -46,6 +47,12 @@ struct RootCube
     return cube;
   }
 
+  static RootCube FromBounds(const Vec3d& lo, const Vec3d& hi)
+  {
+    const double l[3] = { lo.x, lo.y, lo.z }, h[3] = { hi.x, hi.y, hi.z };
+    return FromBounds(l, h);
+  }
+
   // Full-depth grid cell of a point; false when the point lies outside.
   OCTORAY_HD bool GridCell(double x, double y, double z, std::uint32_t cell[3]) const
   {
@@ -62,6 +69,12 @@ struct RootCube
       cell[a] = static_cast<std::uint32_t>(g);
     }
     return true;
+  }
+
+  OCTORAY_HD bool Contains(const Vec3d& p) const
+  {
+    std::uint32_t cell[3];
+    return GridCell(p.x, p.y, p.z, cell);
   }
 
   OCTORAY_HD bool FullKey(double x, double y, double z, std::uint64_t& key) const

@@ -29,25 +29,22 @@ OCTORAY_HD float PowerOfTwo(int e)
 
 struct Ray
 {
-  float origin[3];
-  float direction[3]; // unit length
-  float inverse[3];   // 1 / direction, +-inf for zero components
+  Vec3f origin;
+  Vec3f direction; // unit length
+  Vec3f inverse;   // 1 / direction, +-inf for zero components
   float tMin, tMax;
 };
 
-OCTORAY_HD void SetDirection(Ray& ray, const float d[3])
+OCTORAY_HD void SetDirection(Ray& ray, const Vec3f& d)
 {
-  for (int a = 0; a < 3; ++a)
-  {
-    ray.direction[a] = d[a];
-    ray.inverse[a] = 1.0f / d[a];
-  }
+  ray.direction = d;
+  ray.inverse = Vec3f{ 1.0f / d.x, 1.0f / d.y, 1.0f / d.z };
 }
 
 // Entry and exit of the ray through the box [lo, lo + size); the axis of the
 // entry face (-1 if the ray starts inside on every axis). False on a miss,
 // and when any value is NaN.
-OCTORAY_HD bool IntersectBox(const Ray& ray, const float lo[3], float size, float& tEnter, float& tExit, int& axis)
+OCTORAY_HD_INLINE bool IntersectBox(const Ray& ray, const Vec3f& lo, float size, float& tEnter, float& tExit, int& axis)
 {
   tEnter = -INFINITY;
   tExit = INFINITY;
@@ -104,7 +101,7 @@ struct NodeHit
   int level;
   float tEnter, tExit;
   int axis;         // entry face axis, -1 when the ray starts inside
-  float lo[3];      // the voxel's corner and size in the unit cube
+  Vec3f lo;         // the voxel's corner and size in the unit cube
   float size;
 };
 
@@ -141,17 +138,16 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
   TraversalEntry stack[kTraversalStack];
   int top = 0;
   {
-    const float origin[3] = { 0.0f, 0.0f, 0.0f };
     float t0, t1;
     int axis;
-    if (!IntersectBox(ray, origin, 1.0f, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax)
+    if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax)
     {
       return;
     }
     stack[top++] = TraversalEntry{ 0u, 0, t0 };
   }
   const unsigned signMask =
-    (ray.direction[0] < 0.0f ? 1u : 0u) | (ray.direction[1] < 0.0f ? 2u : 0u) | (ray.direction[2] < 0.0f ? 4u : 0u);
+    (ray.direction.x < 0.0f ? 1u : 0u) | (ray.direction.y < 0.0f ? 2u : 0u) | (ray.direction.z < 0.0f ? 4u : 0u);
   while (top > 0)
   {
     const TraversalEntry e = stack[--top];
@@ -165,10 +161,7 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     hit.size = PowerOfTwo(-e.level);
     std::uint32_t cell[3];
     DecodeMorton(tree.key[e.node], cell[0], cell[1], cell[2]);
-    for (int a = 0; a < 3; ++a)
-    {
-      hit.lo[a] = static_cast<float>(cell[a]) * hit.size;
-    }
+    hit.lo = Vec3f{ static_cast<float>(cell[0]), static_cast<float>(cell[1]), static_cast<float>(cell[2]) } * hit.size;
     if (e.level == tree.depth || lod.StopAt(hit.size, e.tEnter))
     {
       IntersectBox(ray, hit.lo, hit.size, hit.tEnter, hit.tExit, hit.axis);
@@ -189,8 +182,8 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
       {
         continue;
       }
-      const float lo[3] = { hit.lo[0] + ((octant & 1u) ? half : 0.0f), hit.lo[1] + ((octant & 2u) ? half : 0.0f),
-        hit.lo[2] + ((octant & 4u) ? half : 0.0f) };
+      const Vec3f offset{ (octant & 1u) ? half : 0.0f, (octant & 2u) ? half : 0.0f, (octant & 4u) ? half : 0.0f };
+      const Vec3f lo = hit.lo + offset;
       float t0, t1;
       int axis;
       if (!IntersectBox(ray, lo, half, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax || top == kTraversalStack)
@@ -217,7 +210,7 @@ struct FirstHitVisitor
 
 // Whether a voxel holds the point p of the unit cube at `level` (or the
 // deepest drawn level above it): used for occupancy-gradient normals.
-OCTORAY_HD bool Occupied(const OctreeView& tree, int level, const float p[3])
+OCTORAY_HD bool Occupied(const OctreeView& tree, int level, const Vec3f& p)
 {
   for (int a = 0; a < 3; ++a)
   {
@@ -226,10 +219,9 @@ OCTORAY_HD bool Occupied(const OctreeView& tree, int level, const float p[3])
       return false;
     }
   }
-  const float scale = PowerOfTwo(level);
-  const std::uint64_t key =
-    EncodeMorton(static_cast<std::uint32_t>(p[0] * scale), static_cast<std::uint32_t>(p[1] * scale),
-      static_cast<std::uint32_t>(p[2] * scale));
+  const Vec3f cell = p * PowerOfTwo(level);
+  const std::uint64_t key = EncodeMorton(static_cast<std::uint32_t>(cell.x), static_cast<std::uint32_t>(cell.y),
+    static_cast<std::uint32_t>(cell.z));
   return tree.Find(level, key) != kInvalidIndex;
 }
 }

@@ -39,8 +39,12 @@ void ValidateDepth(int depth)
   }
 }
 
-void ValidateUpdate(const PositionsView& positions, std::size_t pointCount)
+void ValidateUpdate(const PositionsView& positions, std::size_t pointCount, bool discardedByUpdate)
 {
+  if (pointCount == 0 && discardedByUpdate)
+  {
+    throw Error("octoray: update after a failed update discarded the octree; build again");
+  }
   if (pointCount == 0)
   {
     throw Error("octoray: update before any build");
@@ -77,19 +81,32 @@ void ValidateUpdate(const PositionsView& positions, std::size_t pointCount)
   }
 }
 
-std::string NonFinitePointMessage(std::size_t index, const double p[3])
+void ValidateRender(std::size_t pointCount, bool discardedByUpdate)
+{
+  if (pointCount == 0)
+  {
+    throw Error(discardedByUpdate ? "octoray: render after a failed update discarded the octree; build again"
+                                  : "octoray: render before any build");
+  }
+}
+
+std::string NonFinitePointMessage(std::size_t index, const Vec3d& p)
 {
   std::ostringstream s;
-  s << "octoray: point " << index << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2]
-    << ")";
+  s << "octoray: point " << index << " has a non-finite coordinate (" << p.x << ", " << p.y << ", " << p.z << ")";
   return s.str();
 }
 
-std::string OutsideCubeMessage(std::size_t index, const double p[3])
+std::string OutsideCubeMessage(std::size_t index, const Vec3d& p)
 {
   std::ostringstream s;
-  s << "octoray: point " << index << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") lies outside the root cube";
+  s << "octoray: point " << index << " (" << p.x << ", " << p.y << ", " << p.z << ") lies outside the root cube";
   return s.str();
+}
+
+std::string DiscardedByUpdateMessage(const std::string& error)
+{
+  return error + " (the update had begun: the octree was discarded; build again)";
 }
 
 std::string OutOfMemoryMessage(const char* what, std::size_t bytesNeeded, std::size_t bytesFree)

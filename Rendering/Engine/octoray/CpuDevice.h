@@ -1,0 +1,215 @@
+// The CPU backend's device for the driver (OctreeDriver.h): loops split over
+// std::thread chunks (Parallel.h), a multi-threaded radix sort, and buffers
+// in host memory. Chunks are contiguous and combined in order, so every
+// result is the same whatever the thread count.
+#pragma once
+
+#include "Parallel.h"
+#include "RadixSort.h"
+
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <numeric>
+#include <vector>
+
+namespace octoray
+{
+// An array in host memory with the interface of DeviceBuffer: it keeps its
+// allocation while a smaller count fits, and leaves new elements
+// uninitialised (every step writes all it reserves).
+template <typename T>
+class HostBuffer
+{
+public:
+  void Reserve(std::size_t n)
+  {
+    if (n > Capacity)
+    {
+      Data.reset(new T[n]);
+      Capacity = n;
+    }
+    Size = n;
+  }
+  void Release()
+  {
+    Data.reset();
+    Capacity = Size = 0;
+  }
+
+  T* Get() const { return Data.get(); }
+  std::size_t Count() const { return Size; }
+  std::size_t Bytes() const { return Capacity * sizeof(T); }
+  bool Empty() const { return Size == 0; }
+
+private:
+  std::unique_ptr<T[]> Data;
+  std::size_t Capacity = 0;
+  std::size_t Size = 0;
+};
+
+class CpuDevice
+{
+public:
+  template <typename T>
+  using Buffer = HostBuffer<T>;
+
+  // The caller's array, read in place: host memory is this device's memory.
+  template <typename T>
+  struct Staged
+  {
+    const T* data;
+    const T* Get() const { return data; }
+  };
+
+  // Host allocations do not fail short of the whole process failing, so a
+  // build reuses the current state's allocations instead of filling a new
+  // one aside (which would hold two copies of the points at once).
+  static constexpr bool kBuildsAside = false;
+
+  int threads = DefaultThreadCount();
+
+  struct NoScope
+  {
+  };
+  NoScope Scope() const { return {}; }
+
+  template <typename T>
+  void Reserve(Buffer<T>& buffer, std::size_t n, const char*)
+  {
+    buffer.Reserve(n);
+  }
+  template <typename T>
+  void Release(Buffer<T>& buffer)
+  {
+    buffer.Release();
+  }
+  template <typename T>
+  Staged<T> Stage(const T* host, std::size_t, const char*)
+  {
+    return Staged<T>{ host };
+  }
+  template <typename T>
+  void Adopt(const Staged<T>& staged, Buffer<T>& buffer, std::size_t n)
+  {
+    if (!staged.Get())
+    {
+      buffer.Release();
+      return;
+    }
+    buffer.Reserve(n);
+    std::copy_n(staged.Get(), n, buffer.Get());
+  }
+  template <typename T>
+  void Upload(Buffer<T>& buffer, const T* host, std::size_t n, const char* what)
+  {
+    Adopt(Stage(host, n, what), buffer, n);
+  }
+  template <typename T>
+  void Download(const Buffer<T>& buffer, std::vector<T>& host)
+  {
+    host.assign(buffer.Get(), buffer.Get() + buffer.Count());
+  }
+  template <typename T>
+  void ToHost(const T* data, std::size_t n, T* host, const char*)
+  {
+    std::copy_n(data, n, host);
+  }
+  template <typename T>
+  void FillBytes(T* data, std::size_t n, unsigned char byte)
+  {
+    std::memset(data, byte, n * sizeof(T));
+  }
+  void Synchronize(const char*) {}
+  std::size_t ScratchBytes() const { return 0; }
+
+  template <typename Fn>
+  void ForEach(const char*, std::size_t n, Fn fn)
+  {
+    ParallelFor(n, threads, fn);
+  }
+
+  template <typename T, typename Map, typename Combine>
+  T Reduce(std::size_t n, T identity, Map map, Combine combine)
+  {
+    const int chunks = n < kParallelPassMinItems ? 1 : threads;
+    std::vector<T> partial(chunks, identity);
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      T sum = identity;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        sum = combine(sum, map(i));
+      }
+      partial[c] = sum;
+    });
+    T sum = identity;
+    for (const T& p : partial)
+    {
+      sum = combine(sum, p);
+    }
+    return sum;
+  }
+
+  template <int Bins, typename Fn>
+  void Histogram(const char*, std::size_t n, Fn binsOf, std::uint64_t* counts)
+  {
+    const int chunks = n < kParallelPassMinItems ? 1 : threads;
+    std::vector<std::uint64_t> local(static_cast<std::size_t>(chunks) * Bins, 0);
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::uint64_t* h = local.data() + static_cast<std::size_t>(c) * Bins;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        const auto bins = binsOf(i);
+        if (bins.first >= 0)
+        {
+          ++h[bins.first];
+        }
+        if (bins.second >= 0)
+        {
+          ++h[bins.second];
+        }
+      }
+    });
+    for (int c = 0; c < chunks; ++c)
+    {
+      for (int b = 0; b < Bins; ++b)
+      {
+        counts[b] += local[static_cast<std::size_t>(c) * Bins + b];
+      }
+    }
+  }
+
+  template <typename Predicate>
+  void Select(std::size_t n, Predicate selected, std::uint32_t* out, std::uint64_t* count)
+  {
+    const int chunks = n < kParallelPassMinItems ? 1 : threads;
+    std::vector<std::size_t> offsets(chunks + 1, 0);
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::size_t k = 0;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        k += selected(i) ? 1 : 0;
+      }
+      offsets[c + 1] = k;
+    });
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::size_t k = offsets[c];
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        if (selected(i))
+        {
+          out[k++] = static_cast<std::uint32_t>(i);
+        }
+      }
+    });
+    *count = offsets[chunks];
+  }
+
+  template <typename Key>
+  int SortPairs(Key* const keys[2], std::uint32_t* const values[2], std::size_t n, int bits, const char*)
+  {
+    return RadixSortPairs(keys[0], values[0], n, bits, threads, keys[1], values[1]);
+  }
+};
+}

@@ -1,0 +1,235 @@
+// The CUDA backend's device for the driver (OctreeDriver.h): one kernel per
+// loop, CUB for sorting, selection and reductions, and buffers in the
+// engine's memory pool (DeviceMemoryPool). Everything runs in order on the
+// default stream; a loop returns before the GPU has run it, and the host
+// waits only where it reads a result (ToHost, Reduce) or Synchronize. Only
+// compiled by nvcc.
+#pragma once
+
+#include "CudaSupport.h"
+
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_reduce.cuh>
+#include <cub/device/device_select.cuh>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace octoray
+{
+namespace cuda
+{
+constexpr int kBlock = 256;
+
+inline unsigned Blocks(std::size_t n)
+{
+  return static_cast<unsigned>((n + kBlock - 1) / kBlock);
+}
+
+template <typename Fn>
+__global__ void ForEachKernel(std::size_t n, Fn fn)
+{
+  const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  if (i < n)
+  {
+    fn(i);
+  }
+}
+
+// Counts per block in shared memory first: a few dozen bins hit by every
+// thread would serialise on global atomics.
+template <int Bins, typename Fn>
+__global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* counts)
+{
+  __shared__ unsigned int local[Bins];
+  for (int b = threadIdx.x; b < Bins; b += blockDim.x)
+  {
+    local[b] = 0;
+  }
+  __syncthreads();
+  const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  if (i < n)
+  {
+    const auto bins = binsOf(i);
+    if (bins.first >= 0)
+    {
+      atomicAdd(&local[bins.first], 1u);
+    }
+    if (bins.second >= 0)
+    {
+      atomicAdd(&local[bins.second], 1u);
+    }
+  }
+  __syncthreads();
+  for (int b = threadIdx.x; b < Bins; b += blockDim.x)
+  {
+    if (local[b])
+    {
+      atomicAdd(&counts[b], static_cast<unsigned long long>(local[b]));
+    }
+  }
+}
+}
+
+class CudaDevice
+{
+public:
+  template <typename T>
+  using Buffer = DeviceBuffer<T>;
+  template <typename T>
+  using Staged = DeviceBuffer<T>;
+
+  // Running out of device memory is an expected failure (a full GPU, the
+  // engine's budget): a build fills a new state aside and replaces the
+  // current one only once complete, so that a failed build leaves the
+  // previous octree as it was.
+  static constexpr bool kBuildsAside = true;
+
+  // Works on `device` (-1: the caller's current device).
+  explicit CudaDevice(int device)
+  {
+    if (device < 0)
+    {
+      CudaCheck(cudaGetDevice(&device), "cudaGetDevice");
+    }
+    Device = device;
+  }
+
+  int Index() const { return Device; }
+  DeviceMemoryPool& Pool() { return Memory; }
+
+  // Makes this device current until the scope ends (every public call).
+  ScopedDevice Scope() const { return ScopedDevice(Device); }
+  // From the start of the owner's destructor on: its buffers are freed on
+  // this device, and the caller's device is current again once this device
+  // (the owner's first member) is destroyed.
+  void ScopeUntilDestroyed() { DestructionScope = std::make_unique<ScopedDevice>(Device); }
+
+  template <typename T>
+  void Reserve(Buffer<T>& buffer, std::size_t n, const char* what)
+  {
+    buffer.Reserve(Memory, n, what);
+  }
+  template <typename T>
+  void Release(Buffer<T>& buffer)
+  {
+    buffer.Release();
+  }
+  template <typename T>
+  Staged<T> Stage(const T* host, std::size_t n, const char* what)
+  {
+    Staged<T> staged;
+    if (host)
+    {
+      Upload(staged, host, n, what);
+    }
+    return staged;
+  }
+  template <typename T>
+  void Adopt(Staged<T>&& staged, Buffer<T>& buffer, std::size_t)
+  {
+    buffer = std::move(staged);
+  }
+  template <typename T>
+  void Upload(Buffer<T>& buffer, const T* host, std::size_t n, const char* what)
+  {
+    Reserve(buffer, n, what);
+    CudaCheck(cudaMemcpy(buffer.Get(), host, n * sizeof(T), cudaMemcpyHostToDevice), what);
+  }
+  template <typename T>
+  void Download(const Buffer<T>& buffer, std::vector<T>& host)
+  {
+    host.resize(buffer.Count());
+    ToHost(buffer.Get(), host.size(), host.data(), "copy to the host");
+  }
+  template <typename T>
+  void ToHost(const T* data, std::size_t n, T* host, const char* what)
+  {
+    if (n)
+    {
+      CudaCheck(cudaMemcpy(host, data, n * sizeof(T), cudaMemcpyDeviceToHost), what);
+    }
+  }
+  template <typename T>
+  void FillBytes(T* data, std::size_t n, unsigned char byte)
+  {
+    CudaCheck(cudaMemset(data, byte, n * sizeof(T)), "cudaMemset");
+  }
+  void Synchronize(const char* what) { CudaCheck(cudaDeviceSynchronize(), what); }
+  std::size_t ScratchBytes() const { return CubScratch.Bytes() + ReduceResult.Bytes(); }
+
+  template <typename Fn>
+  void ForEach(const char* name, std::size_t n, Fn fn)
+  {
+    if (n)
+    {
+      Launch(name, cuda::ForEachKernel<Fn>, cuda::Blocks(n), cuda::kBlock, n, fn);
+    }
+  }
+
+  template <typename T, typename Map, typename Combine>
+  T Reduce(std::size_t n, T identity, Map map, Combine combine)
+  {
+    auto in = thrust::make_transform_iterator(thrust::counting_iterator<std::size_t>(0), map);
+    Reserve(ReduceResult, sizeof(T), "reduction");
+    T* out = reinterpret_cast<T*>(ReduceResult.Get());
+    std::size_t bytes = 0;
+    CudaCheck(cub::DeviceReduce::Reduce(nullptr, bytes, in, out, n, combine, identity), "cub::DeviceReduce");
+    CudaCheck(cub::DeviceReduce::Reduce(Temporary(bytes), bytes, in, out, n, combine, identity), "cub::DeviceReduce");
+    T result;
+    ToHost(out, 1, &result, "cub::DeviceReduce");
+    return result;
+  }
+
+  template <int Bins, typename Fn>
+  void Histogram(const char* name, std::size_t n, Fn binsOf, std::uint64_t* counts)
+  {
+    static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit counts");
+    if (n)
+    {
+      Launch(name, cuda::HistogramKernel<Bins, Fn>, cuda::Blocks(n), cuda::kBlock, n, binsOf,
+        reinterpret_cast<unsigned long long*>(counts));
+    }
+  }
+
+  template <typename Predicate>
+  void Select(std::size_t n, Predicate selected, std::uint32_t* out, std::uint64_t* count)
+  {
+    auto in = thrust::counting_iterator<std::uint32_t>(0);
+    std::size_t bytes = 0;
+    CudaCheck(cub::DeviceSelect::If(nullptr, bytes, in, out, count, n, selected), "cub::DeviceSelect");
+    CudaCheck(cub::DeviceSelect::If(Temporary(bytes), bytes, in, out, count, n, selected), "cub::DeviceSelect");
+  }
+
+  template <typename Key>
+  int SortPairs(Key* const keys[2], std::uint32_t* const values[2], std::size_t n, int bits, const char* what)
+  {
+    cub::DoubleBuffer<Key> k(keys[0], keys[1]);
+    cub::DoubleBuffer<std::uint32_t> v(values[0], values[1]);
+    const std::string name = std::string("cub::DeviceRadixSort (") + what + ")";
+    std::size_t bytes = 0;
+    CudaCheck(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, n, 0, bits), name.c_str());
+    CudaCheck(cub::DeviceRadixSort::SortPairs(Temporary(bytes), bytes, k, v, n, 0, bits), name.c_str());
+    return k.selector;
+  }
+
+private:
+  // CUB's temporary storage; its allocation is kept while later calls fit.
+  void* Temporary(std::size_t bytes)
+  {
+    Reserve(CubScratch, bytes, "CUB temporary storage");
+    return CubScratch.Get();
+  }
+
+  // Declared first so that it is destroyed last (ScopeUntilDestroyed).
+  std::unique_ptr<ScopedDevice> DestructionScope;
+  int Device = 0;
+  // Declared before the buffers so that it outlives them.
+  DeviceMemoryPool Memory;
+  DeviceBuffer<unsigned char> CubScratch;
+  DeviceBuffer<unsigned char> ReduceResult;
+};
+}

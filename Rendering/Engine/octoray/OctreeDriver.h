@@ -1,0 +1,592 @@
+// The build and the update of the octree, written once for both backends
+// against a small device interface, as pbrt-v4 writes its integrators once
+// over ParallelFor and GPUParallelFor. A device (CpuDevice.h, CudaDevice.h)
+// differs from the other only in where memory lives and how loops run:
+//
+//   Buffer<T>                         an owning array: Get(), Count(), Bytes(), Empty()
+//   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
+//   Release(buffer)
+//   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
+//   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
+//   Upload, Download, ToHost, FillBytes   copies in and out, a memset
+//   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
+//   Reduce(n, identity, map, combine) combine over every map(i), returned to the host
+//   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
+//   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
+//   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
+//   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
+//   Scope()                           makes the device current while the returned object lives
+//   kBuildsAside                      whether a build fills a new state aside (each device says why)
+//
+// Loops capture what they use by value (OCTORAY_LAMBDA): views and plain
+// pointers, never the state or a device. One algorithm per step on both
+// backends, so they build the same octree node for node; where the host
+// must see a result (a check, the level sizes) it is one copy, named below.
+#pragma once
+
+#include "DepthChoice.h"
+#include "OctreeKernels.h"
+#include "OctreeState.h"
+#include "Validation.h"
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+namespace octoray
+{
+// The in-place update writes, sorts and reduces 2 (depth + 1) records per
+// point that changed leaf, where the re-sort path sorts one key per point:
+// past a sixteenth of the points (for a depth-7 octree, where the records
+// then outnumber the points) the re-sort costs less, and the update takes it.
+constexpr std::size_t kInPlaceUpdateShare = 16;
+
+// Where loops report to the host, in DriverScratch::counters.
+enum CounterSlot : int
+{
+  kCounterHistogram = 0,                                        // DepthChoice's two histograms
+  kCounterFirst = kCounterHistogram + 2 * kDepthHistogramBins,  // first failing index; kNoIndex: none
+  kCounterSelected,                                             // how many items the last Select kept
+  kCounterTopology,                                             // set: the in-place update cannot be done
+  kCounterSlots
+};
+
+inline double SecondsSince(std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A caller's positions, staged where the device's loops read them.
+template <class Device>
+struct StagedPositions
+{
+  typename Device::template Staged<float> xyzFloat;
+  typename Device::template Staged<double> xyzDouble;
+
+  PointArraysView View(std::size_t n) const
+  {
+    PointArraysView v;
+    v.count = n;
+    v.xyzFloat = xyzFloat.Get();
+    v.xyzDouble = xyzDouble.Get();
+    return v;
+  }
+};
+
+template <class Device>
+StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const double* xyzDouble, std::size_t n,
+  const char* what)
+{
+  return StagedPositions<Device>{ d.Stage(xyzFloat, xyzFloat ? 3 * n : 0, what),
+    d.Stage(xyzDouble, xyzDouble ? 3 * n : 0, what) };
+}
+
+// Runs step(i) for every i in [0, n) as the loop `name` and returns the
+// first i whose step failed (returned false), or kNoIndex. One copy to the
+// host.
+template <class Device, class Step>
+std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const char* name, std::size_t n, Step step)
+{
+  std::uint64_t* first = scratch.counters.Get() + kCounterFirst;
+  d.FillBytes(first, 1, 0xFF);
+  d.ForEach(name, n, OCTORAY_LAMBDA(std::size_t i) {
+    if (!step(i))
+    {
+      AtomicMin(first, i);
+    }
+  });
+  std::uint64_t result = kNoIndex;
+  d.ToHost(first, 1, &result, name);
+  return result;
+}
+
+// starts[r] = where the r-th run of equal (key >> shift) among n sorted
+// keys starts, with n after the last run: the nodes one level up (shift 3)
+// or the records of one node (shift 0). `starts` has room for n + 1; the
+// count goes to kCounterSelected, which the host reads only where it does
+// not know it.
+template <class Device, typename Key>
+void RunStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int shift,
+  std::uint32_t* starts)
+{
+  d.Select(
+    n + 1,
+    OCTORAY_LAMBDA(std::size_t i) { return i == n || i == 0 || (keys[i] >> shift) != (keys[i - 1] >> shift); },
+    starts, scratch.counters.Get() + kCounterSelected);
+}
+
+template <class Device>
+Bounds PositionBounds(Device& d, const PointArraysView& pts)
+{
+  return d.Reduce(
+    pts.count, EmptyBounds(), OCTORAY_LAMBDA(std::size_t i) { return PointBounds(pts, i); },
+    OCTORAY_LAMBDA(const Bounds& a, const Bounds& b) { return MergeBounds(a, b); });
+}
+
+// A point of the state, read back for an error message.
+template <class Device>
+Vec3d StoredPosition(Device& d, const OctreeState<Device>& s, std::size_t i)
+{
+  if (!s.points.xyzDouble.Empty())
+  {
+    double p[3];
+    d.ToHost(s.points.xyzDouble.Get() + 3 * i, 3, p, "point positions");
+    return Vec3d{ p[0], p[1], p[2] };
+  }
+  float p[3];
+  d.ToHost(s.points.xyzFloat.Get() + 3 * i, 3, p, "point positions");
+  return Vec3d{ p[0], p[1], p[2] };
+}
+
+// How each kind of attribute input becomes the engine's copy (Attributes.h
+// names the kind of each); an absent attribute releases its arrays.
+template <class A, class Device, class Points>
+void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, Points& s)
+{
+  const std::string what = std::string("point ") + A::kLabel;
+  const auto* in = A::Of(points);
+  d.Adopt(d.Stage(in, in ? points.count : 0, what.c_str()), A::Of(s), points.count);
+}
+
+template <class A, class Device, class Points>
+void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, Points& s)
+{
+  auto& out = A::Of(s);
+  if (!A::Of(points))
+  {
+    d.Release(out);
+    return;
+  }
+  const std::string what = std::string("point ") + A::kLabel;
+  const auto raw = d.Stage(A::Of(points), 3 * points.count, what.c_str());
+  d.Reserve(out, points.count, what.c_str());
+  const float* in = raw.Get();
+  Vec3f* unit = out.Get();
+  d.ForEach("UnitNormalKernel", points.count,
+    OCTORAY_LAMBDA(std::size_t i) { unit[i] = UnitNormal(in[3 * i], in[3 * i + 1], in[3 * i + 2]); });
+}
+
+// Colours become RGBA: 8-bit ones in color8, float ones in the attribute's
+// array; a missing alpha is opaque.
+template <class A, class Device, class Points>
+void Ingest(ColorInput, A, Device& d, const PointCloudView& points, Points& s)
+{
+  const std::size_t n = points.count;
+  const int cc = points.colorComponents;
+  auto& rgba = A::Of(s);
+  if (points.color8)
+  {
+    const auto raw = d.Stage(points.color8, cc * n, "point colours");
+    d.Release(rgba);
+    d.Reserve(s.color8, 4 * n, "point colours");
+    const std::uint8_t* in = raw.Get();
+    std::uint8_t* out = s.color8.Get();
+    d.ForEach("WidenColor8Kernel", n, OCTORAY_LAMBDA(std::size_t i) {
+      for (int c = 0; c < 4; ++c)
+      {
+        out[4 * i + c] = c < cc ? in[cc * i + c] : 255;
+      }
+    });
+  }
+  else if (points.colorFloat)
+  {
+    const auto raw = d.Stage(points.colorFloat, cc * n, "point colours");
+    d.Release(s.color8);
+    d.Reserve(rgba, n, "point colours");
+    const float* in = raw.Get();
+    Rgba* out = rgba.Get();
+    d.ForEach("WidenColorFloatKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+      const float* c = in + cc * i;
+      out[i] = Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f };
+    });
+  }
+  else
+  {
+    d.Release(s.color8);
+    d.Release(rgba);
+  }
+}
+
+// The cube a build uses: fitted to the staged positions, or the caller's
+// fixed one, which must hold them all. Checked before anything is replaced,
+// so that a refused build leaves the octree as it was; errors name the
+// first offending point with its coordinates as the caller gave them.
+template <class Device>
+RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArraysView& staged,
+  const PointCloudView& points, const BuildOptions& options)
+{
+  const Bounds b = PositionBounds(d, staged);
+  if (b.firstBad != kNoIndex)
+  {
+    throw Error(NonFinitePointMessage(b.firstBad, points.Position(b.firstBad)));
+  }
+  if (!options.fixedCube)
+  {
+    return RootCube::FromBounds(b.lo, b.hi);
+  }
+  // Every point is inside when both corners of the bounds are.
+  const RootCube cube = options.cube;
+  if (!cube.Contains(b.lo) || !cube.Contains(b.hi))
+  {
+    const std::uint64_t first = FirstFailedStep(d, scratch, "OutsideCubeKernel", staged.count,
+      OCTORAY_LAMBDA(std::size_t i) { return cube.Contains(staged.Position(i)); });
+    throw Error(OutsideCubeMessage(first, points.Position(first)));
+  }
+  return cube;
+}
+
+// Sorted (leaf key, point) pairs of the state's points, the leaf level and
+// the newNode histogram that gives every level's node count.
+struct SortedPoints
+{
+  const std::uint64_t* key;
+  const std::uint32_t* index;
+  std::uint32_t* spare; // the sort's other index array (n + 1 entries): room for run starts
+  int depth;
+  std::uint64_t histogram[2 * kDepthHistogramBins];
+};
+
+// Keys (computed, or the stored ones when they are current), sort, and one
+// histogram of neighbouring keys: the node count of every level and, for an
+// automatic depth (requestedDepth 0), the depth. Two copies to the host:
+// the key check, the histogram.
+template <class Device>
+SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  int requestedDepth, bool computeKeys, BuildStats& stats)
+{
+  const std::size_t n = s.count;
+  auto phase = std::chrono::steady_clock::now();
+  d.Reserve(s.points.key, n, "point keys");
+  for (int b = 0; b < 2; ++b)
+  {
+    d.Reserve(scratch.sortKey[b], n, "sort keys");
+    d.Reserve(scratch.sortIndex[b], n + 1, "sort indices");
+  }
+  const PointArraysView pts = s.Points();
+  std::uint64_t* pointKey = s.points.key.Get();
+  std::uint64_t* sortKey = scratch.sortKey[0].Get();
+  std::uint32_t* sortIndex = scratch.sortIndex[0].Get();
+  // Only the leaf level's bits need sorting when the depth is known.
+  const int leafShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
+  if (computeKeys)
+  {
+    // The cube holds every point (fitted or checked): a failure here is a bug.
+    const std::uint64_t outside = FirstFailedStep(d, scratch, "KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+      std::uint64_t key = 0;
+      const bool inside = ComputePointKey(pts, cube, i, key);
+      pointKey[i] = key;
+      sortKey[i] = key >> leafShift;
+      sortIndex[i] = static_cast<std::uint32_t>(i);
+      return inside;
+    });
+    if (outside != kNoIndex)
+    {
+      throw Error(OutsideCubeMessage(outside, StoredPosition(d, s, outside)));
+    }
+  }
+  else
+  {
+    d.ForEach("LeafKeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+      sortKey[i] = pointKey[i] >> leafShift;
+      sortIndex[i] = static_cast<std::uint32_t>(i);
+    });
+  }
+  stats.keySeconds = SecondsSince(phase);
+
+  phase = std::chrono::steady_clock::now();
+  SortedPoints sorted;
+  std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
+  std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
+  const int bits = requestedDepth > 0 ? 3 * requestedDepth : 3 * kMaxLevel;
+  const int result = d.SortPairs(keys, values, n, bits, "point keys");
+  std::uint64_t* sortedKey = keys[result];
+  sorted.key = sortedKey;
+  sorted.index = values[result];
+  sorted.spare = values[1 - result];
+  std::uint64_t* histogram = scratch.counters.Get() + kCounterHistogram;
+  d.FillBytes(histogram, 2 * kDepthHistogramBins, 0);
+  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
+    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(sortedKey, n, i, leafShift); }, histogram);
+  d.ToHost(histogram, 2 * kDepthHistogramBins, sorted.histogram, "NeighbourHistogramKernel");
+  sorted.depth = requestedDepth;
+  if (sorted.depth == 0)
+  {
+    sorted.depth = ChooseDepthFromHistograms(sorted.histogram, sorted.histogram + kDepthHistogramBins);
+    const int shift = 3 * (kMaxLevel - sorted.depth);
+    d.ForEach("ShiftKernel", n, OCTORAY_LAMBDA(std::size_t i) { sortedKey[i] >>= shift; });
+  }
+  stats.sortSeconds = SecondsSince(phase);
+  return sorted;
+}
+
+// The node arrays from the sorted points: leaves, then each level from the
+// one below, its nodes the runs of equal parent keys. The level sizes are
+// known from the histogram, so nothing returns to the host per level.
+template <class Device>
+void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const SortedPoints& sorted,
+  const RootCube& cube)
+{
+  const int depth = sorted.depth;
+  s.depth = depth;
+  s.cube = cube;
+  for (int l = 0; l <= kMaxLevel; ++l)
+  {
+    const std::uint64_t nodes = l <= depth ? NodesAtLevel(sorted.histogram, l) : 0;
+    s.levelBegin[l + 1] = s.levelBegin[l] + static_cast<std::uint32_t>(nodes);
+  }
+  const std::size_t nodes = s.levelBegin[depth + 1];
+  ForEachNodeArray([&](auto a) {
+    const std::string what = std::string("node ") + a.kLabel;
+    if (Present(a, s.attributes))
+    {
+      d.Reserve(a.Of(s.nodes), nodes, what.c_str());
+    }
+    else
+    {
+      d.Release(a.Of(s.nodes));
+    }
+  });
+  const OctreeView view = s.View();
+  const PointArraysView pts = s.Points();
+  std::uint32_t* starts = sorted.spare;
+
+  RunStarts(d, scratch, sorted.key, s.count, 0, starts);
+  const std::uint64_t* sortedKey = sorted.key;
+  const std::uint32_t* sortedIndex = sorted.index;
+  const std::uint32_t leafBegin = view.levelBegin[depth];
+  d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
+    ReduceLeaf(view, pts, sortedIndex, leafBegin + static_cast<std::uint32_t>(j), sortedKey[starts[j]], starts[j],
+      starts[j + 1]);
+  });
+  for (int l = depth - 1; l >= 0; --l)
+  {
+    const std::uint32_t begin = view.levelBegin[l];
+    const std::uint32_t childBegin = view.levelBegin[l + 1];
+    RunStarts(d, scratch, view.key + childBegin, view.LevelSize(l + 1), 3, starts);
+    d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
+      const std::uint32_t c0 = childBegin + starts[j];
+      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), view.key[c0] >> 3, c0, childBegin + starts[j + 1]);
+    });
+  }
+  d.Synchronize("octree build");
+}
+
+// Keys, sort and levels of the state's points inside `cube`: the octree.
+template <class Device>
+BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  int requestedDepth, bool computeKeys)
+{
+  BuildStats stats;
+  stats.points = s.count;
+  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, stats);
+  const auto phase = std::chrono::steady_clock::now();
+  LinkLevels(d, scratch, s, sorted, cube);
+  stats.levelSeconds = SecondsSince(phase);
+  stats.depth = s.depth;
+  stats.cube = cube;
+  stats.nodes = s.levelBegin[s.depth + 1];
+  for (int l = 0; l <= s.depth; ++l)
+  {
+    stats.nodesPerLevel.push_back(s.levelBegin[l + 1] - s.levelBegin[l]);
+  }
+  return stats;
+}
+
+// Engine::Build: checks the input, makes it the point state (`current`, or
+// a new one that replaces it once complete where the device builds aside)
+// and builds the octree.
+template <class Device>
+BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_ptr<OctreeState<Device>>& current,
+  const PointCloudView& points, const BuildOptions& options)
+{
+  ValidateCloud(points);
+  ValidateDepth(options.depth);
+  const std::size_t n = points.count;
+  d.Reserve(scratch.counters, kCounterSlots, "counters");
+  StagedPositions<Device> staged = StagePositions(d, points.xyzFloat, points.xyzDouble, n, "point positions");
+  const RootCube cube = CheckedCube(d, scratch, staged.View(n), points, options);
+
+  std::unique_ptr<OctreeState<Device>> fresh;
+  OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
+  s.count = n;
+  s.attributes = points.Attributes();
+  d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
+  d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
+  ForEachAttribute([&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, s.points); });
+  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true);
+  if (fresh)
+  {
+    current = std::move(fresh);
+  }
+  return stats;
+}
+
+// The in-place update of the moves listed (changed of them, indices into
+// the moved points' fromLeaf and toLeaf): counts and means adjusted along
+// both paths of each. False, with nothing changed, when a node would appear
+// or empty. Copies to the host: the two checks and the run count.
+template <class Device>
+bool UpdateInPlace(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const std::uint32_t* moves,
+  std::size_t changed, const std::uint32_t* indices, const std::uint64_t* fromLeaf, const std::uint64_t* toLeaf)
+{
+  const OctreeView view = s.View();
+  const PointArraysView pts = s.Points();
+  const std::size_t pathRecords = 2 * (static_cast<std::size_t>(s.depth) + 1);
+  const std::size_t records = changed * pathRecords;
+  typename Device::template Buffer<std::uint32_t> node[2], point[2];
+  for (int b = 0; b < 2; ++b)
+  {
+    d.Reserve(node[b], records, "update records");
+    d.Reserve(point[b], records + 1, "update records");
+  }
+  std::uint64_t* flag = scratch.counters.Get() + kCounterTopology;
+  d.FillBytes(flag, 1, 0);
+  std::uint32_t* recordNode = node[0].Get();
+  std::uint32_t* recordPoint = point[0].Get();
+  d.ForEach("PathRecordsKernel", changed, OCTORAY_LAMBDA(std::size_t c) {
+    const std::uint32_t k = moves[c];
+    const std::uint32_t i = indices ? indices[k] : k;
+    if (!WritePathRecords(view, i, fromLeaf[k], toLeaf[k], c * pathRecords, recordNode, recordPoint))
+    {
+      AtomicRaise(flag);
+    }
+  });
+  std::uint64_t blocked = 0;
+  d.ToHost(flag, 1, &blocked, "PathRecordsKernel");
+  if (blocked)
+  {
+    return false;
+  }
+  std::uint32_t* keys[2] = { node[0].Get(), node[1].Get() };
+  std::uint32_t* values[2] = { point[0].Get(), point[1].Get() };
+  const int result = d.SortPairs(keys, values, records, 32, "update records");
+  const std::uint32_t* byNode = keys[result];
+  const std::uint32_t* pointOf = values[result];
+  std::uint32_t* starts = values[1 - result];
+  RunStarts(d, scratch, byNode, records, 0, starts);
+  std::uint64_t runs = 0;
+  d.ToHost(scratch.counters.Get() + kCounterSelected, 1, &runs, "run starts");
+  --runs; // the end of the last run
+  d.ForEach("EmptiedNodesKernel", runs, OCTORAY_LAMBDA(std::size_t r) {
+    if (WouldEmpty(view, byNode, pointOf, starts[r], starts[r + 1]))
+    {
+      AtomicRaise(flag);
+    }
+  });
+  d.ToHost(flag, 1, &blocked, "EmptiedNodesKernel");
+  if (blocked)
+  {
+    return false;
+  }
+  d.ForEach("ApplyDeltasKernel", runs,
+    OCTORAY_LAMBDA(std::size_t r) { ApplyRecords(view, pts, byNode, pointOf, starts[r], starts[r + 1]); });
+  d.Synchronize("ApplyDeltasKernel");
+  return true;
+}
+
+// Engine::Update on a built state (the caller validated `positions`). Sets
+// `writing` before its first write to the state.
+template <class Device>
+UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s,
+  const PositionsView& positions, bool& writing)
+{
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t moved = positions.count;
+  UpdateStats stats;
+  stats.moved = moved;
+  d.Reserve(scratch.counters, kCounterSlots, "counters");
+  const auto staged = d.Stage(positions.indices, positions.indices ? moved : 0, "update indices");
+  const StagedPositions<Device> xyz =
+    StagePositions(d, positions.xyzFloat, positions.xyzDouble, moved, "update positions");
+  const PointArraysView to = xyz.View(moved);
+  const std::uint32_t* indices = staged.Get();
+  // Checked before the first write, so that a bad position changes nothing.
+  const std::uint64_t bad = FirstFailedStep(d, scratch, "FirstNonFiniteKernel", moved,
+    OCTORAY_LAMBDA(std::size_t k) { return IsFinitePoint(to.Position(k)); });
+  if (bad != kNoIndex)
+  {
+    throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, positions.Position(bad)));
+  }
+
+  writing = true;
+  float* xyzFloat = s.points.xyzFloat.Get();
+  double* xyzDouble = s.points.xyzDouble.Get();
+  d.ForEach("ScatterPositionsKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
+    const std::size_t i = indices ? indices[k] : k;
+    const Vec3d p = to.Position(k);
+    for (int a = 0; a < 3; ++a)
+    {
+      if (xyzDouble)
+      {
+        xyzDouble[3 * i + a] = p[a];
+      }
+      else
+      {
+        xyzFloat[3 * i + a] = static_cast<float>(p[a]);
+      }
+    }
+  });
+
+  // New keys; the moves that changed leaf, in order; the first point that
+  // left the cube. One copy to the host: that point and the moves' count.
+  typename Device::template Buffer<std::uint64_t> fromLeaf, toLeaf;
+  typename Device::template Buffer<std::uint32_t> changedMoves;
+  d.Reserve(fromLeaf, moved, "update moves");
+  d.Reserve(toLeaf, moved, "update moves");
+  d.Reserve(changedMoves, moved, "update moves");
+  const PointArraysView pts = s.Points();
+  const RootCube cube = s.cube;
+  const int leafShift = 3 * (kMaxLevel - s.depth);
+  std::uint64_t* pointKey = s.points.key.Get();
+  std::uint64_t* from = fromLeaf.Get();
+  std::uint64_t* into = toLeaf.Get();
+  std::uint64_t* first = scratch.counters.Get() + kCounterFirst;
+  d.FillBytes(first, 1, 0xFF);
+  d.ForEach("MovedKeysKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
+    const std::size_t i = indices ? indices[k] : k;
+    std::uint64_t key = 0;
+    const bool inside = ComputePointKey(pts, cube, i, key);
+    from[k] = pointKey[i] >> leafShift;
+    into[k] = inside ? key >> leafShift : from[k];
+    pointKey[i] = inside ? key : pointKey[i];
+    if (!inside)
+    {
+      AtomicMin(first, i);
+    }
+  });
+  d.Select(moved, OCTORAY_LAMBDA(std::size_t k) { return from[k] != into[k]; }, changedMoves.Get(),
+    scratch.counters.Get() + kCounterSelected);
+  std::uint64_t report[2]; // kCounterFirst, kCounterSelected
+  d.ToHost(first, 2, report, "MovedKeysKernel");
+  const std::size_t changed = report[1];
+
+  if (report[0] != kNoIndex)
+  {
+    // A point left the cube: rebuild around the new bounds, at the same depth.
+    const Bounds b = PositionBounds(d, pts);
+    BuildLevels(d, scratch, s, RootCube::FromBounds(b.lo, b.hi), s.depth, true);
+    stats.changedLeaf = moved;
+    stats.path = UpdateStats::Path::NewCube;
+  }
+  else if (changed == 0)
+  {
+    stats.path = UpdateStats::Path::Unchanged;
+  }
+  else if (changed <= s.count / kInPlaceUpdateShare &&
+    UpdateInPlace(d, scratch, s, changedMoves.Get(), changed, indices, from, into))
+  {
+    stats.changedLeaf = changed;
+    stats.path = UpdateStats::Path::InPlace;
+  }
+  else
+  {
+    // Nodes appear or empty, or too many points moved for the in-place
+    // path: the stored keys sorted again, the levels rebuilt in place.
+    BuildLevels(d, scratch, s, s.cube, s.depth, false);
+    stats.changedLeaf = changed;
+    stats.path = UpdateStats::Path::Relevel;
+  }
+  stats.seconds = SecondsSince(start);
+  return stats;
+}
+}

@@ -1,0 +1,78 @@
+// Everything one octree holds on a backend's device (its copy of the points
+// and its node arrays, in the device's buffers), the scratch the build keeps
+// between builds, and what the engine reports of both.
+#pragma once
+
+#include "Octree.h"
+#include "PointArrays.h"
+#include "PointCloud.h"
+
+#include <string>
+#include <type_traits>
+
+namespace octoray
+{
+template <class Device>
+struct OctreeState
+{
+  std::size_t count = 0;   // points
+  unsigned attributes = 0; // AttributeBits of the points, and so of the nodes
+  PointArrays<Device::template Buffer> points;
+
+  int depth = 0;
+  RootCube cube;
+  std::uint32_t levelBegin[kMaxLevel + 2] = {}; // nodes of level l: [levelBegin[l], levelBegin[l+1])
+  NodeArrays<Device::template Buffer> nodes;
+
+  PointArraysView Points() const
+  {
+    PointArraysView v;
+    v.count = count;
+    v.xyzFloat = DataOrNull(points.xyzFloat);
+    v.xyzDouble = DataOrNull(points.xyzDouble);
+    v.color8 = DataOrNull(points.color8);
+    ForEachAttribute([&](auto a) { a.Of(v) = DataOrNull(a.Of(points)); });
+    return v;
+  }
+
+  OctreeView View() const { return MakeOctreeView(nodes, depth, levelBegin, kMaxLevel + 2, attributes, cube); }
+};
+
+// Buffers a build keeps for the next, so that rebuilds of similar size
+// allocate nothing.
+template <class Device>
+struct DriverScratch
+{
+  template <typename T>
+  using Buffer = typename Device::template Buffer<T>;
+
+  // (key, point) pairs and the sort's second buffers; the spare index
+  // array holds run starts after the sort.
+  Buffer<std::uint64_t> sortKey[2];
+  Buffer<std::uint32_t> sortIndex[2];
+  Buffer<std::uint64_t> counters; // what loops report to the host (CounterSlot, OctreeDriver.h)
+
+  std::size_t Bytes() const
+  {
+    return sortKey[0].Bytes() + sortKey[1].Bytes() + sortIndex[0].Bytes() + sortIndex[1].Bytes() + counters.Bytes();
+  }
+};
+
+// What the engine holds, array by array, under the labels of Attributes.h;
+// `sortBytes`: the scratch of the build and of the device.
+template <class Device>
+MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes)
+{
+  MemoryReport m;
+  ForEachNodeArray([&](auto a) { m.Add(std::string("node ") + a.kLabel, a.Of(s.nodes).Bytes()); });
+  m.Add("point positions", s.points.xyzFloat.Bytes() + s.points.xyzDouble.Bytes());
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const std::size_t compact = std::is_same<typename A::Input, ColorInput>::value ? s.points.color8.Bytes() : 0;
+    m.Add(std::string("point ") + a.kLabel, a.Of(s.points).Bytes() + compact);
+  });
+  m.Add("point keys", s.points.key.Bytes());
+  m.Add("sort buffers", sortBytes);
+  return m;
+}
+}

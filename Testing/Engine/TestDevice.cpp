@@ -1,0 +1,270 @@
+// The shared pieces under the driver and the renderer, against plain
+// references: the CPU device's primitives (whatever the thread count, the
+// same results), the driver's run starts and first-failure search, the
+// attribute list's slots, and the vector vocabulary's rounding.
+#include <octoray/CpuDevice.h>
+#include <octoray/OctreeDriver.h>
+#include <octoray/RenderKernels.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+using namespace octoray;
+
+namespace
+{
+// Sizes on both sides of the thresholds where loops start splitting.
+const std::size_t kSizes[] = { 0, 1, 5, kParallelForMinItems + 3, kParallelPassMinItems + 17 };
+
+// check(n, device) for every size on devices of 1, 2 and 3 threads: the
+// results must not depend on how the work is split.
+template <typename Check>
+void OnEverySplit(Check&& check)
+{
+  for (std::size_t n : kSizes)
+  {
+    for (int threads : { 1, 2, 3 })
+    {
+      SCOPED_TRACE("n " + std::to_string(n) + ", threads " + std::to_string(threads));
+      CpuDevice d;
+      d.threads = threads;
+      check(n, d);
+    }
+  }
+}
+
+std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint64_t seed)
+{
+  std::mt19937_64 rng(seed);
+  std::vector<std::uint64_t> keys(n);
+  for (auto& k : keys)
+  {
+    k = rng() & ((std::uint64_t(1) << bits) - 1);
+  }
+  return keys;
+}
+}
+
+TEST(CpuDevice, ForEachReduceAndHistogramCoverEveryItemOnce)
+{
+  OnEverySplit([](std::size_t n, CpuDevice& d) {
+    std::vector<int> seen(n, 0);
+    int* out = seen.data();
+    d.ForEach("test", n, OCTORAY_LAMBDA(std::size_t i) { out[i] += 1; });
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+
+    const std::uint64_t sum = d.Reduce(
+      n, std::uint64_t(0), OCTORAY_LAMBDA(std::size_t i) { return std::uint64_t(i * i); },
+      OCTORAY_LAMBDA(std::uint64_t a, std::uint64_t b) { return a + b; });
+    std::uint64_t expected = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      expected += i * i;
+    }
+    EXPECT_EQ(sum, expected);
+
+    std::uint64_t counts[7] = { 5, 0, 0, 0, 0, 0, 0 }; // added to, not replaced
+    d.Histogram<7>("test", n, OCTORAY_LAMBDA(std::size_t i) {
+      return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
+    }, counts);
+    std::uint64_t reference[7] = { 5, 0, 0, 0, 0, 0, 0 };
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      ++reference[i % 3];
+      if (i % 2 == 0)
+      {
+        ++reference[3 + i % 4];
+      }
+    }
+    for (int b = 0; b < 7; ++b)
+    {
+      EXPECT_EQ(counts[b], reference[b]) << "bin " << b;
+    }
+  });
+}
+
+TEST(CpuDevice, SelectKeepsOrderAndCounts)
+{
+  OnEverySplit([](std::size_t n, CpuDevice& d) {
+    std::vector<std::uint32_t> out(n + 1, 0xDEADBEEFu);
+    std::uint64_t count = 12345;
+    d.Select(n, OCTORAY_LAMBDA(std::size_t i) { return (i * 7919) % 5 < 2; }, out.data(), &count);
+    std::vector<std::uint32_t> expected;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if ((i * 7919) % 5 < 2)
+      {
+        expected.push_back(static_cast<std::uint32_t>(i));
+      }
+    }
+    ASSERT_EQ(count, expected.size());
+    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), out.begin()));
+  });
+}
+
+// Stable, for both key widths and keys below 2^bits (the passes cover
+// `bits`), with the result where the return value says.
+template <typename Key>
+void ExpectStableSort(int bits)
+{
+  SCOPED_TRACE("bits " + std::to_string(bits));
+  OnEverySplit([bits](std::size_t n, CpuDevice& d) {
+    const std::vector<std::uint64_t> random = RandomKeys(n, bits, n + d.threads);
+    std::vector<Key> k0(random.begin(), random.end()), k1(n);
+    std::vector<std::uint32_t> v0(n), v1(n);
+    std::iota(v0.begin(), v0.end(), 0u);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> reference;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      reference.emplace_back(k0[i], static_cast<std::uint32_t>(i));
+    }
+    std::stable_sort(reference.begin(), reference.end(),
+      [](const auto& a, const auto& b) { return a.first < b.first; });
+    Key* keys[2] = { k0.data(), k1.data() };
+    std::uint32_t* values[2] = { v0.data(), v1.data() };
+    const int result = d.SortPairs(keys, values, n, bits, "test");
+    ASSERT_TRUE(result == 0 || result == 1);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      ASSERT_EQ(values[result][i], reference[i].second) << "position " << i;
+      ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
+    }
+  });
+}
+
+TEST(CpuDevice, SortPairsIsStable)
+{
+  ExpectStableSort<std::uint64_t>(63);
+  ExpectStableSort<std::uint64_t>(30);
+  ExpectStableSort<std::uint32_t>(29);
+  ExpectStableSort<std::uint32_t>(5);
+}
+
+TEST(CpuDevice, RunStartsAndFirstFailedStep)
+{
+  CpuDevice d;
+  d.threads = 2;
+  DriverScratch<CpuDevice> scratch;
+  d.Reserve(scratch.counters, kCounterSlots, "counters");
+  for (std::size_t n : kSizes)
+  {
+    SCOPED_TRACE("n " + std::to_string(n));
+    std::vector<std::uint64_t> keys = RandomKeys(n, 12, n);
+    std::sort(keys.begin(), keys.end());
+    for (int shift : { 0, 3 })
+    {
+      std::vector<std::uint32_t> starts(n + 1);
+      RunStarts(d, scratch, keys.data(), n, shift, starts.data());
+      std::vector<std::uint32_t> expected;
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        if (i == 0 || (keys[i] >> shift) != (keys[i - 1] >> shift))
+        {
+          expected.push_back(static_cast<std::uint32_t>(i));
+        }
+      }
+      expected.push_back(static_cast<std::uint32_t>(n));
+      EXPECT_EQ(scratch.counters.Get()[kCounterSelected], expected.size());
+      EXPECT_TRUE(std::equal(expected.begin(), expected.end(), starts.begin()));
+    }
+    const std::size_t bad = n / 3 + 1;
+    std::uint64_t first = kNoIndex;
+    for (std::size_t i = n; i-- > 0;)
+    {
+      first = i >= bad && i % 2 == 0 ? i : first;
+    }
+    EXPECT_EQ(FirstFailedStep(d, scratch, "test", n, OCTORAY_LAMBDA(std::size_t i) { return i < bad || i % 2; }),
+      first);
+  }
+}
+
+// The attribute list's slots are laid out in its order, every bit its own.
+TEST(Attributes, SlotsAndBitsFollowTheList)
+{
+  int slot = 0;
+  unsigned bits = 0;
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    EXPECT_EQ(A::kSlot, slot) << A::kLabel;
+    slot += AttributeValue<typename A::Type>::kSlots;
+    EXPECT_EQ(bits & A::kBit, 0u) << A::kLabel;
+    bits |= A::kBit;
+  });
+  EXPECT_EQ(slot, kSlotCount);
+  EXPECT_EQ(bits, (1u << kAttributeCount) - 1);
+  const Rgba c{ 0.25f, 0.5f, 0.75f, 1.0f };
+  float v[4];
+  AttributeValue<Rgba>::ToSlots(c, v);
+  EXPECT_EQ(v[2], 0.75f);
+  const double sum[4] = { 1.0, 2.0, 3.0, 4.0 };
+  const Rgba mean = AttributeValue<Rgba>::Mean(sum, 0.5);
+  EXPECT_EQ(mean.r, 0.5f);
+  EXPECT_EQ(mean.a, 2.0f);
+}
+
+// The vector operators round like the per-component expressions they stand
+// for (the backends' pictures depend on it): products and sums in the
+// written order, division by a length as a division.
+TEST(VecMath, OperatorsRoundLikeTheComponentExpressions)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  for (int i = 0; i < 10000; ++i)
+  {
+    const Vec3f a{ u(rng), u(rng), u(rng) }, b{ u(rng), u(rng), u(rng) };
+    const float s = u(rng);
+    EXPECT_EQ(Dot(a, b), a.x * b.x + a.y * b.y + a.z * b.z);
+    const Vec3f r = a - 2.0f * s * b;
+    EXPECT_EQ(r.y, a.y - 2.0f * s * b.y);
+    const float len = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+    const Vec3f n = Normalize(a);
+    EXPECT_EQ(n.x, a.x / len);
+    EXPECT_EQ(n.z, a.z / len);
+    const Vec3d w = ToDouble(a) + double(s) * ToDouble(b);
+    EXPECT_EQ(w.y, double(a.y) + double(s) * double(b.y));
+    Vec3f m = a;
+    m[1] = 7.0f;
+    EXPECT_EQ(m.y, 7.0f);
+    EXPECT_EQ(m[2], a.z);
+  }
+  EXPECT_EQ(Normalize(Vec3f{ 0, 0, 0 }).x, 0.0f);
+  EXPECT_EQ(Clamp01(-0.5f), 0.0f);
+  EXPECT_EQ(Clamp01(1.5), 1.0);
+  EXPECT_EQ(Clamp01(0.25f), 0.25f);
+  EXPECT_EQ(Clamp01(NAN), 0.0f);
+  EXPECT_EQ(Clamp01(-0.0), 0.0);
+}
+
+TEST(VecMath, ChannelToByteRoundsToNearest)
+{
+  EXPECT_EQ(ChannelToByte(-1.0f), 0);
+  EXPECT_EQ(ChannelToByte(2.0f), 255);
+  EXPECT_EQ(ChannelToByte(0.5f / 255.0f), 1);
+  EXPECT_EQ(ChannelToByte(0.49f / 255.0f), 0);
+  EXPECT_EQ(ChannelToByte(127.5f / 255.0f), 128);
+}
+
+// One transfer-function lookup for node colours and projected values: the
+// scalar range maps onto the table's entries, rounded to the nearest;
+// outside it the ends; NaN the first entry.
+TEST(VecMath, TransferLookupClampsAndRounds)
+{
+  FrameConstants f;
+  const Rgba table[5] = { { 0, 0, 0, 0 }, { 1, 0, 0, 0 }, { 2, 0, 0, 0 }, { 3, 0, 0, 0 }, { 4, 0, 0, 0 } };
+  f.transfer = table;
+  f.transferSize = 5;
+  f.transferRange[0] = -1.0f;
+  f.transferRange[1] = 1.0f;
+  EXPECT_EQ(TransferLookup(f, -1.0f).r, 0.0f);
+  EXPECT_EQ(TransferLookup(f, 1.0f).r, 4.0f);
+  EXPECT_EQ(TransferLookup(f, 0.0f).r, 2.0f);
+  EXPECT_EQ(TransferLookup(f, 0.2f).r, 2.0f);
+  EXPECT_EQ(TransferLookup(f, 0.3f).r, 3.0f);
+  EXPECT_EQ(TransferLookup(f, -7.0f).r, 0.0f);
+  EXPECT_EQ(TransferLookup(f, 9.0f).r, 4.0f);
+  EXPECT_EQ(TransferLookup(f, NAN).r, 0.0f);
+}
