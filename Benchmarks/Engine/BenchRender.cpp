@@ -30,10 +30,6 @@
 #include <string>
 #include <vector>
 
-#ifndef OCTORAY_LIDAR_FILE
-#define OCTORAY_LIDAR_FILE "Data/Particles/lidar_simple.particles"
-#endif
-
 namespace
 {
 using namespace octoray;

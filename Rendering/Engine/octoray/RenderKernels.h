@@ -250,6 +250,16 @@ OCTORAY_HD Vec3f EntryPoint(const Ray& ray, const NodeHit& hit)
   return p;
 }
 
+// Where shadow rays start: one voxel above the hit along its shading normal.
+// A smooth normal (the points' normals, a CT's gradient) leans away from the
+// voxel faces of the staircase the octree draws, so a ray started on the
+// face itself meets the neighbouring steps and speckles lit surfaces with
+// shadow acne; one voxel along the normal clears the steps.
+OCTORAY_HD Vec3f ShadowRayOrigin(const Vec3f& surface, const Vec3f& normal, const NodeHit& hit)
+{
+  return surface + hit.size * normal;
+}
+
 // Lit colour of a surface hit (before reflection): depth cue, or Phong
 // (ambient + diffuse + specular) from every light that sees the hit.
 template <typename F>
@@ -292,7 +302,7 @@ OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, c
     if constexpr (F::kShadows)
     {
       Ray shadow;
-      shadow.origin = p;
+      shadow.origin = ShadowRayOrigin(p, n, hit);
       SetDirection(shadow, l);
       shadow.tMin = 0.0f;
       shadow.tMax = distance;
