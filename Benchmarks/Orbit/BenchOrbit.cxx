@@ -23,7 +23,7 @@
 //
 //   octoray_bench_orbit [--points 1e6,1e7,1e8] [--sizes 1920x1080,3840x2160]
 //     [--methods octoray,octoray-host,pointgauss,points,smart-256,smart-512]
-//     [--file particles.txt] [--frames 60] [--seconds 6] [--json out.json]
+//     [--file particles.txt|cloud.pcd] [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json]
 //     [--images DIR]   (each method's first frame as a PNG)
 #include "BenchUtil.h"
 
@@ -36,6 +36,7 @@
 #include "vtkNew.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkPCDReader.h"
 #include "vtkParticleTextReader.h"
 #include "vtkPNGWriter.h"
 #include "vtkPiecewiseFunction.h"
@@ -173,6 +174,7 @@ struct Method
 {
   vtkSmartPointer<vtkProp> Prop;
   double PrepareSeconds = 0.0; // resampling onto an image, before the first render
+  bool PreparedEarlier = false; // for an earlier window size: not in this run's clock
   vtkOctreeVolumeMapper* Octree = nullptr;
   std::string Note;
 };
@@ -238,40 +240,13 @@ Method Points(const Scene& scene)
   return m;
 }
 
-// The points resampled onto `grid`^3 voxels over their bounds by
-// vtkPointInterpolator with a Gaussian kernel (radius: the scene's splat
-// radius, at least a voxel), then vtkSmartVolumeMapper: RGBA voxels with the
-// interpolated colour and, as alpha, the interpolator's mask of voxels that
-// had points within the radius.
-Method SmartVolume(const Scene& scene, int grid)
+// RGBA voxels from the interpolator's output: its colour and, as alpha, its
+// mask of voxels that had points within the kernel's radius.
+vtkSmartPointer<vtkUnsignedCharArray> RgbaVoxels(vtkDataSet* out, vtkDataArray* valid, const int dims[3])
 {
-  const double* b = scene.Bounds;
-  const double longest = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
-  const double h = longest / (grid - 1);
-  const double t0 = Now();
-  vtkNew<vtkImageData> image;
-  int dims[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    dims[a] = std::max(2, static_cast<int>(std::ceil((b[2 * a + 1] - b[2 * a]) / h)) + 1);
-  }
-  image->SetDimensions(dims);
-  image->SetOrigin(b[0], b[2], b[4]);
-  image->SetSpacing(h, h, h);
-  vtkNew<vtkGaussianKernel> kernel;
-  kernel->SetRadius(std::max(scene.Radius, h));
-  kernel->SetSharpness(2.0);
-  vtkNew<vtkPointInterpolator> interpolator;
-  interpolator->SetInputData(image);
-  interpolator->SetSourceData(scene.Cloud);
-  interpolator->SetKernel(kernel);
-  interpolator->SetNullPointsStrategyToMaskPoints();
-  interpolator->Update();
-  vtkDataSet* out = interpolator->GetOutput();
   auto* colours = vtkDataArray::SafeDownCast(out->GetPointData()->GetArray("Colors"));
-  auto* valid = vtkDataArray::SafeDownCast(out->GetPointData()->GetArray(interpolator->GetValidPointsMaskArrayName()));
   const vtkIdType voxels = out->GetNumberOfPoints();
-  vtkNew<vtkUnsignedCharArray> rgba;
+  auto rgba = vtkSmartPointer<vtkUnsignedCharArray>::New();
   rgba->SetName("RGBA");
   rgba->SetNumberOfComponents(4);
   rgba->SetNumberOfTuples(voxels);
@@ -306,13 +281,74 @@ Method SmartVolume(const Scene& scene, int grid)
       }
     }
   }
-  auto volumeImage = vtkSmartPointer<vtkImageData>::New();
-  volumeImage->CopyStructure(out);
-  volumeImage->GetPointData()->SetScalars(rgba);
+  return rgba;
+}
+
+struct Resampled
+{
+  vtkSmartPointer<vtkImageData> Image;
+  double Seconds = 0.0;
+  bool Earlier = false; // done for an earlier window size
+};
+
+// The points resampled onto `grid`^3 voxels over their bounds by
+// vtkPointInterpolator with a Gaussian kernel (radius: the scene's splat
+// radius, at least a voxel). The image does not depend on the window size:
+// it is made once per scene and grid, and its time counted again in each
+// window size's first picture.
+Resampled Resample(const Scene& scene, int grid)
+{
+  static std::map<std::string, Resampled> done;
+  const std::string key = scene.Name + "/" + std::to_string(scene.Cloud->GetNumberOfPoints()) + "/" + std::to_string(grid);
+  if (done.count(key))
+  {
+    Resampled earlier = done[key];
+    earlier.Earlier = true;
+    return earlier;
+  }
+  const double* b = scene.Bounds;
+  const double longest = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
+  const double h = longest / (grid - 1);
+  const double t0 = Now();
+  vtkNew<vtkImageData> image;
+  int dims[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    dims[a] = std::max(2, static_cast<int>(std::ceil((b[2 * a + 1] - b[2 * a]) / h)) + 1);
+  }
+  image->SetDimensions(dims);
+  image->SetOrigin(b[0], b[2], b[4]);
+  image->SetSpacing(h, h, h);
+  vtkNew<vtkGaussianKernel> kernel;
+  kernel->SetRadius(std::max(scene.Radius, h));
+  kernel->SetSharpness(2.0);
+  vtkNew<vtkPointInterpolator> interpolator;
+  interpolator->SetInputData(image);
+  interpolator->SetSourceData(scene.Cloud);
+  interpolator->SetKernel(kernel);
+  interpolator->SetNullPointsStrategyToMaskPoints();
+  interpolator->Update();
+  vtkDataSet* out = interpolator->GetOutput();
+  auto* valid = vtkDataArray::SafeDownCast(
+    out->GetPointData()->GetArray(interpolator->GetValidPointsMaskArrayName().c_str()));
+  Resampled r;
+  r.Image = vtkSmartPointer<vtkImageData>::New();
+  r.Image->CopyStructure(out);
+  r.Image->GetPointData()->SetScalars(RgbaVoxels(out, valid, dims));
+  r.Seconds = Now() - t0;
+  done[key] = r;
+  return r;
+}
+
+// vtkSmartVolumeMapper (GPU ray casting) of the resampled RGBA voxels.
+Method SmartVolume(const Scene& scene, int grid)
+{
+  const Resampled resampled = Resample(scene, grid);
   Method m;
-  m.PrepareSeconds = Now() - t0;
+  m.PrepareSeconds = resampled.Seconds;
+  m.PreparedEarlier = resampled.Earlier;
   vtkNew<vtkSmartVolumeMapper> mapper;
-  mapper->SetInputData(volumeImage);
+  mapper->SetInputData(resampled.Image);
   mapper->SetRequestedRenderModeToGPU();
   auto volume = vtkSmartPointer<vtkVolume>::New();
   volume->SetMapper(mapper);
@@ -329,6 +365,7 @@ Method SmartVolume(const Scene& scene, int grid)
   property->SetScalarOpacity(opacity);
   volume->SetProperty(property);
   m.Prop = volume;
+  const int* dims = resampled.Image->GetDimensions();
   m.Note = std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]);
   return m;
 }
@@ -411,7 +448,7 @@ Result Orbit(const Scene& scene, const std::string& name, int width, int height,
   ren->ResetCameraClippingRange(scene.Bounds);
   window->Render();
   gl->WaitForCompletion();
-  r.FirstPictureSeconds = Now() - t0;
+  r.FirstPictureSeconds = Now() - t0 + (m.PreparedEarlier ? m.PrepareSeconds : 0.0);
   r.PrepareSeconds = m.PrepareSeconds;
   r.Note = m.Note;
   r.GpuBytes = DeviceBytesUsed() - before;
@@ -482,22 +519,172 @@ Scene MakeScene(const std::string& name, vtkSmartPointer<vtkPolyData> cloud, dou
   s.Radius = 1.5 * longest / std::sqrt(static_cast<double>(cloud->GetNumberOfPoints()));
   return s;
 }
+
+struct Options
+{
+  std::string Points = "1e6,1e7,1e8", Sizes = "1920x1080,3840x2160",
+              Methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", File, Json, Images;
+  int Frames = 60;
+  double Seconds = 6.0, MaxPrepare = 90.0;
+};
+
+// The generated point sets, and the file's points (a particle text file or a
+// PCL point cloud) as a scene of its own.
+std::vector<Scene> LoadScenes(const Options& o)
+{
+  std::vector<Scene> scenes;
+  for (const std::string& count : SplitList(o.Points))
+  {
+    const auto n = static_cast<std::size_t>(std::strtod(count.c_str(), nullptr));
+    const double t0 = Now();
+    vtkSmartPointer<vtkPolyData> cloud = ClusteredPoints(n);
+    scenes.push_back(MakeScene("clusters", cloud, Now() - t0));
+  }
+  if (!o.File.empty())
+  {
+    const double t0 = Now();
+    const bool pcd = o.File.size() > 4 && o.File.compare(o.File.size() - 4, 4, ".pcd") == 0;
+    vtkSmartPointer<vtkPointFileReader> reader;
+    if (pcd)
+    {
+      reader = vtkSmartPointer<vtkPCDReader>::New();
+    }
+    else
+    {
+      reader = vtkSmartPointer<vtkParticleTextReader>::New();
+    }
+    reader->SetFileName(o.File.c_str());
+    reader->Update();
+    auto cloud = vtkSmartPointer<vtkPolyData>::New();
+    cloud->ShallowCopy(reader->GetOutput());
+    cloud->SetVerts(nullptr);
+    scenes.push_back(MakeScene(o.File.substr(o.File.find_last_of('/') + 1), cloud, Now() - t0));
+  }
+  return scenes;
+}
+
+Record ToRecord(const Result& r)
+{
+  Record record;
+  record.name = "orbit " + r.Scene + " " + std::to_string(r.Width) + "x" + std::to_string(r.Height) + " " + r.Method;
+  record.backend = r.Method.rfind("octoray", 0) == 0 ? "cuda" : "vtk";
+  record.n = r.Points;
+  record.seconds = r.MedianFrame;
+  record.With("first_picture_s", r.FirstPictureSeconds)
+    .With("prepare_s", r.PrepareSeconds)
+    .With("p95_frame_s", r.P95Frame)
+    .With("frames", r.Frames)
+    .With("gpu_bytes", r.GpuBytes)
+    .With("width", r.Width)
+    .With("height", r.Height);
+  if (!r.Backend.empty())
+  {
+    record.With("trace_s", r.Trace).With("depth_read_s", r.Depth).With("transfer_s", r.Transfer).With("draw_s", r.Draw);
+  }
+  return record;
+}
+
+// The ratios, where the methods ran: octoray's frame against the
+// fastest VTK frame and against its own picture through host memory, and its
+// first picture against vtkSmartVolumeMapper's.
+void PrintRatios(const std::map<std::string, Result>& results)
+{
+  const auto octoray = results.find("octoray");
+  if (octoray == results.end())
+  {
+    return;
+  }
+  const Result& o = octoray->second;
+  const Result* fastest = nullptr;
+  const Result* smart = nullptr;
+  for (const auto& [method, r] : results)
+  {
+    if (method.rfind("octoray", 0) == 0)
+    {
+      continue;
+    }
+    if (!fastest || r.MedianFrame < fastest->MedianFrame)
+    {
+      fastest = &r;
+    }
+    if (method.rfind("smart", 0) == 0 && (!smart || r.FirstPictureSeconds < smart->FirstPictureSeconds))
+    {
+      smart = &r;
+    }
+  }
+  std::printf("  => octoray frame %.2f ms", 1e3 * o.MedianFrame);
+  if (fastest)
+  {
+    std::printf("; fastest VTK frame (%s) %.2f ms, %.2fx octoray's", fastest->Method.c_str(), 1e3 * fastest->MedianFrame,
+      fastest->MedianFrame / o.MedianFrame);
+  }
+  if (smart)
+  {
+    std::printf("; first picture %.3f s, %.3fx %s's", o.FirstPictureSeconds,
+      o.FirstPictureSeconds / smart->FirstPictureSeconds, smart->Method.c_str());
+  }
+  const auto host = results.find("octoray-host");
+  if (host != results.end())
+  {
+    std::printf("; picture through host memory %.2f ms a frame", 1e3 * host->second.MedianFrame);
+  }
+  std::printf("\n");
+}
+
+// A resampling onto grid^3 voxels whose time, extrapolated from the last
+// one's seconds per voxel, would pass --max-prepare.
+bool ResamplingTooSlow(const std::string& method, double secondsPerVoxel, const Options& o, double& estimate)
+{
+  if (method.rfind("smart-", 0) != 0 || secondsPerVoxel <= 0.0)
+  {
+    return false;
+  }
+  const double grid = std::stod(method.substr(6));
+  estimate = secondsPerVoxel * grid * grid * grid;
+  return estimate > o.MaxPrepare;
+}
+
+// Every method on one scene at one window size.
+void RunSize(const Scene& scene, int w, int h, const Options& o, std::vector<Record>& records)
+{
+  std::map<std::string, Result> results;
+  double secondsPerVoxel = 0.0; // the last resampling's
+  for (const std::string& method : SplitList(o.Methods))
+  {
+    double estimate = 0.0;
+    if (ResamplingTooSlow(method, secondsPerVoxel, o, estimate))
+    {
+      std::printf("%-10s %11lld %4dx%-4d %-13s skipped: resampling estimated at %.0f s (over --max-prepare %.0f)\n",
+        scene.Name.c_str(), static_cast<long long>(scene.Cloud->GetNumberOfPoints()), w, h, method.c_str(), estimate,
+        o.MaxPrepare);
+      continue;
+    }
+    const Result r = Orbit(scene, method, w, h, o.Frames, o.Seconds, o.Images);
+    if (method.rfind("smart-", 0) == 0)
+    {
+      const double grid = std::stod(method.substr(6));
+      secondsPerVoxel = r.PrepareSeconds / (grid * grid * grid);
+    }
+    Print(r);
+    results[method] = r;
+    records.push_back(ToRecord(r));
+  }
+  PrintRatios(results);
+}
 }
 
 int main(int argc, char* argv[])
 {
-  std::string points = "1e6,1e7,1e8", sizes = "1920x1080,3840x2160",
-              methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", file, json, images;
-  int frames = 60;
-  double seconds = 6.0, maxPrepare = 90.0;
+  Options o;
   CommandLine cli;
-  cli.Text("--points", points).Text("--sizes", sizes).Text("--methods", methods).Text("--file", file);
-  cli.Integer("--frames", frames, 3).Real("--seconds", seconds).Text("--json", json).Text("--images", images);
-  cli.Real("--max-prepare", maxPrepare);
+  cli.Text("--points", o.Points).Text("--sizes", o.Sizes).Text("--methods", o.Methods).Text("--file", o.File);
+  cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
+  cli.Real("--max-prepare", o.MaxPrepare);
   if (!cli.Parse(argc, argv))
   {
-    std::fprintf(stderr, "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] "
-                         "[--file particles.txt] [--frames 60] [--seconds 6] [--json out.json] [--images DIR]\n",
+    std::fprintf(stderr,
+      "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] [--file particles.txt|cloud.pcd]\n"
+      "          [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json] [--images DIR]\n",
       argv[0]);
     return 2;
   }
@@ -506,108 +693,18 @@ int main(int argc, char* argv[])
     std::printf("no usable CUDA device: octoray falls back to the CPU and GPU memory reads 0\n");
   }
   cudaFree(nullptr); // the CUDA context first: its own memory is nobody's cost
-  std::vector<Scene> scenes;
-  for (const std::string& count : SplitList(points))
-  {
-    const auto n = static_cast<std::size_t>(std::strtod(count.c_str(), nullptr));
-    const double t0 = Now();
-    vtkSmartPointer<vtkPolyData> cloud = ClusteredPoints(n);
-    scenes.push_back(MakeScene("clusters", cloud, Now() - t0));
-  }
-  if (!file.empty())
-  {
-    const double t0 = Now();
-    vtkNew<vtkParticleTextReader> reader;
-    reader->SetFileName(file.c_str());
-    reader->Update();
-    auto cloud = vtkSmartPointer<vtkPolyData>::New();
-    cloud->ShallowCopy(reader->GetOutput());
-    cloud->SetVerts(nullptr);
-    scenes.push_back(MakeScene(file.substr(file.find_last_of('/') + 1), cloud, Now() - t0));
-  }
   std::vector<Record> records;
-  for (const Scene& scene : scenes)
+  for (const Scene& scene : LoadScenes(o))
   {
     std::printf("\n%s, %lld points: generated or read in %.2f s\n", scene.Name.c_str(),
       static_cast<long long>(scene.Cloud->GetNumberOfPoints()), scene.PrepareSeconds);
-    for (const std::string& size : SplitList(sizes))
+    for (const std::string& size : SplitList(o.Sizes))
     {
       int w = 0, h = 0;
       std::sscanf(size.c_str(), "%dx%d", &w, &h);
-      std::map<std::string, Result> results;
-      double resampleSeconds = 0.0; // the last resampling: seconds per voxel
-      for (const std::string& method : SplitList(methods))
-      {
-        if (method.rfind("smart-", 0) == 0 && resampleSeconds > 0.0)
-        {
-          const double grid = std::stod(method.substr(6));
-          const double estimate = resampleSeconds * grid * grid * grid;
-          if (estimate > maxPrepare)
-          {
-            std::printf("%-10s %11lld %4dx%-4d %-13s skipped: resampling estimated at %.0f s (over --max-prepare %.0f)\n",
-              scene.Name.c_str(), static_cast<long long>(scene.Cloud->GetNumberOfPoints()), w, h, method.c_str(),
-              estimate, maxPrepare);
-            continue;
-          }
-        }
-        const Result r = Orbit(scene, method, w, h, frames, seconds, images);
-        if (method.rfind("smart-", 0) == 0)
-        {
-          const double grid = std::stod(method.substr(6));
-          resampleSeconds = r.PrepareSeconds / (grid * grid * grid);
-        }
-        Print(r);
-        results[method] = r;
-        Record record;
-        record.name = "orbit " + scene.Name + " " + size + " " + method;
-        record.backend = method.rfind("octoray", 0) == 0 ? "cuda" : "vtk";
-        record.n = r.Points;
-        record.seconds = r.MedianFrame;
-        record.With("first_picture_s", r.FirstPictureSeconds)
-          .With("prepare_s", r.PrepareSeconds)
-          .With("p95_frame_s", r.P95Frame)
-          .With("frames", r.Frames)
-          .With("gpu_bytes", r.GpuBytes)
-          .With("width", w)
-          .With("height", h);
-        if (!r.Backend.empty())
-        {
-          record.With("trace_s", r.Trace).With("depth_read_s", r.Depth).With("transfer_s", r.Transfer).With("draw_s", r.Draw);
-        }
-        records.push_back(record);
-      }
-      // The ratios: octoray against the fastest VTK frame, and its
-      // first picture against vtkSmartVolumeMapper's.
-      if (results.count("octoray"))
-      {
-        const Result& o = results["octoray"];
-        double fastest = 0.0, smartFirst = 0.0;
-        std::string fastestName, smartName;
-        for (const auto& [method, r] : results)
-        {
-          if (method.rfind("octoray", 0) == 0)
-          {
-            continue;
-          }
-          if (fastest == 0.0 || r.MedianFrame < fastest)
-          {
-            fastest = r.MedianFrame;
-            fastestName = method;
-          }
-          if (method.rfind("smart", 0) == 0 && (smartFirst == 0.0 || r.FirstPictureSeconds < smartFirst))
-          {
-            smartFirst = r.FirstPictureSeconds;
-            smartName = method;
-          }
-        }
-        std::printf("  => octoray frame %.2f ms: %.1fx faster than the fastest VTK path (%s, %.2f ms); first picture "
-                    "%.3f of %s's; interop %.2f ms vs host %.2f ms a frame\n",
-          1e3 * o.MedianFrame, fastest / o.MedianFrame, fastestName.c_str(), 1e3 * fastest,
-          smartFirst > 0 ? o.FirstPictureSeconds / smartFirst : 0.0, smartName.c_str(), 1e3 * o.MedianFrame,
-          results.count("octoray-host") ? 1e3 * results["octoray-host"].MedianFrame : 0.0);
-      }
+      RunSize(scene, w, h, o, records);
     }
   }
-  SaveRecords(json, records);
+  SaveRecords(o.Json, records);
   return 0;
 }

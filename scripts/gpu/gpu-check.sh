@@ -117,7 +117,7 @@ for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper
   [ -f "$out/$f.log" ] && echo "$f: $(grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out/$f.log" | sort | uniq -c | tr -s ' ' | paste -sd';')"
 done
 [ -f "$out/bench.log" ] && grep -E "^(device|build|update|render)" "$out/bench.log"
-[ -f "$out/orbit.log" ] && grep -E "^(clusters|  =>)" "$out/orbit.log" | cut -c1-200
+[ -f "$out/orbit.log" ] && grep -E "points: generated|frame median|  =>|skipped" "$out/orbit.log" | cut -c1-220
 printf '%s\n' "${status[@]}"
 } | tee "$out/summary.txt"
 # What `make report` reads, in one archive (the device tool brings back only
