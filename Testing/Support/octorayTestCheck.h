@@ -19,6 +19,13 @@ inline int& Failures()
   return failures;
 }
 
+// A failed check: "file:line: what", counted.
+inline void Report(const char* file, int line, const std::string& what)
+{
+  std::cerr << file << ":" << line << ": " << what << std::endl;
+  ++Failures();
+}
+
 // EXIT_SUCCESS, or EXIT_FAILURE after saying how many checks failed.
 inline int Result()
 {
@@ -36,8 +43,7 @@ inline int Result()
   {                                                                                                \
     if (!(cond))                                                                                   \
     {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": check failed: " #cond << std::endl;           \
-      ++octoray_test::Failures();                                                                  \
+      octoray_test::Report(__FILE__, __LINE__, "check failed: " #cond);                            \
     }                                                                                              \
   } while (0)
 
@@ -45,12 +51,10 @@ inline int Result()
 #define CHECK_CONTAINS(text, part)                                                                 \
   do                                                                                               \
   {                                                                                                \
-    const std::string t_ = (text);                                                                 \
-    if (t_.find(part) == std::string::npos)                                                        \
+    const std::string t_ = (text), p_ = (part);                                                    \
+    if (t_.find(p_) == std::string::npos)                                                          \
     {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": '" << t_ << "' lacks '" << (part) << "'"     \
-                << std::endl;                                                                      \
-      ++octoray_test::Failures();                                                                  \
+      octoray_test::Report(__FILE__, __LINE__, "'" + t_ + "' lacks '" + p_ + "'");                 \
     }                                                                                              \
   } while (0)
 
@@ -61,9 +65,8 @@ inline int Result()
     const std::string t_ = (text), e_ = (expected);                                                \
     if (t_ != e_)                                                                                  \
     {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ":\n  got      '" << t_ << "'\n  expected '"    \
-                << e_ << "'" << std::endl;                                                         \
-      ++octoray_test::Failures();                                                                  \
+      octoray_test::Report(                                                                        \
+        __FILE__, __LINE__, "\n  got      '" + t_ + "'\n  expected '" + e_ + "'");                \
     }                                                                                              \
   } while (0)
 

@@ -135,8 +135,7 @@ void Image(Dicom& d)
     const std::string e_ = (dicom).Check();                                                        \
     if (!e_.empty())                                                                               \
     {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": sound file rejected: " << e_ << std::endl;    \
-      ++octoray_test::Failures();                                                                  \
+      octoray_test::Report(__FILE__, __LINE__, "sound file rejected: " + e_);                      \
     }                                                                                              \
   } while (0)
 
