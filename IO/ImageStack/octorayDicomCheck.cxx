@@ -188,7 +188,8 @@ std::string Check(Bytes& bytes)
 {
   const uint64_t size = bytes.Size();
   unsigned char magic[4];
-  const bool part10 = size >= 132 && bytes.Read(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0;
+  const bool part10 =
+    size >= 132 && bytes.Read(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0;
   if (!bytes.Error.empty())
   {
     return bytes.Error;

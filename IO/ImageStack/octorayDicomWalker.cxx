@@ -31,7 +31,8 @@ bool DataSetWalker::Walk(uint64_t pos, uint64_t end)
 //------------------------------------------------------------------------------
 // Elements from pos to end, or (itemStart > 0) up to and including the item
 // delimiter of an undefined-length item that starts at itemStart.
-bool DataSetWalker::DataSet(uint64_t& pos, uint64_t end, uint64_t itemStart, int depth, Encoding enc)
+bool DataSetWalker::DataSet(
+  uint64_t& pos, uint64_t end, uint64_t itemStart, int depth, Encoding enc)
 {
   const char* where = depth == 0 ? "" : " (in a sequence item)";
   while (pos < end)
@@ -133,7 +134,8 @@ bool DataSetWalker::DefinedLengthValue(const Header& h, int depth, Encoding enc)
 //------------------------------------------------------------------------------
 // The items of sequence seq; pos ends after it. A defined-length sequence
 // ends at end (its value's end).
-bool DataSetWalker::Sequence(const Header& seq, uint64_t& pos, uint64_t end, int depth, Encoding enc)
+bool DataSetWalker::Sequence(
+  const Header& seq, uint64_t& pos, uint64_t end, int depth, Encoding enc)
 {
   if (depth > octoray::DicomMaximumDepth)
   {

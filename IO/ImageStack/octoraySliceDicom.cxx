@@ -143,7 +143,8 @@ bool ReadSlice(const std::string& f, const DicomSlice* first, size_t files, Dico
   s.Height = dims[1];
   s.Frames = img.GetNumberOfDimensions() > 2 ? dims[2] : 1;
   s.Samples = pf.GetSamplesPerPixel();
-  if (first && (s.Width != first->Width || s.Height != first->Height || s.Samples != first->Samples))
+  if (first &&
+    (s.Width != first->Width || s.Height != first->Height || s.Samples != first->Samples))
   {
     error = MismatchMessage("DICOM slice", f, Describe(s), first->File, Describe(*first));
     return false;

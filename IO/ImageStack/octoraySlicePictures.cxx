@@ -157,7 +157,8 @@ bool ListPages(const std::vector<std::string>& files, std::vector<Page>& pages,
       else if (page.Width != format.Width || page.Height != format.Height ||
         page.Channels != format.Channels || page.Type != format.Type)
       {
-        error = MismatchMessage("slice", page.Name, page.Describe(), format.Name, format.Describe());
+        error =
+          MismatchMessage("slice", page.Name, page.Describe(), format.Name, format.Describe());
         return false;
       }
       pages.push_back({ f, s });

@@ -133,7 +133,8 @@ bool ReadColour(const char* name, const char* depthName, int w, int h,
   std::vector<unsigned char> all(static_cast<size_t>(w) * h * cs.nchannels);
   if (!cin->read_image(0, 0, 0, cs.nchannels, TypeDesc::UINT8, all.data()))
   {
-    error = std::string("cannot read the pixels of colour image '") + name + "': " + cin->geterror();
+    error =
+      std::string("cannot read the pixels of colour image '") + name + "': " + cin->geterror();
     return false;
   }
   rgb.resize(static_cast<size_t>(w) * h * 3);

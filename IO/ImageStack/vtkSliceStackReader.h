@@ -209,7 +209,8 @@ private:
   void operator=(const vtkSliceStackReader&) = delete;
 
   bool ListSlices(std::vector<std::string>& files);
-  bool ReadStack(const std::vector<std::string>& files, vtkImageData* image, vtkPolyData* particles);
+  bool ReadStack(
+    const std::vector<std::string>& files, vtkImageData* image, vtkPolyData* particles);
   int KeepLastOutputs(vtkPolyData* output, vtkImageData* image);
   void Fail(const std::string& message);
 };
