@@ -56,8 +56,8 @@ ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fr
 # Coverage for libFuzzer in the project's code (the readers the fuzz targets
 # call), not only in the targets themselves.
 ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
-ASAN_TARGETS = octoray_engine_tests TestParticleTextReader TestSliceStackReader TestDicomCheck \
-  TestReaderRobustness TestSceneLeaks octorayIOParticlesCxxTests octoray_fuzz_ParticleHeader \
+ASAN_TARGETS = octoray_engine_tests octorayIOParticlesCxxTests octorayIOImageStackCxxTests \
+  octorayFiltersPCLCxxTests TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader \
   octoray_fuzz_ParticleText octoray_fuzz_PCD octoray_fuzz_SliceStackMetadata \
   octorayIOParticlesPython octorayIOImageStackPython octorayFiltersPCLPython \
   octorayRenderingVolumePython
@@ -73,7 +73,7 @@ test-asan: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
 	  ctest --output-on-failure -j $(JOBS) \
-	  -R '^(deps\.|engine\.cpu|vtk\.ParticleTextReader|vtk\.SliceStackReader|octoray::IOParticlesCxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
+	  -R '^(deps\.|engine\.cpu|octoray::(IOParticles|IOImageStack|FiltersPCL)Cxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
 
 # The demo (Wrapping/Python/octoray/demo.py): the head CT (DICOM, bone and
 # skin presets, and side by side with vtkSmartVolumeMapper), the PCL laser

@@ -18,7 +18,7 @@
 // item or sequence around it, bytes that are not a VR where explicit VR is
 // expected, an undefined length where the standard allows none, a sequence
 // or item without its delimiter, stray items or delimiters, nesting deeper
-// than MaximumDepth. Not checked: the values themselves (GDCM reads them;
+// than DicomMaximumDepth. Not checked: the values themselves (GDCM reads them;
 // what it cannot decode it reports), a deflated data set (only its file
 // meta group is walked).
 #ifndef octorayDicomCheck_h

@@ -1,8 +1,8 @@
 #include "vtkDepthMapReader.h"
 
-#include "vtkCellArray.h"
+#include "octorayVertexCells.h"
+
 #include "vtkFloatArray.h"
-#include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
@@ -14,8 +14,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <vector>
 
 vtkStandardNewMacro(vtkDepthMapReader);
@@ -49,11 +49,110 @@ void vtkDepthMapReader::Fail(const std::string& message)
   vtkErrorMacro(<< message);
 }
 
+namespace
+{
+using namespace OIIO;
+
+// The depth image's values: the channel named Z or depth if there is one,
+// else the first; integers as their stored values (not normalised to 0..1).
+bool ReadDepth(const char* name, std::vector<float>& depth, int& w, int& h, std::string& error)
+{
+  auto in = ImageInput::open(name);
+  if (!in)
+  {
+    error = std::string("cannot read depth image '") + name + "': " + OIIO::geterror();
+    return false;
+  }
+  const ImageSpec spec = in->spec();
+  w = spec.width;
+  h = spec.height;
+  int channel = 0;
+  for (int c = 0; c < spec.nchannels; ++c)
+  {
+    const std::string n = spec.channelnames.size() > static_cast<size_t>(c) ? spec.channelnames[c] : "";
+    if (n == "Z" || n == "depth" || n == "Depth")
+    {
+      channel = c;
+      break;
+    }
+  }
+  depth.resize(static_cast<size_t>(w) * h);
+  auto read = [&](TypeDesc type, auto sample) {
+    std::vector<decltype(sample)> raw(depth.size());
+    const bool ok = in->read_image(0, 0, channel, channel + 1, type, raw.data());
+    std::copy(raw.begin(), raw.end(), depth.begin());
+    return ok;
+  };
+  const bool integer = spec.format.is_floating_point() == false;
+  bool ok;
+  if (integer && spec.format.basetype == TypeDesc::UINT16)
+  {
+    ok = read(TypeDesc::UINT16, static_cast<unsigned short>(0));
+  }
+  else if (integer && spec.format.basetype == TypeDesc::UINT8)
+  {
+    ok = read(TypeDesc::UINT8, static_cast<unsigned char>(0));
+  }
+  else if (!integer)
+  {
+    ok = in->read_image(0, 0, channel, channel + 1, TypeDesc::FLOAT, depth.data());
+  }
+  else
+  {
+    error = std::string("depth image '") + name + "' has pixel type " + spec.format.c_str() +
+      "; expected 8- or 16-bit unsigned integers or floats";
+    return false;
+  }
+  if (!ok)
+  {
+    error = std::string("cannot read the pixels of depth image '") + name + "': " + in->geterror();
+    return false;
+  }
+  in->close();
+  return true;
+}
+
+// The colour image as RGB bytes (grey repeated), w x h like the depth image.
+bool ReadColour(const char* name, const char* depthName, int w, int h,
+  std::vector<unsigned char>& rgb, std::string& error)
+{
+  auto cin = ImageInput::open(name);
+  if (!cin)
+  {
+    error = std::string("cannot read colour image '") + name + "': " + OIIO::geterror();
+    return false;
+  }
+  const ImageSpec& cs = cin->spec();
+  if (cs.width != w || cs.height != h)
+  {
+    error = std::string("colour image '") + name + "' is " + std::to_string(cs.width) + "x" +
+      std::to_string(cs.height) + " but depth image '" + depthName + "' is " + std::to_string(w) +
+      "x" + std::to_string(h);
+    return false;
+  }
+  std::vector<unsigned char> all(static_cast<size_t>(w) * h * cs.nchannels);
+  if (!cin->read_image(0, 0, 0, cs.nchannels, TypeDesc::UINT8, all.data()))
+  {
+    error =
+      std::string("cannot read the pixels of colour image '") + name + "': " + cin->geterror();
+    return false;
+  }
+  rgb.resize(static_cast<size_t>(w) * h * 3);
+  for (size_t p = 0; p < static_cast<size_t>(w) * h; ++p)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      rgb[3 * p + c] = all[p * cs.nchannels + std::min(c, cs.nchannels - 1)];
+    }
+  }
+  return true;
+}
+} // namespace
+
 //------------------------------------------------------------------------------
 int vtkDepthMapReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  using namespace OIIO;
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   this->ErrorMessage.clear();
   this->NumberOfInvalidPixels = 0;
@@ -69,101 +168,35 @@ int vtkDepthMapReader::RequestData(
       std::to_string(this->FocalLengthX) + ", fy=" + std::to_string(this->FocalLengthY));
     return 0;
   }
-  auto in = ImageInput::open(this->FileName);
-  if (!in)
-  {
-    this->Fail(std::string("cannot read depth image '") + this->FileName + "': " + OIIO::geterror());
-    return 0;
-  }
-  const ImageSpec spec = in->spec();
-  const int w = spec.width, h = spec.height;
-  // Depth is the channel named Z or depth if there is one, else the first.
-  int channel = 0;
-  for (int c = 0; c < spec.nchannels; ++c)
-  {
-    const std::string n = spec.channelnames.size() > static_cast<size_t>(c) ? spec.channelnames[c] : "";
-    if (n == "Z" || n == "depth" || n == "Depth")
-    {
-      channel = c;
-      break;
-    }
-  }
-  std::vector<float> depth(static_cast<size_t>(w) * h);
-  // Integers are read as their stored values (not normalised to 0..1).
-  const bool integer = spec.format.is_floating_point() == false;
-  bool ok;
-  if (integer && spec.format.basetype == TypeDesc::UINT16)
-  {
-    std::vector<unsigned short> raw(depth.size());
-    ok = in->read_image(0, 0, channel, channel + 1, TypeDesc::UINT16, raw.data());
-    std::copy(raw.begin(), raw.end(), depth.begin());
-  }
-  else if (integer && spec.format.basetype == TypeDesc::UINT8)
-  {
-    std::vector<unsigned char> raw(depth.size());
-    ok = in->read_image(0, 0, channel, channel + 1, TypeDesc::UINT8, raw.data());
-    std::copy(raw.begin(), raw.end(), depth.begin());
-  }
-  else if (!integer)
-  {
-    ok = in->read_image(0, 0, channel, channel + 1, TypeDesc::FLOAT, depth.data());
-  }
-  else
-  {
-    this->Fail(std::string("depth image '") + this->FileName + "' has pixel type " +
-      spec.format.c_str() + "; expected 8- or 16-bit unsigned integers or floats");
-    return 0;
-  }
-  if (!ok)
-  {
-    this->Fail(std::string("cannot read the pixels of depth image '") + this->FileName + "': " +
-      in->geterror());
-    return 0;
-  }
-  in->close();
-
+  std::vector<float> depth;
   std::vector<unsigned char> rgb;
-  if (this->ColorFileName && *this->ColorFileName)
+  int w = 0, h = 0;
+  std::string error;
+  if (!ReadDepth(this->FileName, depth, w, h, error) ||
+    (this->ColorFileName && *this->ColorFileName &&
+      !ReadColour(this->ColorFileName, this->FileName, w, h, rgb, error)))
   {
-    auto cin = ImageInput::open(this->ColorFileName);
-    if (!cin)
-    {
-      this->Fail(std::string("cannot read colour image '") + this->ColorFileName +
-        "': " + OIIO::geterror());
-      return 0;
-    }
-    const ImageSpec& cs = cin->spec();
-    if (cs.width != w || cs.height != h)
-    {
-      this->Fail(std::string("colour image '") + this->ColorFileName + "' is " +
-        std::to_string(cs.width) + "x" + std::to_string(cs.height) + " but depth image '" +
-        this->FileName + "' is " + std::to_string(w) + "x" + std::to_string(h));
-      return 0;
-    }
-    std::vector<unsigned char> all(static_cast<size_t>(w) * h * cs.nchannels);
-    if (!cin->read_image(0, 0, 0, cs.nchannels, TypeDesc::UINT8, all.data()))
-    {
-      this->Fail(std::string("cannot read the pixels of colour image '") + this->ColorFileName +
-        "': " + cin->geterror());
-      return 0;
-    }
-    rgb.resize(static_cast<size_t>(w) * h * 3);
-    for (size_t p = 0; p < static_cast<size_t>(w) * h; ++p)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        rgb[3 * p + c] = all[p * cs.nchannels + std::min(c, cs.nchannels - 1)];
-      }
-    }
+    this->Fail(error);
+    return 0;
   }
   this->UpdateProgress(0.5);
+  this->MakePoints(depth.data(), w, h, rgb.empty() ? nullptr : rgb.data(), output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
 
+//------------------------------------------------------------------------------
+// Pinhole back-projection of every Stride-th pixel whose scaled depth is in
+// range; the others are counted as invalid.
+void vtkDepthMapReader::MakePoints(
+  const float* depth, int w, int h, const unsigned char* rgb, vtkPolyData* output)
+{
   auto pts = vtkSmartPointer<vtkFloatArray>::New();
   pts->SetNumberOfComponents(3);
   auto z = vtkSmartPointer<vtkFloatArray>::New();
   z->SetName("Depth");
   vtkSmartPointer<vtkUnsignedCharArray> colors;
-  if (!rgb.empty())
+  if (rgb)
   {
     colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
     colors->SetName("Colors");
@@ -192,7 +225,6 @@ int vtkDepthMapReader::RequestData(
       }
     }
   }
-  const vtkIdType n = pts->GetNumberOfTuples();
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetData(pts);
   output->SetPoints(points);
@@ -207,18 +239,8 @@ int vtkDepthMapReader::RequestData(
   }
   if (this->GenerateVertices)
   {
-    auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
-    offsets->SetNumberOfTuples(n + 1);
-    auto conn = vtkSmartPointer<vtkIdTypeArray>::New();
-    conn->SetNumberOfTuples(n);
-    std::iota(offsets->GetPointer(0), offsets->GetPointer(0) + n + 1, 0);
-    std::iota(conn->GetPointer(0), conn->GetPointer(0) + n, 0);
-    auto verts = vtkSmartPointer<vtkCellArray>::New();
-    verts->SetData(offsets, conn);
-    output->SetVerts(verts);
+    output->SetVerts(octoray::VertexCells(pts->GetNumberOfTuples()));
   }
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 //------------------------------------------------------------------------------

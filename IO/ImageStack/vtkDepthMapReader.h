@@ -108,6 +108,8 @@ private:
   vtkDepthMapReader(const vtkDepthMapReader&) = delete;
   void operator=(const vtkDepthMapReader&) = delete;
   void Fail(const std::string& message);
+  void MakePoints(const float* depth, int width, int height, const unsigned char* rgb,
+    vtkPolyData* output);
 };
 
 #endif

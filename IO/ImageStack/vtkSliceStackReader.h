@@ -208,10 +208,10 @@ private:
   vtkSliceStackReader(const vtkSliceStackReader&) = delete;
   void operator=(const vtkSliceStackReader&) = delete;
 
-  bool CollectFiles(std::vector<std::string>& files);
-  bool ReadPictures(const std::vector<std::string>& files, vtkImageData* image);
-  bool ReadDICOM(const std::vector<std::string>& files, vtkImageData* image);
-  void MakeParticles(vtkImageData* image, vtkPolyData* output);
+  bool ListSlices(std::vector<std::string>& files);
+  bool ReadStack(
+    const std::vector<std::string>& files, vtkImageData* image, vtkPolyData* particles);
+  int KeepLastOutputs(vtkPolyData* output, vtkImageData* image);
   void Fail(const std::string& message);
 };
 

@@ -18,7 +18,7 @@ texts = {
     "exponents": "1e3 -2.5E-2 +3\n0x1 inf nan\n",
     "comments_blank": "# comment\n\n   \n1 2 3 # trailing\n",
     "utm": "637012.24 849028.31 431.66\n",
-    # every malformed case of the reader tests (Testing/Python, Testing/Filters)
+    # every malformed case of the reader tests (Testing/Python, IO/Particles/Testing/Cxx)
     "bad_short_line": "1 2 3\n4 5\n",
     "bad_long_line": "1 2 3\n4 5 6 7\n",
     "bad_word": "1 2 3\n4 abc 6\n",

@@ -403,11 +403,5 @@ int main(int argc, char* argv[])
     CHECK(lit);
   }
 
-  if (octorayTestFailures)
-  {
-    std::cerr << octorayTestFailures << " check(s) failed" << std::endl;
-    return 1;
-  }
-  std::cout << "all robustness checks passed" << std::endl;
-  return 0;
+  return octoray_test::Result();
 }

@@ -5,6 +5,7 @@
 // message, the previous output kept after a failure, abort, and random,
 // truncated and bit-flipped files that must give an error, never a crash.
 #include "octorayLZF.h"
+#include "octorayTestCheck.h"
 
 #include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
@@ -35,28 +36,6 @@
 
 namespace
 {
-int Failures = 0;
-#define CHECK(cond)                                                                                \
-  do                                                                                               \
-  {                                                                                                \
-    if (!(cond))                                                                                   \
-    {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": check failed: " #cond << std::endl;           \
-      ++Failures;                                                                                  \
-    }                                                                                              \
-  } while (0)
-#define CHECK_EQ_STR(text, expected)                                                               \
-  do                                                                                               \
-  {                                                                                                \
-    const std::string t_ = (text), e_ = (expected);                                                \
-    if (t_ != e_)                                                                                  \
-    {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ":\n  got      '" << t_ << "'\n  expected '"    \
-                << e_ << "'" << std::endl;                                                         \
-      ++Failures;                                                                                  \
-    }                                                                                              \
-  } while (0)
-
 std::string Dir;
 
 std::string Path(const std::string& name)
@@ -1115,11 +1094,5 @@ int TestPCDReader(int argc, char* argv[])
   TestProgressAndAbort();
   TestDamagedFiles();
 
-  if (Failures)
-  {
-    std::cerr << Failures << " check(s) failed\n";
-    return EXIT_FAILURE;
-  }
-  std::cout << "all checks passed\n";
-  return EXIT_SUCCESS;
+  return octoray_test::Result();
 }

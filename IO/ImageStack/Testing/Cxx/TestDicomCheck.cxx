@@ -1,25 +1,16 @@
 // The structural check that vtkSliceStackReader runs on a DICOM file before
 // GDCM sees it (octorayDicomCheck.h): files built here byte by byte, sound
-// and damaged, each damage with the message it must give; the bundled
-// series; the fuzz findings that made GDCM 3.0 abort or allocate gigabytes
-// (Testing/Fuzz/regressions/slice_stack/dicom_*), through the reader too.
-//
-// usage: TestDicomCheck Data-directory fuzz-regressions-directory scratch-directory
+// and damaged, each damage with the message it must give, and the bundled
+// series. The fuzz findings that made GDCM 3.0 abort are
+// TestDicomFindings.cxx.
 #include "octorayDicomCheck.h"
 #include "octorayTestCheck.h"
 
-#include "vtkImageData.h"
-#include "vtkNew.h"
-#include "vtkObject.h"
-#include "vtkPolyData.h"
-#include "vtkSliceStackReader.h"
+#include "vtkTestUtilities.h"
 
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -138,51 +129,20 @@ void Image(Dicom& d)
   d.Element(0x7FE0, 0x0010, "OW", std::string(8, '\x7'));
 }
 
-std::vector<unsigned char> ReadFile(const std::string& name)
-{
-  std::ifstream in(name, std::ios::binary);
-  return std::vector<unsigned char>(
-    (std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 #define CHECK_SOUND(dicom)                                                                         \
   do                                                                                               \
   {                                                                                                \
     const std::string e_ = (dicom).Check();                                                        \
     if (!e_.empty())                                                                               \
     {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": sound file rejected: " << e_ << std::endl;    \
-      ++octorayTestFailures;                                                                       \
+      octoray_test::Report(__FILE__, __LINE__, "sound file rejected: " + e_);                      \
     }                                                                                              \
   } while (0)
-#define CHECK_MESSAGE(got, expected)                                                               \
-  do                                                                                               \
-  {                                                                                                \
-    const std::string g_ = (got);                                                                  \
-    const std::string x_ = (expected);                                                             \
-    if (g_ != x_)                                                                                  \
-    {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": message\n  '" << g_ << "'\nexpected\n  '"     \
-                << x_ << "'" << std::endl;                                                         \
-      ++octorayTestFailures;                                                                       \
-    }                                                                                              \
-  } while (0)
-} // namespace
 
-int main(int argc, char* argv[])
+// Every transfer syntax's encoding, sequences and items of both lengths,
+// encapsulated pixel data, an undefined-length UN, a bare data set.
+void TestSoundFiles()
 {
-  if (argc < 4)
-  {
-    std::cerr << "usage: " << argv[0] << " Data-directory regressions-directory scratch-directory"
-              << std::endl;
-    return EXIT_FAILURE;
-  }
-  const std::string data = argv[1];
-  const std::string regressions = argv[2];
-  const std::string scratch = argv[3];
-  fs::create_directories(scratch);
-
-  // --- sound files --------------------------------------------------------
   for (const char* syntax : { ExplicitLE, ImplicitLE, ExplicitBE })
   {
     Dicom d = Part10(syntax);
@@ -251,29 +211,73 @@ int main(int argc, char* argv[])
     Image(liar);
     CHECK_SOUND(liar);
   }
+}
+
+void TestBundledSeries(const std::string& data)
+{
   for (const auto& e : fs::directory_iterator(data + "/DICOM/CT5N"))
   {
-    CHECK_MESSAGE(octoray::CheckDicomStructure(e.path().string()), "");
+    CHECK_EQ_STR(octoray::CheckDicomStructure(e.path().string()), "");
   }
-  CHECK_MESSAGE(octoray::CheckDicomStructure(data + "/DICOM/CT_small/CT_small.dcm"), "");
+  CHECK_EQ_STR(octoray::CheckDicomStructure(data + "/DICOM/CT_small/CT_small.dcm"), "");
+}
 
-  // --- damaged files, each with its message -------------------------------
+// Lengths past the end of the file, and undefined where none may be.
+void TestLengths()
+{
   {
     // The length of a value runs past the end of the file.
     Dicom d = Part10(ImplicitLE);
     const size_t at = d.Size();
     d.Head(0x0028, 0x0010, "US", 2600000000u);
     d.Raw("\2\0");
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "DICOM element (0028,0010) at byte " + std::to_string(at) +
         " claims 2600000000 bytes, the file has " + std::to_string(d.Size()));
   }
+  {
+    // Undefined lengths: a sequence and an item that never end, a VR that
+    // allows none, a pixel data fragment.
+    Dicom s = Part10(ExplicitLE);
+    const size_t sat = s.Size();
+    s.Head(0x0008, 0x1115, "SQ", Undefined);
+    s.Item(0);
+    CHECK_EQ_STR(s.Check(),
+      "the DICOM sequence (0008,1115) at byte " + std::to_string(sat) +
+        " has no sequence delimiter (FFFE,E0DD) before the end of the file");
+    Dicom i = Part10(ExplicitLE);
+    i.Head(0x0008, 0x1115, "SQ", Undefined);
+    const size_t iat = i.Size();
+    i.Item(Undefined);
+    i.Element(0x0008, 0x1150, "UI", "1.2\0");
+    CHECK_EQ_STR(i.Check(),
+      "the DICOM item at byte " + std::to_string(iat) +
+        " has an undefined length and no item delimiter (FFFE,E00D) before the end of the file");
+    Dicom v = Part10(ExplicitLE);
+    const size_t vat = v.Size();
+    v.Head(0x0028, 0x0010, "OD", Undefined);
+    CHECK_EQ_STR(v.Check(),
+      "DICOM element (0028,0010) at byte " + std::to_string(vat) +
+        " has an undefined length, which VR OD does not allow");
+    Dicom f = Part10(JPEGBaseline);
+    f.Head(0x7FE0, 0x0010, "OB", Undefined);
+    const size_t fat = f.Size();
+    f.Item(Undefined);
+    CHECK_EQ_STR(f.Check(),
+      "the pixel data fragment at byte " + std::to_string(fat) +
+        " claims an undefined length, the file has " + std::to_string(f.Size()));
+  }
+}
+
+// Bytes that are no VR; headers cut short.
+void TestHeaders()
+{
   {
     Dicom d = Part10(ExplicitLE);
     d.Element(0x0008, 0x0060, "CS", "CT");
     const size_t at = d.Size();
     d.Element(0x0028, 0x0010, "Q\x01", "ab");
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "DICOM element (0028,0010) at byte " + std::to_string(at) +
         " has no valid VR: found 'Q\\x01' where explicit VR little endian expects one");
   }
@@ -283,49 +287,23 @@ int main(int argc, char* argv[])
     Image(d);
     const size_t at = d.Size();
     d.Raw(std::string("\x08\x00\x10\x00\x00", 5));
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "a DICOM element header at byte " + std::to_string(at) +
         " is cut short: it needs 8 bytes, the file has " + std::to_string(d.Size()));
     Dicom l = Part10(ExplicitLE);
     const size_t lat = l.Size();
     l.Head(0x7FE0, 0x0010, "OW", 8);
     l.Bytes.resize(l.Size() - 2);
-    CHECK_MESSAGE(l.Check(),
+    CHECK_EQ_STR(l.Check(),
       "the header of DICOM element (7FE0,0010) at byte " + std::to_string(lat) +
         " is cut short: it needs 12 bytes, the file has " + std::to_string(l.Size()));
   }
-  {
-    // Undefined lengths: a sequence and an item that never end, a VR that
-    // allows none, a pixel data fragment.
-    Dicom s = Part10(ExplicitLE);
-    const size_t sat = s.Size();
-    s.Head(0x0008, 0x1115, "SQ", Undefined);
-    s.Item(0);
-    CHECK_MESSAGE(s.Check(),
-      "the DICOM sequence (0008,1115) at byte " + std::to_string(sat) +
-        " has no sequence delimiter (FFFE,E0DD) before the end of the file");
-    Dicom i = Part10(ExplicitLE);
-    i.Head(0x0008, 0x1115, "SQ", Undefined);
-    const size_t iat = i.Size();
-    i.Item(Undefined);
-    i.Element(0x0008, 0x1150, "UI", "1.2\0");
-    CHECK_MESSAGE(i.Check(),
-      "the DICOM item at byte " + std::to_string(iat) +
-        " has an undefined length and no item delimiter (FFFE,E00D) before the end of the file");
-    Dicom v = Part10(ExplicitLE);
-    const size_t vat = v.Size();
-    v.Head(0x0028, 0x0010, "OD", Undefined);
-    CHECK_MESSAGE(v.Check(),
-      "DICOM element (0028,0010) at byte " + std::to_string(vat) +
-        " has an undefined length, which VR OD does not allow");
-    Dicom f = Part10(JPEGBaseline);
-    f.Head(0x7FE0, 0x0010, "OB", Undefined);
-    const size_t fat = f.Size();
-    f.Item(Undefined);
-    CHECK_MESSAGE(f.Check(),
-      "the pixel data fragment at byte " + std::to_string(fat) +
-        " claims an undefined length, the file has " + std::to_string(f.Size()));
-  }
+}
+
+// Items and elements longer than what encloses them, stray delimiters,
+// nesting too deep.
+void TestEnclosing()
+{
   {
     // An item longer than its defined-length sequence; an element longer
     // than its item.
@@ -336,7 +314,7 @@ int main(int argc, char* argv[])
     d.Element(0x0008, 0x1150, "UI", "1.2\0");
     d.Raw("xx");
     Image(d);
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "the DICOM item at byte " + std::to_string(iat) +
         " of sequence (0008,1115) claims 40 bytes, its enclosing item or sequence ends at byte " +
         std::to_string(iat + 18));
@@ -346,7 +324,7 @@ int main(int argc, char* argv[])
     const size_t eat = e.Size();
     e.Element(0x0008, 0x1150, "UI", "1.2.3.45");
     Image(e);
-    CHECK_MESSAGE(e.Check(),
+    CHECK_EQ_STR(e.Check(),
       "DICOM element (0008,1150) at byte " + std::to_string(eat) +
         " claims 8 bytes, its enclosing item or sequence ends at byte " + std::to_string(eat + 12));
   }
@@ -356,7 +334,7 @@ int main(int argc, char* argv[])
     Image(d);
     const size_t at = d.Size();
     d.ItemEnd();
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "unexpected item delimiter (FFFE,E00D) at byte " + std::to_string(at) + " in the data set");
     Dicom s = Part10(ExplicitLE);
     const size_t sat = s.Size();
@@ -364,7 +342,7 @@ int main(int argc, char* argv[])
     const size_t xat = s.Size();
     s.Element(0x0008, 0x1150, "UI", "1.2\0");
     s.SequenceEnd();
-    CHECK_MESSAGE(s.Check(),
+    CHECK_EQ_STR(s.Check(),
       "DICOM sequence (0008,1115) at byte " + std::to_string(sat) + " holds (0008,1150) at byte " +
         std::to_string(xat) + " where an item (FFFE,E000) or its delimiter (FFFE,E0DD) must be");
   }
@@ -381,104 +359,65 @@ int main(int argc, char* argv[])
       d.Head(0x0008, 0x1115, "SQ", Undefined);
       d.Item(Undefined);
     }
-    CHECK_MESSAGE(d.Check(),
+    CHECK_EQ_STR(d.Check(),
       "DICOM sequence (0008,1115) at byte " + std::to_string(at) + " is nested more than " +
         std::to_string(octoray::DicomMaximumDepth) + " levels deep");
   }
-  {
-    // The file meta group: its length past the end of the file, a length
-    // that does not end where its elements end, a transfer syntax UID
-    // longer than a UID can be.
-    Dicom d = Part10(ExplicitLE);
-    Image(d);
-    d.Bytes[140] = 0xFF;
-    d.Bytes[141] = 0xFF;
-    const uint32_t claimed = 0xFFFF;
-    CHECK_MESSAGE(d.Check(),
-      "the DICOM file meta group length (0002,0000) at byte 132 says the group ends at byte " +
-        std::to_string(144 + claimed) + ", the file has " + std::to_string(d.Size()));
-    Dicom m = Part10(ExplicitLE);
-    const size_t metaEnd = m.Size();
-    Image(m);
-    m.Bytes[140] -= 2;
-    CHECK_MESSAGE(m.Check(),
-      "the DICOM file meta group length (0002,0000) at byte 132 says the group ends at byte " +
-        std::to_string(metaEnd - 2) + ", but its elements end at byte " + std::to_string(metaEnd));
-    Dicom u = Part10(std::string(70, '1'));
-    CHECK_MESSAGE(u.Check().substr(0, 52), "the DICOM transfer syntax UID (0002,0010) at byte 15");
-    CHECK_CONTAINS(u.Check(), "is 70 bytes long; a UID has at most 64");
-  }
-  {
-    // Sound structure on which GDCM 3.0 still stops the process (seen with
-    // pydicom's rtdose_1frame.dcm).
-    Dicom g = Part10(ImplicitLE);
-    g.Element(0x0008, 0x0016, "UI", "1.2.840.10008.5.1.4.1.1.481.2");
-    g.Element(0x0028, 0x0010, "US", std::string("\2\0", 2));
-    const size_t offsetAt = g.Size();
-    g.Element(0x3004, 0x000C, "DS", "0\\1 ");
-    g.Element(0x7FE0, 0x0010, "OW", std::string(8, '\x7'));
-    CHECK_MESSAGE(g.Check(),
-      "the DICOM grid frame offset vector (3004,000C) at byte " + std::to_string(offsetAt) +
-        " comes without a number of frames (0028,0008), which GDCM 3.0 cannot read");
-    g.Element(0x0028, 0x0008, "IS", "2 ");
-    CHECK_SOUND(g);
-  }
+}
 
-  // --- the fuzz findings that stopped GDCM 3.0 ----------------------------
-  // (their first byte picks the fuzz target's file extension; the rest is
-  // the file)
-  struct Finding
-  {
-    const char* Name;
-    const char* Message;
-  };
-  const Finding findings[] = {
-    { "dicom_meta_assert",
-      "DICOM element (0002,2E31) at byte 192 (file meta group) has no valid VR: found '59' where "
-      "explicit VR little endian expects one" },
-    { "dicom_readcompat_assert",
-      "DICOM element (0010,0010) at byte 870 claims 16394 bytes, the file has 3936" },
-    { "dicom_huge_length_oom",
-      "DICOM element (0803,0000) at byte 530 has no valid VR: found '\\x00\\x00' where explicit "
-      "VR little endian expects one" },
-  };
-  vtkObject::GlobalWarningDisplayOff();
-  for (const Finding& f : findings)
-  {
-    const std::vector<unsigned char> bytes = ReadFile(regressions + "/" + f.Name);
-    CHECK(bytes.size() > 132);
-    if (bytes.size() <= 132)
-    {
-      continue;
-    }
-    CHECK_MESSAGE(octoray::CheckDicomStructure(bytes.data() + 1, bytes.size() - 1), f.Message);
-    // The reader, metadata path and full read, after a good read of the
-    // bundled series: the error names the file, the output stays.
-    const std::string path = scratch + "/" + f.Name + ".dcm";
-    {
-      std::ofstream out(path, std::ios::binary);
-      out.write(reinterpret_cast<const char*>(bytes.data() + 1), bytes.size() - 1);
-    }
-    vtkNew<vtkSliceStackReader> r;
-    r->AddFileName((data + "/DICOM/CT_small/CT_small.dcm").c_str());
-    r->SetBackgroundRange(-5000, 0);
-    r->Update();
-    const vtkIdType before = r->GetOutput()->GetNumberOfPoints();
-    CHECK(before > 0);
-    r->ClearFileNames();
-    r->AddFileName(path.c_str());
-    r->UpdateInformation();
-    const std::string expected = "cannot read DICOM slice '" + path + "': " + f.Message;
-    CHECK_MESSAGE(r->GetErrorMessage(), expected);
-    r->Update();
-    CHECK_MESSAGE(r->GetErrorMessage(), expected);
-    CHECK(r->GetOutput()->GetNumberOfPoints() == before);
-  }
+// The file meta group: its length past the end of the file, a length
+// that does not end where its elements end, a transfer syntax UID
+// longer than a UID can be.
+void TestFileMeta()
+{
+  Dicom d = Part10(ExplicitLE);
+  Image(d);
+  d.Bytes[140] = 0xFF;
+  d.Bytes[141] = 0xFF;
+  const uint32_t claimed = 0xFFFF;
+  CHECK_EQ_STR(d.Check(),
+    "the DICOM file meta group length (0002,0000) at byte 132 says the group ends at byte " +
+      std::to_string(144 + claimed) + ", the file has " + std::to_string(d.Size()));
+  Dicom m = Part10(ExplicitLE);
+  const size_t metaEnd = m.Size();
+  Image(m);
+  m.Bytes[140] -= 2;
+  CHECK_EQ_STR(m.Check(),
+    "the DICOM file meta group length (0002,0000) at byte 132 says the group ends at byte " +
+      std::to_string(metaEnd - 2) + ", but its elements end at byte " + std::to_string(metaEnd));
+  Dicom u = Part10(std::string(70, '1'));
+  CHECK_EQ_STR(u.Check().substr(0, 52), "the DICOM transfer syntax UID (0002,0010) at byte 15");
+  CHECK_CONTAINS(u.Check(), "is 70 bytes long; a UID has at most 64");
+}
 
-  if (octorayTestFailures)
-  {
-    std::cerr << octorayTestFailures << " checks failed" << std::endl;
-    return EXIT_FAILURE;
-  }
-  return EXIT_SUCCESS;
+// Sound structure on which GDCM 3.0 still stops the process (seen with
+// pydicom's rtdose_1frame.dcm).
+void TestGdcmRules()
+{
+  Dicom g = Part10(ImplicitLE);
+  g.Element(0x0008, 0x0016, "UI", "1.2.840.10008.5.1.4.1.1.481.2");
+  g.Element(0x0028, 0x0010, "US", std::string("\2\0", 2));
+  const size_t offsetAt = g.Size();
+  g.Element(0x3004, 0x000C, "DS", "0\\1 ");
+  g.Element(0x7FE0, 0x0010, "OW", std::string(8, '\x7'));
+  CHECK_EQ_STR(g.Check(),
+    "the DICOM grid frame offset vector (3004,000C) at byte " + std::to_string(offsetAt) +
+      " comes without a number of frames (0028,0008), which GDCM 3.0 cannot read");
+  g.Element(0x0028, 0x0008, "IS", "2 ");
+  CHECK_SOUND(g);
+}
+} // namespace
+
+int TestDicomCheck(int argc, char* argv[])
+{
+  char* data = vtkTestUtilities::ExpandDataFileName(argc, argv, "Data");
+  TestSoundFiles();
+  TestBundledSeries(data);
+  delete[] data;
+  TestLengths();
+  TestHeaders();
+  TestEnclosing();
+  TestFileMeta();
+  TestGdcmRules();
+  return octoray_test::Result();
 }
