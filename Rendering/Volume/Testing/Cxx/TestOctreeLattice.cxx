@@ -5,6 +5,7 @@
 // leaf inside the solid holding a lattice point) and the check that points
 // are on their lattice.
 #include <octorayLattice.h>
+#include <octorayTestCheck.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -15,17 +16,6 @@
 
 namespace
 {
-int failures = 0;
-#define CHECK(cond)                                                                                \
-  do                                                                                               \
-  {                                                                                                \
-    if (!(cond))                                                                                   \
-    {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": check failed: " #cond << std::endl;           \
-      ++failures;                                                                                  \
-    }                                                                                              \
-  } while (0)
-
 using namespace octoray::lattice;
 
 std::vector<int> Fill(double sx, double sy, double sz, long long nx = 10, long long ny = 10, long long nz = 10)
@@ -286,10 +276,5 @@ int TestOctreeLattice(int, char*[])
     const double wide[6] = { 0, 1e6, 0, 1, 0, 1 }; // 10^12 leaves across
     CHECK(!ChooseLeafGrid(l, wide).Valid);
   }
-  if (failures)
-  {
-    std::cerr << failures << " check(s) failed" << std::endl;
-    return EXIT_FAILURE;
-  }
-  return EXIT_SUCCESS;
+  return octoray_test::Result();
 }

@@ -4,6 +4,8 @@
 #ifndef octorayMapperTesting_h
 #define octorayMapperTesting_h
 
+#include "octorayTestCheck.h" // CHECK, octoray_test::Result
+
 #include "vtkCamera.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -30,26 +32,6 @@
 
 namespace octoray_test
 {
-// ---- Checks that report every failure and fail the test at the end.
-inline int& Failures()
-{
-  static int failures = 0;
-  return failures;
-}
-#define CHECK(cond)                                                                                \
-  do                                                                                               \
-  {                                                                                                \
-    if (!(cond))                                                                                   \
-    {                                                                                              \
-      std::cerr << __FILE__ << ":" << __LINE__ << ": check failed: " #cond << std::endl;           \
-      ++octoray_test::Failures();                                                                  \
-    }                                                                                              \
-  } while (0)
-inline int Result()
-{
-  return Failures() == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
-}
-
 // ---- The backend under test.
 struct Backend
 {
