@@ -33,6 +33,7 @@
 #include "vtkFloatArray.h"
 #include "vtkGaussianKernel.h"
 #include "vtkImageData.h"
+#include "vtkLookupTable.h"
 #include "vtkNew.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -528,6 +529,37 @@ struct Options
   double Seconds = 6.0, MaxPrepare = 90.0;
 };
 
+// A cloud without colours (the LMS400 laser scan has only intensity) gets
+// them from its intensity, or else its elevation, through a blue-to-red
+// table over the value range: every method then draws the same colours, and
+// the resampled volumes have colour to interpolate.
+void ColourIfUncoloured(vtkPolyData* cloud)
+{
+  if (cloud->GetPointData()->GetArray("Colors"))
+  {
+    return;
+  }
+  vtkSmartPointer<vtkDataArray> values = cloud->GetPointData()->GetArray("Intensity");
+  if (!values)
+  {
+    values = vtkSmartPointer<vtkFloatArray>::New();
+    values->SetNumberOfTuples(cloud->GetNumberOfPoints());
+    for (vtkIdType i = 0; i < cloud->GetNumberOfPoints(); ++i)
+    {
+      values->SetTuple1(i, cloud->GetPoint(i)[2]);
+    }
+  }
+  vtkNew<vtkLookupTable> table;
+  table->SetRange(values->GetRange(0));
+  table->SetHueRange(0.667, 0.0);
+  table->Build();
+  vtkSmartPointer<vtkUnsignedCharArray> rgb;
+  rgb.TakeReference(table->MapScalars(values, VTK_COLOR_MODE_MAP_SCALARS, 0, VTK_RGB));
+  rgb->SetName("Colors");
+  cloud->GetPointData()->AddArray(rgb);
+  cloud->GetPointData()->SetScalars(rgb);
+}
+
 // The generated point sets, and the file's points (a particle text file or a
 // PCL point cloud) as a scene of its own.
 std::vector<Scene> LoadScenes(const Options& o)
@@ -558,6 +590,7 @@ std::vector<Scene> LoadScenes(const Options& o)
     auto cloud = vtkSmartPointer<vtkPolyData>::New();
     cloud->ShallowCopy(reader->GetOutput());
     cloud->SetVerts(nullptr);
+    ColourIfUncoloured(cloud);
     scenes.push_back(MakeScene(o.File.substr(o.File.find_last_of('/') + 1), cloud, Now() - t0));
   }
   return scenes;
