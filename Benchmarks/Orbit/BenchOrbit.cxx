@@ -531,7 +531,7 @@ struct Options
 
 // A cloud without colours (the LMS400 laser scan has only intensity) gets
 // them from its intensity, or else its elevation, through a blue-to-red
-// table over the value range: every method then draws the same colours, and
+// table: every method then draws the same colours, and
 // the resampled volumes have colour to interpolate.
 void ColourIfUncoloured(vtkPolyData* cloud)
 {
@@ -549,8 +549,15 @@ void ColourIfUncoloured(vtkPolyData* cloud)
       values->SetTuple1(i, cloud->GetPoint(i)[2]);
     }
   }
+  // The range from the 1st to the 99th percentile, as the Python scenes
+  // colour: a few bright returns would otherwise push the rest into blue.
+  std::vector<double> sorted(values->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
+  {
+    sorted[i] = values->GetTuple1(i);
+  }
   vtkNew<vtkLookupTable> table;
-  table->SetRange(values->GetRange(0));
+  table->SetRange(Percentile(sorted, 0.01), Percentile(sorted, 0.99));
   table->SetHueRange(0.667, 0.0);
   table->Build();
   vtkSmartPointer<vtkUnsignedCharArray> rgb;
