@@ -141,8 +141,20 @@ class Context:
         path = os.path.join(self.gpu, "COMMAND.md")
         if not os.path.exists(path):
             return None
+        # The indented lines are the commands (a trailing backslash continues
+        # one; a '#' starts a remark on how long it took), joined by "; ".
+        commands, current = [], ""
         with open(path) as f:
-            return f.read().strip()
+            for line in f:
+                if not line.startswith("    "):
+                    continue
+                current += line.split("#")[0].strip()
+                if current.endswith("\\"):
+                    current = current[:-1] + " "
+                else:
+                    commands.append(" ".join(current.split()))
+                    current = ""
+        return "; ".join(commands)
 
     def write_csv(self, name, header, rows):
         """Writes Benchmarks/report/<name>.csv; returns the link for RESULTS.md."""

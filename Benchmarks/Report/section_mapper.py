@@ -139,7 +139,7 @@ def orbit_text(ctx, rows, summary_rows):
              for r in rows]
     link = ctx.write_csv("mapper-orbit", ["scene", "points", "size", "method", "median_ms", "p95_ms", "frames",
                                           "first_picture_ms", "prepare_ms", "gpu_mb"], table)
-    where = [(f"{r['n']:,}", r["size"], method_title(r["method"]), ms(r["trace"]), ms(r["depth"]),
+    where = [(r["scene"], f"{r['n']:,}", r["size"], method_title(r["method"]), ms(r["trace"]), ms(r["depth"]),
               ms(r["transfer"]), ms(r["draw"]), ms(r["median"])) for r in rows if r["trace"] is not None]
     ratio_rows = []
     for (scene, n, size), ours, fastest, first in ratios(rows):
@@ -155,9 +155,13 @@ def orbit_text(ctx, rows, summary_rows):
     return [
         "",
         "**Orbit against VTK's GPU mappers** (`octoray_bench_orbit`, Benchmarks/Orbit): the same points, "
-        "the same 60-frame camera orbit (fewer frames, at least 3, for a method whose frame is slow) and "
-        "the same offscreen window, each frame ended by glFinish. Points: 64 Gaussian clusters (fixed "
-        "seed) coloured by position. First picture: from points in memory to the first frame (octree "
+        "the same camera orbit (the frame count and time limit are in the command; a method whose frame is "
+        "slow draws fewer frames, at least 3) and the same offscreen window, each frame ended by glFinish. "
+        "Scenes: 64 Gaussian clusters (fixed seed) coloured by position, and the largest real cloud in "
+        "Data/, the LMS400 laser scan of a table (`make data`; 460,400 points, coloured by intensity "
+        "between its 1st and 99th percentiles). octoray and vtkPointGaussianMapper are lit, the points "
+        "and the resampled volumes are not. A resampling estimated to take longer than `--max-prepare` "
+        "is skipped, and says so. First picture: from points in memory to the first frame (octree "
         "build, or resampling onto an image, plus the first render); making the points is not counted. "
         "GPU memory: what the device's use grew by (cudaMemGetInfo: CUDA and OpenGL together). "
         f"Table as CSV: [{link}]({link}).",
@@ -174,6 +178,6 @@ def orbit_text(ctx, rows, summary_rows):
         "Where octoray's frame goes (medians over the orbit; the rest of the frame is VTK's own: clearing, "
         "the render passes, glFinish):",
         "",
-        ctx.table(["points", "window", "path", "trace ms", "depth read ms", "picture to OpenGL ms",
-                   "composite draw ms", "frame ms"], where, "lllrrrrr"),
+        ctx.table(["scene", "points", "window", "path", "trace ms", "depth read ms", "picture to OpenGL ms",
+                   "composite draw ms", "frame ms"], where, "llllrrrrr"),
     ]
