@@ -46,8 +46,13 @@ def render(ctx):
     if not summary_path:
         return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
-    with open(summary_path) as f:
-        summary = f.read()
+    # A run may come in calls (racecheck, the slowest, in a call of its
+    # own): every summary*.txt of the run, read as one.
+    summary = ""
+    for name in sorted(os.listdir(os.path.dirname(summary_path))):
+        if name.startswith("summary") and name.endswith(".txt"):
+            with open(os.path.join(os.path.dirname(summary_path), name)) as f:
+                summary += f.read()
     device = ""
     if ctx.gpu_file("gpu.txt"):
         with open(ctx.gpu_file("gpu.txt")) as f:

@@ -5,8 +5,6 @@ VTK's own GPU mappers.
 Nothing is measured here: the files come from scripts/gpu/gpu-check.sh on a
 GPU machine (VTK with EGL on the NVIDIA driver), committed in
 Benchmarks/gpu/ with COMMAND.md."""
-import json
-import os
 import re
 import xml.etree.ElementTree as ET
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import vtk
 import octoray
+from octoray.png import read_png, write_png
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 from conftest import Messages, array, points
@@ -14,26 +15,6 @@ from conftest import Messages, array, points
 # Data/README.md: intrinsics of the subsampled Middlebury depth map.
 FX = FY = 497.489
 CX, CY = 155.5965, 127.4385
-
-
-def write_png16(path, depth):
-    h, w = depth.shape
-    image = vtk.vtkImageData()
-    image.SetDimensions(w, h, 1)
-    image.GetPointData().SetScalars(numpy_to_vtk(np.ascontiguousarray(depth[::-1]).ravel(), deep=1))
-    writer = vtk.vtkPNGWriter()
-    writer.SetInputData(image)
-    writer.SetFileName(path)
-    writer.Write()
-
-
-def png_array(path):
-    r = vtk.vtkPNGReader()
-    r.SetFileName(path)
-    r.Update()
-    im = r.GetOutput()
-    w, h, _ = im.GetDimensions()
-    return vtk_to_numpy(im.GetPointData().GetScalars()).reshape(h, w, -1)[::-1]
 
 
 def depth_reader(path, **options):
@@ -53,8 +34,8 @@ def test_real_depth_map(data_dir):
     r, out, msgs = depth_reader(depth_path, ColorFileName=color_path,
                                 Intrinsics=(FX, FY, CX, CY), DepthScale=0.001)
     assert not msgs.errors, msgs.errors
-    d = png_array(depth_path)[..., 0].astype(np.float64)
-    rgb = png_array(color_path)
+    d = read_png(depth_path)[..., 0].astype(np.float64)
+    rgb = read_png(color_path)
     valid = d > 0
     assert out.GetNumberOfPoints() == np.count_nonzero(valid)
     assert r.GetNumberOfInvalidPixels() == np.count_nonzero(~valid)
@@ -71,7 +52,7 @@ def test_plane_depth(tmp_path):
     path = os.path.join(str(tmp_path), "plane.png")
     depth = np.full((40, 60), 2000, np.uint16)
     depth[0, :] = 0  # no measurement
-    write_png16(path, depth)
+    write_png(path, depth)
     r, out, msgs = depth_reader(path, Intrinsics=(100.0, 100.0, 30.0, 20.0), DepthScale=0.001,
                                 Stride=2)
     p = points(out)
@@ -114,7 +95,7 @@ def test_depth_errors(tmp_path, data_dir):
     assert r.GetErrorMessage() == (depth_path + ": the focal lengths fx and fy must be set and "
                                    "positive (pixels); got fx=0.000000, fy=0.000000")
     small = os.path.join(str(tmp_path), "small.png")
-    write_png16(small, np.ones((2, 2), np.uint16))
+    write_png(small, np.ones((2, 2), np.uint16))
     r, out, msgs = depth_reader(depth_path, ColorFileName=small, Intrinsics=(1.0, 1.0, 0.0, 0.0))
     assert r.GetErrorMessage() == ("colour image '%s' is 2x2 but depth image '%s' is 371x250"
                                    % (small, depth_path))

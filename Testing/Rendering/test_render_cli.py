@@ -7,9 +7,8 @@ import subprocess
 import sys
 
 import numpy as np
-import vtk
 import octoray
-from vtk.util.numpy_support import vtk_to_numpy
+from octoray.png import read_png
 
 DATA = os.environ.get("OCTORAY_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "Data"))
 PARTICLES = os.path.join(DATA, "Particles", "lidar_simple.particles")
@@ -20,13 +19,11 @@ def run(*args):
                           capture_output=True, text=True, timeout=300)
 
 
-def read_png(path):
-    r = vtk.vtkPNGReader()
-    r.SetFileName(path)
-    r.Update()
-    img = r.GetOutput()
-    w, h, _ = img.GetDimensions()
-    return w, h, vtk_to_numpy(img.GetPointData().GetScalars())
+def read_pixels(path):
+    """width, height and the pixels, one row of components each."""
+    rows = read_png(path)
+    h, w = rows.shape[:2]
+    return w, h, rows.reshape(h * w, -1)
 
 
 def test_mappers_are_in_the_package():
@@ -51,7 +48,7 @@ def test_render_particles(tmp_path):
     for word in ("backend: CPU", "load:", "build:", "render:"):
         assert word in r.stdout
     assert "reading" in r.stderr and "100%" in r.stderr  # the progress bar
-    w, h, rgb = read_png(str(out))
+    w, h, rgb = read_pixels(str(out))
     assert (w, h) == (160, 120)
     # The cloud covers a real part of the picture (the background is black).
     covered = (rgb[:, :3].max(axis=1) > 0).sum()
@@ -64,7 +61,7 @@ def test_render_modes_differ(tmp_path):
         out = tmp_path / (mode + ".png")
         r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", mode)
         assert r.returncode == 0, r.stderr
-        pictures.append(read_png(str(out))[2])
+        pictures.append(read_pixels(str(out))[2])
     assert (pictures[0] != pictures[1]).any()
 
 
@@ -74,7 +71,7 @@ def test_render_dicom_folder(tmp_path):
             "--mode", "mip", "--background", "-5000", "-500")
     assert r.returncode == 0, r.stderr
     assert "backend: CPU" in r.stdout
-    assert read_png(str(out))[2][:, :3].max() > 0
+    assert read_pixels(str(out))[2][:, :3].max() > 0
 
 
 def test_render_slice_stack_closed(tmp_path):
@@ -121,7 +118,7 @@ def test_render_pcd(tmp_path):
     r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96")
     assert r.returncode == 0, r.stderr
     assert "points: 400" in r.stdout
-    w, h, rgb = read_png(str(out))
+    w, h, rgb = read_pixels(str(out))
     # The grid's colours are red with some green, never blue.
     drawn = rgb[:, :3].max(axis=1) > 0
     assert drawn.sum() > 0.2 * w * h
@@ -149,7 +146,7 @@ def test_preset_on_a_ct(tmp_path):
         assert "colour: preset %s" % preset in r.stdout
         threshold = {"ct-bone": 306, "ct-skin": -750}[preset]
         assert "threshold: %g " % threshold in r.stdout
-        rgb = read_png(str(out))[2].astype(int)
+        rgb = read_pixels(str(out))[2].astype(int)
         drawn = drawn_pixels(rgb)
         covered[preset] = drawn.sum()
         mean = rgb[drawn, :3].mean(axis=0)
@@ -192,7 +189,7 @@ def test_color_by(tmp_path):
         assert r.returncode == 0, r.stderr
         line = next(l for l in r.stdout.splitlines() if l.startswith("colour:"))
         assert expect in line, line
-        pictures[what] = read_png(str(out))[2]
+        pictures[what] = read_pixels(str(out))[2]
         if what == "auto":
             # The range comes from the 1st..99th percentile: the one point
             # at 1000 does not stretch it.
@@ -222,6 +219,6 @@ def test_normals(tmp_path):
         assert r.returncode == 0, r.stderr
         assert ("normals:" in r.stdout) == expect, r.stdout
         assert ("normals" in r.stderr) == expect  # the progress line
-        pictures[(mode, normals)] = read_png(str(out))[2]
+        pictures[(mode, normals)] = read_pixels(str(out))[2]
     # PCL's normals shade the bump differently from the octree's occupancy.
     assert (np.abs(pictures[("phong", "auto")].astype(int) - pictures[("phong", "none")].astype(int)) > 16).mean() > 0.01
