@@ -531,8 +531,8 @@ struct Options
 
 // A cloud without colours (the LMS400 laser scan has only intensity) gets
 // them from its intensity, or else its elevation, through a blue-to-red
-// table: every method then draws the same colours, and
-// the resampled volumes have colour to interpolate.
+// table: every method then draws the same colours, and the resampled
+// volumes have colour to interpolate.
 void ColourIfUncoloured(vtkPolyData* cloud)
 {
   if (cloud->GetPointData()->GetArray("Colors"))
