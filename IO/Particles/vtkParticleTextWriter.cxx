@@ -11,6 +11,7 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,45 +25,26 @@ inline char* Put(char* p, char* end, double v, bool isFloat)
   auto r = isFloat ? std::to_chars(p, end, static_cast<float>(v)) : std::to_chars(p, end, v);
   return r.ptr;
 }
-} // namespace
 
-//------------------------------------------------------------------------------
-vtkParticleTextWriter::vtkParticleTextWriter() = default;
-
-//------------------------------------------------------------------------------
-vtkParticleTextWriter::~vtkParticleTextWriter()
+// One column of the file: a component of an array, written as an integer
+// (colours) or in the array's own precision.
+struct Column
 {
-  this->SetFileName(nullptr);
-}
+  std::string Name;
+  vtkDataArray* Array;
+  int Component;
+  bool IsFloat;
+  bool IsColor;
+};
 
-//------------------------------------------------------------------------------
-int vtkParticleTextWriter::FillInputPortInformation(int, vtkInformation* info)
+// The columns the file gets: x y z; r g b from "Colors"; the attributes the
+// reader knows by name; with writeAll every other named one-component
+// array whose name can stand in a header line.
+std::vector<Column> ColumnsOf(vtkPointSet* input, bool writeAll)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
-  return 1;
-}
-
-//------------------------------------------------------------------------------
-void vtkParticleTextWriter::WriteData()
-{
-  vtkPointSet* input = vtkPointSet::SafeDownCast(this->GetInput());
-  if (!input || !this->FileName)
-  {
-    vtkErrorMacro(<< "a point set input and a file name are needed");
-    return;
-  }
-  struct Col
-  {
-    std::string Name;
-    vtkDataArray* Array;
-    int Component;
-    bool IsFloat;
-    bool IsColor;
-  };
-  std::vector<Col> cols;
+  std::vector<Column> cols;
   vtkPoints* pts = input->GetPoints();
-  const vtkIdType n = input->GetNumberOfPoints();
-  if (n > 0 && pts)
+  if (input->GetNumberOfPoints() > 0 && pts)
   {
     const bool f = pts->GetDataType() != VTK_DOUBLE;
     for (int c = 0; c < 3; ++c)
@@ -95,50 +77,47 @@ void vtkParticleTextWriter::WriteData()
       used.emplace_back(name);
     }
   }
-  if (this->WriteAllArrays)
+  for (int i = 0; writeAll && i < pd->GetNumberOfArrays(); ++i)
   {
-    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+    vtkDataArray* a = pd->GetArray(i);
+    if (!a || !a->GetName() || a->GetNumberOfComponents() != 1)
     {
-      vtkDataArray* a = pd->GetArray(i);
-      if (!a || !a->GetName() || a->GetNumberOfComponents() != 1)
-      {
-        continue;
-      }
-      std::string name = a->GetName();
-      bool skip = std::find(used.begin(), used.end(), name) != used.end() ||
-        name.find_first_of(" \t,#") != std::string::npos;
-      if (skip)
-      {
-        continue;
-      }
+      continue;
+    }
+    const std::string name = a->GetName();
+    if (std::find(used.begin(), used.end(), name) == used.end() &&
+      name.find_first_of(" \t,#") == std::string::npos)
+    {
       cols.push_back({ name, a, 0, a->GetDataType() != VTK_DOUBLE, false });
       used.push_back(name);
     }
   }
+  return cols;
+}
 
-  FILE* f = std::fopen(this->FileName, "wb");
-  if (!f)
-  {
-    vtkErrorMacro(<< this->FileName << ": cannot open for writing");
-    return;
-  }
+// The header line and a line per point, through a 1 MiB buffer; false when
+// a write failed. progress(fraction) every 65536 points.
+bool WriteRows(std::FILE* f, const std::vector<Column>& cols, vtkIdType n, const std::function<void(double)>& progress)
+{
   std::string header = "#";
   for (const auto& c : cols)
   {
     header += " " + c.Name;
   }
   header += "\n";
-  std::fwrite(header.data(), 1, header.size(), f);
+  bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
   std::vector<char> buf(1 << 20);
   char* p = buf.data();
   char* end = buf.data() + buf.size();
-  bool ok = true;
+  auto flush = [&] {
+    ok = ok && std::fwrite(buf.data(), 1, p - buf.data(), f) == static_cast<size_t>(p - buf.data());
+    p = buf.data();
+  };
   for (vtkIdType i = 0; i < n && ok; ++i)
   {
     if (end - p < static_cast<ptrdiff_t>(32 * cols.size() + 2))
     {
-      ok = std::fwrite(buf.data(), 1, p - buf.data(), f) == static_cast<size_t>(p - buf.data());
-      p = buf.data();
+      flush();
     }
     for (size_t c = 0; c < cols.size(); ++c)
     {
@@ -147,16 +126,52 @@ void vtkParticleTextWriter::WriteData()
         *p++ = ' ';
       }
       const double v = cols[c].Array->GetComponent(i, cols[c].Component);
-      p = cols[c].IsColor ? std::to_chars(p, end, static_cast<int>(v)).ptr
-                          : Put(p, end, v, cols[c].IsFloat);
+      p = cols[c].IsColor ? std::to_chars(p, end, static_cast<int>(v)).ptr : Put(p, end, v, cols[c].IsFloat);
     }
     *p++ = '\n';
     if ((i & 0xffff) == 0)
     {
-      this->UpdateProgress(static_cast<double>(i) / n);
+      progress(static_cast<double>(i) / n);
     }
   }
-  ok = ok && std::fwrite(buf.data(), 1, p - buf.data(), f) == static_cast<size_t>(p - buf.data());
+  flush();
+  return ok;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkParticleTextWriter::vtkParticleTextWriter() = default;
+
+//------------------------------------------------------------------------------
+vtkParticleTextWriter::~vtkParticleTextWriter()
+{
+  this->SetFileName(nullptr);
+}
+
+//------------------------------------------------------------------------------
+int vtkParticleTextWriter::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkParticleTextWriter::WriteData()
+{
+  vtkPointSet* input = vtkPointSet::SafeDownCast(this->GetInput());
+  if (!input || !this->FileName)
+  {
+    vtkErrorMacro(<< "a point set input and a file name are needed");
+    return;
+  }
+  const std::vector<Column> cols = ColumnsOf(input, this->WriteAllArrays);
+  std::FILE* f = std::fopen(this->FileName, "wb");
+  if (!f)
+  {
+    vtkErrorMacro(<< this->FileName << ": cannot open for writing");
+    return;
+  }
+  bool ok = WriteRows(f, cols, input->GetNumberOfPoints(), [this](double done) { this->UpdateProgress(done); });
   ok = (std::fclose(f) == 0) && ok;
   if (!ok)
   {
