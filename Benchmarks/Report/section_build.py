@@ -279,6 +279,8 @@ def _cuda(ctx):
     mem = {(r["n"], r["depth"]): r["seconds"] for r in records if r["name"] == "gpu bytes per point"}
     # Runs since the report exist record the device phases (BuildStats) too.
     phases = all("sort_seconds" in r for r in builds)
+    # And since issue 16, the pinned host-to-device copy of the same input.
+    upload = all(r.get("pinned_upload_seconds") for r in builds)
     rows, csv_rows = [], []
     for r in builds:
         row = [count(r["n"]), r["depth"], seconds(r["seconds"])]
@@ -289,6 +291,8 @@ def _cuda(ctx):
         row += [seconds(r["peer_seconds"]), "%.0f" % (r["seconds"] / r["peer_seconds"])]
         if phases:
             row += ["%.1f" % (device / r["peer_seconds"]), count(r["nodes"])]
+        if upload:
+            row += [seconds(r["pinned_upload_seconds"]), "%.2f" % (r["seconds"] / r["pinned_upload_seconds"])]
         row += ["%.0f" % mem.get((r["n"], r["depth"]), 0)]
         rows.append(row)
         csv_rows.append([r["n"], r["depth"], r["seconds"], r["peer_seconds"], mem.get((r["n"], r["depth"])),
@@ -297,7 +301,8 @@ def _cuda(ctx):
     csv = ctx.write_csv("build-cuda", ["points", "depth", "build_s", "cub_sort_s", "gpu_bytes_per_point",
                                        "keys_s", "sort_s", "levels_s", "nodes"], csv_rows)
     header = ["points", "depth", "whole call"] + (["device phases, ms (keys / sort / levels)"] if phases else []) + \
-        ["bare CUB sort", "call / sort"] + (["phases / sort", "nodes"] if phases else []) + ["GPU bytes/point"]
+        ["bare CUB sort", "call / sort"] + (["phases / sort", "nodes"] if phases else []) + \
+        (["pinned copy of the input", "call / copy"] if upload else []) + ["GPU bytes/point"]
     updates = [r for r in records if r["name"].startswith("update")]
     urows = [[r["name"].split()[1], count(r["n"]), r["depth"], seconds(r["seconds"]), seconds(r["peer_seconds"]),
               "%.2f" % (r["seconds"] / r["peer_seconds"])] for r in updates]
@@ -306,7 +311,8 @@ def _cuda(ctx):
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
         "events in the same run. Medians of 7 (3 at 100 M). GPU bytes per point include the sort buffers the engine "
-        "keeps for rebuilds.%s" % (gpu_source(ctx, name), "" if phases else
+        "keeps for rebuilds. The pinned copy: the same input arrays as one block of page-locked host memory copied "
+        "to the device (cudaMemcpy, median of 5), what a whole call from host arrays cannot beat.%s" % (gpu_source(ctx, name), "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),
         "",
         ctx.table(header, rows),
