@@ -70,13 +70,12 @@ int main(int argc, char** argv)
 
   try
   {
-    std::string why;
-    if (backend == "cuda" && !CudaAvailable(&why))
+    const std::vector<Backend> backends = RequestedBackends(backend);
+    if (backends.empty())
     {
-      std::printf("no usable GPU: %s\n", why.c_str());
-      return 0;
+      return 0; // CUDA asked for where there is none: nothing to measure
     }
-    auto engine = CreateEngine(backend == "cuda" ? Backend::CUDA : Backend::CPU);
+    auto engine = CreateEngine(backends.front());
     std::printf("octoray_bench_quantisation: %s; build time median of %d after a warm-up\n",
       engine->Description().c_str(), repeats);
 

@@ -115,17 +115,7 @@ int main(int argc, char** argv)
   parts = "," + parts + ",";
   const auto wanted = [&](const char* part) { return parts.find(std::string(",") + part + ",") != std::string::npos; };
 
-  std::vector<Backend> backends;
-  if (backend == "cpu" || backend == "all")
-    backends.push_back(Backend::CPU);
-  if (backend == "cuda" || backend == "all")
-  {
-    std::string why;
-    if (CudaAvailable(&why))
-      backends.push_back(Backend::CUDA);
-    else
-      std::printf("CUDA skipped: %s\n", why.c_str());
-  }
+  const std::vector<Backend> backends = RequestedBackends(backend);
 
   try
   {

@@ -12,6 +12,7 @@
 
 #include "BenchUtil.h"
 
+#include <octoray/Engine.h>
 #include <octoray/Frame.h>
 #include <octoray/PointCloud.h>
 #include <octoray/Render.h>
@@ -19,12 +20,38 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 namespace octoray
 {
 namespace bench
 {
+// The backends `--backend cpu|cuda|all` names. CUDA is left out where no
+// device is usable, saying why; asked for alone, that leaves none.
+inline std::vector<Backend> RequestedBackends(const std::string& choice)
+{
+  std::vector<Backend> backends;
+  if (choice == "cpu" || choice == "all")
+  {
+    backends.push_back(Backend::CPU);
+  }
+  if (choice == "cuda" || choice == "all")
+  {
+    std::string why;
+    if (CudaAvailable(&why))
+    {
+      backends.push_back(Backend::CUDA);
+    }
+    else
+    {
+      std::printf("CUDA skipped: %s\n", why.c_str());
+    }
+  }
+  return backends;
+}
+
 // Float positions, 8-bit colours and a reflectivity per point: the
 // attributes the CUDA benchmark's clouds carry.
 struct ColouredCloud
