@@ -70,12 +70,11 @@ int main(int argc, char** argv)
 
   try
   {
-    const std::vector<Backend> backends = RequestedBackends(backend);
-    if (backends.empty())
+    std::unique_ptr<Engine> engine = RequestedEngine(backend);
+    if (!engine)
     {
-      return 0; // CUDA asked for where there is none: nothing to measure
+      return 0;
     }
-    auto engine = CreateEngine(backends.front());
     std::printf("octoray_bench_quantisation: %s; build time median of %d after a warm-up\n",
       engine->Description().c_str(), repeats);
 

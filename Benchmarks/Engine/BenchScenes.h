@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,14 @@ inline std::vector<Backend> RequestedBackends(const std::string& choice)
     }
   }
   return backends;
+}
+
+// The engine of the one backend `--backend cpu|cuda` names; null where that
+// is CUDA and none is usable (the program then has nothing to measure).
+inline std::unique_ptr<Engine> RequestedEngine(const std::string& choice)
+{
+  const std::vector<Backend> backends = RequestedBackends(choice);
+  return backends.empty() ? nullptr : CreateEngine(backends.front());
 }
 
 // Float positions, 8-bit colours and a reflectivity per point: the

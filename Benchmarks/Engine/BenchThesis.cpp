@@ -81,12 +81,11 @@ int main(int argc, char** argv)
 
   try
   {
-    const std::vector<Backend> backends = RequestedBackends(backend);
-    if (backends.empty())
+    std::unique_ptr<Engine> engine = RequestedEngine(backend);
+    if (!engine)
     {
-      return 0; // CUDA asked for where there is none: nothing to measure
+      return 0;
     }
-    auto engine = CreateEngine(backends.front());
     const std::string name = engine->Description();
     std::printf("octoray_bench_thesis: %s; medians of %d after a warm-up\n", name.c_str(), repeats);
     std::vector<Record> records;
