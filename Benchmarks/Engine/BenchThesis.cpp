@@ -34,6 +34,17 @@ int Usage()
   return 2;
 }
 
+// A build's record: its median, fastest time, memory and nodes (depth 7, the
+// thesis's).
+Record BuildRecord(const char* name, const std::string& backend, std::size_t n, const Timing& build, double bytes,
+  std::size_t nodes)
+{
+  return Record{ name, backend, n, 7, build.median, "", 0.0 }
+    .With("bytes", bytes)
+    .With("nodes", double(nodes))
+    .With("min_seconds", build.min);
+}
+
 // Median frame time from the engine's own RenderStats after a warm-up frame.
 Timing TraceTime(Engine& engine, const RenderSettings& s, int repeats, RenderStats& stats)
 {
@@ -103,10 +114,7 @@ int main(int argc, char** argv)
       const double bytes = double(engine->Memory().Total());
       std::printf("| %zu | %.2f | %.2f | %.1f |\n", c.Size(), build.median * 1e3, trace.median * 1e3, bytes / 1e6);
       std::fflush(stdout);
-      records.push_back(Record{ "thesis/table2/build", backend, c.Size(), 7, build.median, "", 0.0 }
-                          .With("bytes", bytes)
-                          .With("nodes", double(stats.nodes))
-                          .With("min_seconds", build.min));
+      records.push_back(BuildRecord("thesis/table2/build", backend, c.Size(), build, bytes, stats.nodes));
       records.push_back(Record{ "thesis/table2/trace_800x600", backend, c.Size(), 7, trace.median, "", 0.0 }
                           .With("min_seconds", trace.min)
                           .With("rays", double(rs.primaryRays + rs.secondaryRays)));
@@ -133,10 +141,7 @@ int main(int argc, char** argv)
                   "Phong + shadows + 1 bounce %.2f ms / image (%zu secondary rays); %.1f MB\n",
         c.Size(), stats.nodes, build.median * 1e3, phong.median * 1e3, full.median * 1e3, fullStats.secondaryRays,
         bytes / 1e6);
-      records.push_back(Record{ "thesis/two_spheres/build", backend, c.Size(), 7, build.median, "", 0.0 }
-                          .With("bytes", bytes)
-                          .With("nodes", double(stats.nodes))
-                          .With("min_seconds", build.min));
+      records.push_back(BuildRecord("thesis/two_spheres/build", backend, c.Size(), build, bytes, stats.nodes));
       records.push_back(Record{ "thesis/two_spheres/phong_800x600", backend, c.Size(), 7, phong.median, "", 0.0 }
                           .With("min_seconds", phong.min)
                           .With("rays", double(phongStats.primaryRays + phongStats.secondaryRays)));

@@ -33,22 +33,22 @@ OPACITY = {
 THRESHOLD = {"ct-bone": 306, "ct-skin": -750, "ct-muscle": 34}
 
 
+def nodes(function, width):
+    """The nodes of a colour (width 6) or opacity (width 4) transfer function."""
+    out = []
+    for i in range(function.GetSize()):
+        v = [0.0] * width
+        function.GetNodeValue(i, v)
+        out.append(tuple(v))
+    return out
+
+
 def colour_nodes(ctf):
-    nodes = []
-    for i in range(ctf.GetSize()):
-        v = [0.0] * 6
-        ctf.GetNodeValue(i, v)
-        nodes.append(tuple(v))
-    return nodes
+    return nodes(ctf, 6)
 
 
 def opacity_nodes(pwf):
-    nodes = []
-    for i in range(pwf.GetSize()):
-        v = [0.0] * 4
-        pwf.GetNodeValue(i, v)
-        nodes.append(tuple(v))
-    return nodes
+    return nodes(pwf, 4)
 
 
 def same(got, want):
