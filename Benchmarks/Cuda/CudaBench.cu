@@ -4,7 +4,13 @@
 //    of the same 63-bit keys with 32-bit indices (the build's floor);
 //  - update of 1% and 100% of 10 M points beside a full rebuild;
 //  - primary rays and shadow + one-bounce rays at 1920x1080, depth 10 and 16;
-//  - GPU bytes per point at depth 10 and 21.
+//  - GPU bytes per point at depth 10 and 21, with the points kept for
+//    updates and without them (the node arrays alone);
+//  - the upload of the caller's pageable arrays beside plain cudaMemcpy and
+//    cudaHostRegister of the same arrays (--only build skips the rest);
+//  - with --billion N: N points generated on the device, built without
+//    their points, and traced at 1920x1080 (build time, bytes per point,
+//    frame time).
 // Times are medians of repeated runs after a warm-up; device work is timed
 // with CUDA events (the sort) or synchronised wall clock (whole engine calls).
 #include <octoray/Engine.h>
@@ -23,6 +29,7 @@
 #include <fstream>
 #include <functional>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -161,9 +168,125 @@ double PinnedUploadSeconds(const Cloud& c, double& megabytes)
   return Median(times);
 }
 
+// The same input arrays copied as a caller's pageable arrays go without the
+// engine's staging: plain cudaMemcpy (what the engine did before), and
+// page-locked in place with cudaHostRegister, copied, unregistered.
+// Medians of 3; 0 where the call failed.
+struct UploadPeers
+{
+  double pageable = 0.0;
+  double registered = 0.0;
+};
+
+UploadPeers MeasureUploadPeers(Cloud& c)
+{
+  struct Array
+  {
+    void* data;
+    std::size_t bytes;
+  };
+  const Array arrays[3] = { { c.xyz.data(), c.xyz.size() * sizeof(float) }, { c.rgb.data(), c.rgb.size() },
+    { c.reflectivity.data(), c.reflectivity.size() * sizeof(float) } };
+  std::size_t total = 0;
+  for (const Array& a : arrays)
+    total += a.bytes;
+  void* device = nullptr;
+  UploadPeers peers;
+  if (cudaMalloc(&device, total) != cudaSuccess)
+    return peers;
+  auto copyAll = [&](bool registerFirst) {
+    char* to = static_cast<char*>(device);
+    bool ok = true;
+    for (const Array& a : arrays)
+    {
+      if (registerFirst)
+        ok = ok && cudaHostRegister(a.data, a.bytes, cudaHostRegisterDefault) == cudaSuccess;
+      ok = ok && cudaMemcpy(to, a.data, a.bytes, cudaMemcpyHostToDevice) == cudaSuccess;
+      if (registerFirst)
+        ok = ok && cudaHostUnregister(a.data) == cudaSuccess;
+      to += a.bytes;
+    }
+    return ok;
+  };
+  for (bool registerFirst : { false, true })
+  {
+    std::vector<double> times;
+    bool ok = true;
+    for (int r = 0; r < 3 && ok; ++r)
+    {
+      const auto t0 = std::chrono::steady_clock::now();
+      ok = copyAll(registerFirst);
+      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    cudaGetLastError();
+    (registerFirst ? peers.registered : peers.pageable) = ok ? Median(times) : 0.0;
+  }
+  cudaFree(device);
+  return peers;
+}
+
+// Gaussian clusters like MakeCloud's, generated on the device from a fixed
+// seed (a counter-based hash, so every point is the same on every run):
+// xyz float and 8-bit RGB, written to device arrays.
+__device__ std::uint64_t SplitMix64(std::uint64_t x)
+{
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+__global__ void ClusteredPointsKernel(std::size_t n, std::uint64_t seed, float* xyz, std::uint8_t* rgb)
+{
+  const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  if (i >= n)
+    return;
+  const float centres[8][3] = { { 0, 0, 0 }, { 4, 1, -2 }, { -3, 3, 1 }, { 2, -4, 3 }, { -2, -2, -3 }, { 3, 3, 3 },
+    { -4, 0, 2 }, { 0, 4, -4 } };
+  const int k = static_cast<int>(i & 7);
+  const float s = 0.3f + 0.2f * k;
+  for (int a = 0; a < 3; ++a)
+  {
+    // Box-Muller from two 24-bit uniforms of one hash.
+    const std::uint64_t h = SplitMix64(seed ^ (3 * i + a) * 0xD1B54A32D192ED03ull);
+    const float u1 = (float((h >> 40) & 0xFFFFFF) + 1.0f) * (1.0f / 16777217.0f);
+    const float u2 = float((h >> 16) & 0xFFFFFF) * (1.0f / 16777216.0f);
+    xyz[3 * i + a] = centres[k][a] + s * sqrtf(-2.0f * logf(u1)) * cospif(2.0f * u2);
+    rgb[3 * i + a] = static_cast<std::uint8_t>(60 + 25 * k + 20 * a);
+  }
+}
+
 RenderSettings Camera(const HostOctree& t, int w, int h)
 {
   return bench::CubeCamera(t.cube, w, h);
+}
+
+// Device time of one frame, picture left on the device (as the VTK mapper
+// draws it), from RenderStats: the median of 9 after a warm-up. `last`: the
+// last frame's statistics (its ray counts).
+double FrameSeconds(Engine& engine, const RenderSettings& s, RenderStats& last)
+{
+  Image image;
+  std::vector<double> frames;
+  for (int r = 0; r < 10; ++r)
+  {
+    last = engine.Render(s, image);
+    if (r)
+      frames.push_back(last.seconds);
+  }
+  return Median(frames);
+}
+
+// The full light model of the render figures: Phong, one directional
+// light with shadows, one mirror bounce.
+void AddShadowsAndBounce(RenderSettings& s)
+{
+  s.shade = ShadeMode::Phong;
+  Light sun;
+  sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
+  s.lights.push_back(sun);
+  s.shadows = true;
+  s.maxBounces = 1;
 }
 
 struct Record
@@ -178,6 +301,61 @@ struct Record
   // (the report reads them; see BenchUtil.h's Record::extra).
   std::vector<std::pair<std::string, double>> extra = {};
 };
+}
+
+// n points generated on the device (ClusteredPointsKernel) and built
+// from there at depth 10 without their points, then traced at 1920x1080:
+// the first build (allocations included, one run), the bytes held, and the
+// frame times. Throws where the device cannot hold them.
+void MeasureDevicePoints(std::size_t n, std::vector<Record>& records)
+{
+  float* xyz = nullptr;
+  std::uint8_t* rgb = nullptr;
+  if (cudaMalloc(&xyz, 3 * n * sizeof(float)) != cudaSuccess || cudaMalloc(&rgb, 3 * n) != cudaSuccess)
+  {
+    cudaGetLastError();
+    cudaFree(xyz);
+    throw std::runtime_error("no room on the device for the generated points");
+  }
+  ClusteredPointsKernel<<<static_cast<unsigned>((n + 255) / 256), 256>>>(n, 1, xyz, rgb);
+  if (cudaDeviceSynchronize() != cudaSuccess)
+    throw std::runtime_error(std::string("generating the points failed: ") + cudaGetErrorString(cudaGetLastError()));
+  PointCloudView v;
+  v.count = n;
+  v.xyzFloat = xyz;
+  v.color8 = rgb;
+  v.colorComponents = 3;
+  auto engine = CreateEngine(Backend::CUDA);
+  BuildOptions o;
+  o.depth = 10;
+  o.keepPoints = false;
+  const auto start = std::chrono::steady_clock::now();
+  const BuildStats build = engine->Build(v, o);
+  cudaDeviceSynchronize();
+  const double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  cudaFree(xyz);
+  cudaFree(rgb);
+  const double bytesPerPoint = double(engine->Memory().Total()) / n;
+  size_t freeBytes = 0, totalBytes = 0;
+  cudaMemGetInfo(&freeBytes, &totalBytes);
+  RenderSettings s = bench::CubeCamera(build.cube, 1920, 1080);
+  s.maxBounces = 0;
+  s.copyToHost = false;
+  RenderStats stats;
+  const double primary = FrameSeconds(*engine, s, stats);
+  AddShadowsAndBounce(s);
+  const double full = FrameSeconds(*engine, s, stats);
+  std::printf("device-generated %zu points, depth 10, points not kept: build %.1f ms (upload %.1f, keys %.1f, sort "
+              "%.1f, levels %.1f ms), %zu nodes, %.2f GPU bytes/point (%.2f GB; %.1f of %.1f GB free after); "
+              "1920x1080 primary %.3f ms (%.0f frames/s), Phong + shadows + 1 bounce %.3f ms (%.0f frames/s)\n",
+    n, buildSeconds * 1e3, build.uploadSeconds * 1e3, build.keySeconds * 1e3, build.sortSeconds * 1e3,
+    build.levelSeconds * 1e3, build.nodes, bytesPerPoint, engine->Memory().Total() / 1e9, freeBytes / 1e9,
+    totalBytes / 1e9, primary * 1e3, 1.0 / primary, full * 1e3, 1.0 / full);
+  records.push_back({ "device points build", n, 10, buildSeconds, "", 0,
+    { { "nodes", double(build.nodes) }, { "bytes_per_point", bytesPerPoint }, { "sort_seconds", build.sortSeconds },
+      { "level_seconds", build.levelSeconds } } });
+  records.push_back({ "device points primary 1920x1080", n, 10, primary, "", 0 });
+  records.push_back({ "device points shadows+bounce 1920x1080", n, 10, full, "", 0 });
 }
 
 int Run(int argc, char** argv);
@@ -198,6 +376,8 @@ int main(int argc, char** argv)
 int Run(int argc, char** argv)
 {
   std::string json;
+  std::string only; // "build" or "render": that section alone
+  std::size_t billion = 0;
   std::vector<std::size_t> sizes = { 1000000, 10000000, 100000000 };
   for (int a = 1; a < argc; ++a)
   {
@@ -205,7 +385,12 @@ int Run(int argc, char** argv)
       json = argv[++a];
     else if (!std::strcmp(argv[a], "--small"))
       sizes = { 1000000, 10000000 };
+    else if (!std::strcmp(argv[a], "--only") && a + 1 < argc)
+      only = argv[++a];
+    else if (!std::strcmp(argv[a], "--billion") && a + 1 < argc)
+      billion = static_cast<std::size_t>(std::stod(argv[++a]));
   }
+  auto section = [&](const char* name) { return only.empty() || only == name; };
   std::string why;
   if (!CudaAvailable(&why))
   {
@@ -217,12 +402,16 @@ int Run(int argc, char** argv)
   std::vector<Record> records;
 
   // Build against the sort floor.
-  Cloud ten;
-  for (std::size_t n : sizes)
+  Cloud ten = section("build") ? Cloud() : MakeCloud(10000000, 1);
+  for (std::size_t n : section("build") ? sizes : std::vector<std::size_t>())
   {
     Cloud c = MakeCloud(n, 1);
     double uploadMegabytes = 0.0;
     const double pinnedUpload = PinnedUploadSeconds(c, uploadMegabytes);
+    const UploadPeers peers = MeasureUploadPeers(c);
+    std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
+                "%.3f ms, cudaHostRegister + copy %.3f ms\n",
+      n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
@@ -238,17 +427,25 @@ int Run(int argc, char** argv)
       const double t = TimeMedian(repeats, [&] { last = engine->Build(c.View(), o); });
       const double floor = SortFloorSeconds(c, 3 * depth);
       const double bytesPerPoint = double(engine->Memory().Total()) / n;
-      std::printf("build n=%zu depth=%d: %.3f ms (keys %.3f, sort %.3f, levels %.3f ms; incl. upload), bare CUB "
+      // Without the points kept for updates: what a static scene holds.
+      BuildOptions lean = o;
+      lean.keepPoints = false;
+      const double leanSeconds = TimeMedian(repeats, [&] { engine->Build(c.View(), lean); });
+      const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
+      std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
                   "sort %.3f ms, ratio %.2f, %zu nodes, %.1f GPU bytes/point; pinned copy of its %.0f MB input "
-                  "%.3f ms, whole call %.2fx that\n",
-        n, depth, t * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3, last.levelSeconds * 1e3, floor * 1e3,
-        t / floor, last.nodes, bytesPerPoint, uploadMegabytes, pinnedUpload * 1e3,
-        pinnedUpload > 0 ? t / pinnedUpload : 0.0);
+                  "%.3f ms, whole call %.2fx that; without the points %.3f ms, %.1f GPU bytes/point\n",
+        n, depth, t * 1e3, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
+        last.levelSeconds * 1e3, floor * 1e3, t / floor, last.nodes, bytesPerPoint, uploadMegabytes,
+        pinnedUpload * 1e3, pinnedUpload > 0 ? t / pinnedUpload : 0.0, leanSeconds * 1e3, leanBytesPerPoint);
       records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
-        { { "key_seconds", last.keySeconds }, { "sort_seconds", last.sortSeconds },
-          { "level_seconds", last.levelSeconds }, { "nodes", double(last.nodes) },
-          { "pinned_upload_seconds", pinnedUpload } } });
-      records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0 });
+        { { "upload_seconds", last.uploadSeconds }, { "key_seconds", last.keySeconds },
+          { "sort_seconds", last.sortSeconds }, { "level_seconds", last.levelSeconds },
+          { "nodes", double(last.nodes) }, { "pinned_upload_seconds", pinnedUpload },
+          { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
+          { "lean_seconds", leanSeconds } } });
+      records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
+        { { "lean_bytes_per_point", leanBytesPerPoint } } });
     }
     if (n == 10000000)
     {
@@ -257,6 +454,7 @@ int Run(int argc, char** argv)
   }
 
   // Update of 1% and 100% of 10 M points against a rebuild.
+  if (section("build"))
   {
     BuildOptions o;
     o.depth = 10;
@@ -304,7 +502,7 @@ int Run(int argc, char** argv)
   }
 
   // Rendering at 1920x1080.
-  for (int depth : { 10, 16 })
+  for (int depth : section("render") ? std::vector<int>{ 10, 16 } : std::vector<int>())
   {
     BuildOptions o;
     o.depth = depth;
@@ -319,35 +517,14 @@ int Run(int argc, char** argv)
     std::size_t hit = 0;
     for (std::size_t i = 0; i < image.depth.size(); ++i)
       hit += image.depth[i] < 1;
-    // Device time of the frame alone, picture left on the device (as the
-    // VTK mapper will draw it), from RenderStats.
     s.copyToHost = false;
-    std::vector<double> frames;
-    for (int r = 0; r < 10; ++r)
-    {
-      stats = engine->Render(s, image);
-      if (r)
-        frames.push_back(stats.seconds);
-    }
-    const double primary = Median(frames);
+    const double primary = FrameSeconds(*engine, s, stats);
     std::printf("render depth %d, primary: %.3f ms on the device, %.0f Mrays/s; %.3f ms with the copy to the host; "
                 "%.1f%% of pixels hit\n",
       depth, primary * 1e3, 1920.0 * 1080 / primary / 1e6, withCopy * 1e3, 100.0 * hit / (1920.0 * 1080));
     records.push_back({ "render primary 1920x1080", ten.xyz.size() / 3, depth, primary, "", 0 });
-    s.shade = ShadeMode::Phong;
-    Light sun;
-    sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
-    s.lights.push_back(sun);
-    s.shadows = true;
-    s.maxBounces = 1;
-    std::vector<double> fullFrames;
-    for (int r = 0; r < 10; ++r)
-    {
-      stats = engine->Render(s, image);
-      if (r)
-        fullFrames.push_back(stats.seconds);
-    }
-    const double full = Median(fullFrames);
+    AddShadowsAndBounce(s);
+    const double full = FrameSeconds(*engine, s, stats);
     const double rays = double(stats.primaryRays + stats.secondaryRays);
     std::printf("render depth %d, Phong + shadows + 1 bounce: %.3f ms, %.0f Mrays/s (%zu secondary rays)\n", depth,
       full * 1e3, rays / full / 1e6, stats.secondaryRays);
@@ -358,11 +535,12 @@ int Run(int argc, char** argv)
   // slice stack (grid points inside an ellipsoid, slice by slice), depth 7,
   // 800x600 rays. Thesis figures, for all five sizes: build 0.02-6.1 s
   // (almost all allocation), ray tracing 24-45 ms per image, 2.4-2.5 GB.
-  std::printf("thesis table 2 (depth 7, 800x600): points, build ms, trace ms/image, GPU MB\n");
   // A fresh engine, so that buffers kept from the 100 M builds above do not
   // count in its memory.
   engine = CreateEngine(Backend::CUDA);
-  for (std::size_t n : bench::ThesisTable2Counts())
+  if (section("build"))
+    std::printf("thesis table 2 (depth 7, 800x600): points, build ms, trace ms/image, GPU MB\n");
+  for (std::size_t n : section("build") ? bench::ThesisTable2Counts() : std::vector<std::size_t>())
   {
     const Cloud c = bench::ThesisSliceStack(n);
     const std::size_t count = c.xyz.size() / 3;
@@ -388,6 +566,20 @@ int Run(int argc, char** argv)
     records.push_back({ "thesis table 2 build", count, 7, build, "", 0,
       { { "bytes", double(engine->Memory().Total()) } } });
     records.push_back({ "thesis table 2 trace 800x600", count, 7, trace, "", 0 });
+  }
+
+  if (billion)
+  {
+    engine.reset();
+    ten = Cloud();
+    try
+    {
+      MeasureDevicePoints(billion, records);
+    }
+    catch (const std::exception& e)
+    {
+      std::printf("device-generated %zu points: %s\n", billion, e.what());
+    }
   }
 
   if (!json.empty())

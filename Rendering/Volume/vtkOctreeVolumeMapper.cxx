@@ -348,6 +348,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RefractionArrayName: "
      << (this->RefractionArrayName ? this->RefractionArrayName : "(none)") << "\n";
   os << indent << "CudaMemoryBudget: " << this->CudaMemoryBudget << "\n";
+  os << indent << "KeepPointsForUpdates: " << (this->KeepPointsForUpdates ? "On" : "Off") << "\n";
   os << indent << "NumberOfBuilds: " << this->NumberOfBuilds << "\n";
   os << indent << "NumberOfUpdates: " << this->NumberOfUpdates << "\n";
   os << indent << "NumberOfTraces: " << this->NumberOfTraces << "\n";

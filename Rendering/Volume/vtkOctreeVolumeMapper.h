@@ -310,6 +310,19 @@ public:
 
   ///@{
   /**
+   * Keep the engine's copy of the points after a build, so that an input
+   * whose positions alone changed (a point set animated in place) is
+   * updated rather than rebuilt. On by default. Off, the engine holds only
+   * the octree's nodes, about a third of the memory for a static scene, and
+   * moved points are rebuilt; it takes effect at the next build.
+   */
+  vtkSetMacro(KeepPointsForUpdates, bool);
+  vtkGetMacro(KeepPointsForUpdates, bool);
+  vtkBooleanMacro(KeepPointsForUpdates, bool);
+  ///@}
+
+  ///@{
+  /**
    * What the mapper did: full octree builds, in-place updates (only point
    * positions changed) and traced pictures. A render that changes nothing
    * redraws the last picture without tracing.
@@ -392,6 +405,7 @@ protected:
   char* ReflectivityArrayName = nullptr;
   char* RefractionArrayName = nullptr;
   vtkIdType CudaMemoryBudget = 0;
+  bool KeepPointsForUpdates = true;
 
   vtkIdType NumberOfBuilds = 0;
   vtkIdType NumberOfUpdates = 0;

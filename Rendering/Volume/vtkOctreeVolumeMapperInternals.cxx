@@ -123,23 +123,29 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
     case vtkOctreeInputHelper::Change::None:
       return Step::Done;
     case vtkOctreeInputHelper::Change::Positions:
-    {
-      // Only the positions moved (a point set animated in place).
-      const double start = Now();
-      const octoray::PositionsView moved = this->Input.Positions(request);
-      const Step step = this->Run("update", [&] { this->Backend.Engine()->Update(moved); });
-      if (step == Step::Done)
-      {
-        this->Input.Remember(request);
-        ++this->OctreeVersion;
-        ++this->Self->NumberOfUpdates;
-        this->Self->LastBuildSeconds = Now() - start;
-      }
-      return step;
-    }
+      // Only the positions moved (a point set animated in place): updated
+      // where the engine kept its points (KeepPointsForUpdates).
+      return this->BuiltWithPoints ? this->Update(request) : this->Build(request);
     default:
       return this->Build(request);
   }
+}
+
+//------------------------------------------------------------------------------
+vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Update(
+  const vtkOctreeInputHelper::Request& request)
+{
+  const double start = Now();
+  const octoray::PositionsView moved = this->Input.Positions(request);
+  const Step step = this->Run("update", [&] { this->Backend.Engine()->Update(moved); });
+  if (step == Step::Done)
+  {
+    this->Input.Remember(request);
+    ++this->OctreeVersion;
+    ++this->Self->NumberOfUpdates;
+    this->Self->LastBuildSeconds = Now() - start;
+  }
+  return step;
 }
 
 //------------------------------------------------------------------------------
@@ -161,6 +167,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
   self->UpdateProgress(0.5);
   octoray::BuildOptions options;
   options.depth = request.LeafDepth;
+  options.keepPoints = self->KeepPointsForUpdates;
   const bool rootBounds = vtkMath::AreBoundsInitialized(request.RootBounds.data());
   if (rootBounds)
   {
@@ -202,6 +209,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     this->BuiltDepth = stats.depth;
     this->BuiltFor = request.Input;
     this->BuiltMTime = request.Input->GetMTime();
+    this->BuiltWithPoints = options.keepPoints;
     this->Input.Remember(request);
     ++this->OctreeVersion;
     ++self->NumberOfBuilds;

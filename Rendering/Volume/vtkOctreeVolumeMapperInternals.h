@@ -52,6 +52,7 @@ public:
   Step Acquire();
   Step PrepareOctree(vtkDataSet* input, vtkVolumeProperty* property);
   Step Build(const vtkOctreeInputHelper::Request& request);
+  Step Update(const vtkOctreeInputHelper::Request& request);
   Step Trace(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window);
   octoray::RenderSettings FrameSettings(vtkRenderer* ren, vtkVolume* vol, int width, int height);
   Step OpaqueDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
@@ -74,6 +75,7 @@ public:
   int BuiltDepth = 0;
   vtkDataSet* BuiltFor = nullptr;
   vtkMTimeType BuiltMTime = 0;
+  bool BuiltWithPoints = false; // KeepPointsForUpdates at the last build: Update can run
   bool CellScalarsWarned = false;
   bool InteropUnusable = false; // said once; the host path from then on
 

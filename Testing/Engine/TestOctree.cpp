@@ -1,4 +1,5 @@
 // The octree against the brute-force reference, on every backend.
+#include "TestRenderSupport.h"
 #include "TestSupport.h"
 
 #include <octoray/Frame.h>
@@ -214,6 +215,60 @@ TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
     "node normals", "point positions", "point colours", "point scalars", "point reflectivities",
     "point refraction indices", "point normals", "point keys", "sort buffers" };
   EXPECT_EQ(labels, expected);
+}
+
+// Without BuildOptions::keepPoints the engine holds the node arrays alone:
+// the same octree and the same picture as with the points kept, less
+// memory, and an update that says why it cannot run.
+TEST_P(OctreeBuild, WithoutItsPointsHoldsOnlyTheNodes)
+{
+  const Cloud c = GaussianClusters(20000, 25);
+  BuildOptions options;
+  options.depth = 8;
+  engine->Build(c.View(), options);
+  const std::size_t keptBytes = engine->Memory().Total();
+  HostOctree kept;
+  engine->CopyToHost(kept);
+  const double eye[3] = { 30, -40, 25 }, target[3] = { 2, 1, 1 };
+  RenderSettings s = Settings(ViewProjection(eye, target, kZUp, 40, 4.0 / 3.0, 5, 150, false, 12), 64, 48);
+  const Image keptImage = RenderChecked(*engine, s);
+
+  options.keepPoints = false;
+  const BuildStats stats = engine->Build(c.View(), options);
+  HostOctree lean;
+  engine->CopyToHost(lean);
+  ExpectSameOctree(lean, kept, true);
+  EXPECT_TRUE(BitIdentical(RenderChecked(*engine, s), keptImage));
+  std::size_t nodeBytes = 0;
+  for (const auto& a : engine->Memory().arrays)
+  {
+    EXPECT_EQ(a.first.rfind("node ", 0), 0u) << a.first << " kept without keepPoints";
+    nodeBytes += a.second;
+  }
+  EXPECT_EQ(stats.bytes, nodeBytes);
+  EXPECT_LT(3 * nodeBytes, 2 * keptBytes) << "node arrays " << nodeBytes << " B of " << keptBytes << " B";
+  EXPECT_EQ(engine->PointCount(), c.Size());
+
+  const std::uint32_t first[1] = { 0 };
+  const double to[3] = { 0, 0, 0 };
+  PositionsView moved;
+  moved.count = 1;
+  moved.xyzDouble = to;
+  moved.indices = first;
+  try
+  {
+    engine->Update(moved);
+    FAIL() << "no error for an update without the points";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_STREQ(e.what(), "octoray: update of an octree built without its points (BuildOptions::keepPoints off); "
+                           "build again from the new positions");
+  }
+  // A build that keeps them makes the octree updatable again.
+  options.keepPoints = true;
+  engine->Build(c.View(), options);
+  EXPECT_EQ(engine->Update(moved).moved, 1u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, OctreeBuild, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);

@@ -18,14 +18,17 @@
 # backends), sanitize (compute-sanitizer memcheck, initcheck and synccheck on
 # the engine's CUDA tests, memcheck on the mapper's), racecheck (on the
 # engine's CUDA tests: the slowest, about 3 minutes), bench (engine
-# benchmarks), report (the report's engine programs), orbit (the mapper
-# against VTK's GPU mappers; ORBIT_ARGS adds arguments).
+# benchmarks; BILLION points, default 1e9, generated on the device, 0: none),
+# profile (Nsight Compute on the render kernel: primary rays, and Phong with
+# shadows and a bounce, 10 M points at depth 10, 1920x1080), report (the
+# report's engine programs), orbit (the mapper against VTK's GPU mappers;
+# ORBIT_ARGS adds arguments).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Benchmarks/gpu/).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 out=$(realpath -m "${1:-build-gpu/logs}")
-parts=",${2:-tests,sanitize,racecheck,bench,report,orbit},"
+parts=",${2:-tests,sanitize,racecheck,bench,profile,report,orbit},"
 mkdir -p "$out"
 status=()
 step() { # name, command...
@@ -92,7 +95,20 @@ if want racecheck; then
 fi
 
 if want bench; then
-  step bench $build/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json"
+  step bench $build/bin/octoray_bench_cuda --json "$out/bench-results-cuda.json" --billion "${BILLION:-1e9}"
+fi
+if want profile; then
+  # RenderKernel launches of `--only render`: 10 with the copy to the host,
+  # then 10 primary and 10 full frames at depth 10 (one of each profiled),
+  # then depth 16. The card's clocks are left as they are.
+  for run in primary:12 full:22; do
+    step "profile-${run%%:*}" ncu --clock-control none -k regex:RenderKernel --launch-skip "${run##*:}" \
+      --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
+      --section MemoryWorkloadAnalysis --section WarpStateStats \
+      --metrics 'regex:smsp__average_warps_issue_stalled_.*_per_issue_active\.ratio$' --csv --page details \
+      --log-file "$out/profile-${run%%:*}.csv" $build/bin/octoray_bench_cuda --only render
+  done
+  python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
 fi
 if want report; then
   # The CT scene is made here by `make report` (VTK reads the DICOM series)
@@ -116,7 +132,8 @@ echo "== octoray GPU check, $(date -u +%Y-%m-%d): $(cat "$out/gpu.txt") =="
 for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper; do
   [ -f "$out/$f.log" ] && echo "$f: $(grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out/$f.log" | sort | uniq -c | tr -s ' ' | paste -sd';')"
 done
-[ -f "$out/bench.log" ] && grep -E "^(device|build|update|render)" "$out/bench.log"
+[ -f "$out/bench.log" ] && grep -E "^(device|upload|build|update|render)" "$out/bench.log"
+[ -f "$out/profile.txt" ] && cat "$out/profile.txt"
 [ -f "$out/orbit.log" ] && grep -E "points: generated|frame median|  =>|skipped" "$out/orbit.log" | cut -c1-220
 printf '%s\n' "${status[@]}"
 } | tee "$out/summary.txt"
@@ -124,7 +141,8 @@ printf '%s\n' "${status[@]}"
 # a limited number of files).
 files=()
 for f in summary.txt gpu.txt engine-tests.xml mapper-tests.xml bench-results-cuda.json quality-cuda.json \
-  bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json orbit.json; do
+  bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json orbit.json profile.txt \
+  profile-primary.csv profile-full.csv; do
   [ -e "$out/$f" ] && files+=("$f")
 done
 (cd "$out" && tar czf report-files.tgz "${files[@]}")

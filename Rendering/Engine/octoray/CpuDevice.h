@@ -122,6 +122,7 @@ public:
   }
   void Synchronize(const char*) {}
   std::size_t ScratchBytes() const { return 0; }
+  void ReleaseScratch() {}
 
   template <typename Fn>
   void ForEach(const char*, std::size_t n, Fn fn)

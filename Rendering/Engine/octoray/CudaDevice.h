@@ -2,11 +2,13 @@
 // loop, CUB for sorting, selection and reductions, and buffers in the
 // engine's memory pool (DeviceMemoryPool). Everything runs in order on the
 // default stream; a loop returns before the GPU has run it, and the host
-// waits only where it reads a result (ToHost, Reduce) or Synchronize. Only
-// compiled by nvcc.
+// waits only where it reads a result (ToHost, Reduce) or Synchronize. The
+// copies of a caller's arrays (Stage, Upload: CudaUpload.h) return
+// complete. Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"
+#include "CudaUpload.h"
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
@@ -118,13 +120,15 @@ public:
   {
     buffer.Release();
   }
+  // `source`: host memory, or device memory (a caller's CUDA arrays),
+  // copied on the device.
   template <typename T>
-  Staged<T> Stage(const T* host, std::size_t n, const char* what)
+  Staged<T> Stage(const T* source, std::size_t n, const char* what)
   {
     Staged<T> staged;
-    if (host)
+    if (source)
     {
-      Upload(staged, host, n, what);
+      Upload(staged, source, n, what);
     }
     return staged;
   }
@@ -134,10 +138,10 @@ public:
     buffer = std::move(staged);
   }
   template <typename T>
-  void Upload(Buffer<T>& buffer, const T* host, std::size_t n, const char* what)
+  void Upload(Buffer<T>& buffer, const T* source, std::size_t n, const char* what)
   {
     Reserve(buffer, n, what);
-    CudaCheck(cudaMemcpy(buffer.Get(), host, n * sizeof(T), cudaMemcpyHostToDevice), what);
+    Staging.Copy(buffer.Get(), source, n * sizeof(T), what);
   }
   template <typename T>
   void Download(const Buffer<T>& buffer, std::vector<T>& host)
@@ -160,6 +164,11 @@ public:
   }
   void Synchronize(const char* what) { CudaCheck(cudaDeviceSynchronize(), what); }
   std::size_t ScratchBytes() const { return CubScratch.Bytes() + ReduceResult.Bytes(); }
+  void ReleaseScratch()
+  {
+    CubScratch.Release();
+    ReduceResult.Release();
+  }
 
   template <typename Fn>
   void ForEach(const char* name, std::size_t n, Fn fn)
@@ -231,5 +240,8 @@ private:
   DeviceMemoryPool Memory;
   DeviceBuffer<unsigned char> CubScratch;
   DeviceBuffer<unsigned char> ReduceResult;
+  // Page-locked host buffers through which large pageable arrays go
+  // (CudaUpload.h); not in the memory report, which counts device bytes.
+  cuda::HostStaging Staging;
 };
 }

@@ -160,6 +160,12 @@ struct BuildOptions
   // data split over parallel ranks. Every point must lie inside it.
   bool fixedCube = false;
   RootCube cube;
+  // Keep the engine's copy of the points (positions, attributes, full-depth
+  // keys) and the sort's buffers after the build, so that Update can move
+  // points without the caller's arrays. Off, the engine holds the node
+  // arrays alone, which is all that rendering reads: a static scene in a
+  // third of the memory, and Update refuses until the next build.
+  bool keepPoints = true;
 };
 
 struct BuildStats
@@ -171,6 +177,7 @@ struct BuildStats
   std::size_t nodes = 0;
   std::size_t bytes = 0;     // MemoryReport::Total() after the build
   double seconds = 0.0;      // whole build, wall clock
+  double uploadSeconds = 0.0; // the caller's arrays copied to the device and converted (colours, normals)
   double keySeconds = 0.0;   // bounds and Morton keys
   double sortSeconds = 0.0;  // radix sort of (key, index)
   double levelSeconds = 0.0; // unique keys per level, links and averages

@@ -15,6 +15,7 @@
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
+//   ReleaseScratch()                  frees the device's own scratch (CUB's temporary storage)
 //   Scope()                           makes the device current while the returned object lives
 //   kBuildsAside                      whether a build fills a new state aside (each device says why)
 //
@@ -123,18 +124,20 @@ Bounds PositionBounds(Device& d, const PointArraysView& pts)
     OCTORAY_LAMBDA(const Bounds& a, const Bounds& b) { return MergeBounds(a, b); });
 }
 
-// A point of the state, read back for an error message.
+// A point of positions where the device's loops read them (the state's, or
+// a caller's staged ones: the caller's own values, wherever the caller's
+// memory is), read back for an error message.
 template <class Device>
-Vec3d StoredPosition(Device& d, const OctreeState<Device>& s, std::size_t i)
+Vec3d ReadPosition(Device& d, const PointArraysView& positions, std::size_t i)
 {
-  if (!s.points.xyzDouble.Empty())
+  if (positions.xyzDouble)
   {
     double p[3];
-    d.ToHost(s.points.xyzDouble.Get() + 3 * i, 3, p, "point positions");
+    d.ToHost(positions.xyzDouble + 3 * i, 3, p, "point positions");
     return Vec3d{ p[0], p[1], p[2] };
   }
   float p[3];
-  d.ToHost(s.points.xyzFloat.Get() + 3 * i, 3, p, "point positions");
+  d.ToHost(positions.xyzFloat + 3 * i, 3, p, "point positions");
   return Vec3d{ p[0], p[1], p[2] };
 }
 
@@ -213,12 +216,12 @@ void Ingest(ColorInput, A, Device& d, const PointCloudView& points, Points& s)
 // first offending point with its coordinates as the caller gave them.
 template <class Device>
 RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArraysView& staged,
-  const PointCloudView& points, const BuildOptions& options)
+  const BuildOptions& options)
 {
   const Bounds b = PositionBounds(d, staged);
   if (b.firstBad != kNoIndex)
   {
-    throw Error(NonFinitePointMessage(b.firstBad, points.Position(b.firstBad)));
+    throw Error(NonFinitePointMessage(b.firstBad, ReadPosition(d, staged, b.firstBad)));
   }
   if (!options.fixedCube)
   {
@@ -230,7 +233,7 @@ RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArray
   {
     const std::uint64_t first = FirstFailedStep(d, scratch, "OutsideCubeKernel", staged.count,
       OCTORAY_LAMBDA(std::size_t i) { return cube.Contains(staged.Position(i)); });
-    throw Error(OutsideCubeMessage(first, points.Position(first)));
+    throw Error(OutsideCubeMessage(first, ReadPosition(d, staged, first)));
   }
   return cube;
 }
@@ -256,14 +259,17 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
 {
   const std::size_t n = s.count;
   auto phase = std::chrono::steady_clock::now();
-  d.Reserve(s.points.key, n, "point keys");
+  if (s.keepPoints)
+  {
+    d.Reserve(s.points.key, n, "point keys");
+  }
   for (int b = 0; b < 2; ++b)
   {
     d.Reserve(scratch.sortKey[b], n, "sort keys");
     d.Reserve(scratch.sortIndex[b], n + 1, "sort indices");
   }
   const PointArraysView pts = s.Points();
-  std::uint64_t* pointKey = s.points.key.Get();
+  std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
   std::uint64_t* sortKey = scratch.sortKey[0].Get();
   std::uint32_t* sortIndex = scratch.sortIndex[0].Get();
   // Only the leaf level's bits need sorting when the depth is known.
@@ -274,14 +280,17 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     const std::uint64_t outside = FirstFailedStep(d, scratch, "KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
       std::uint64_t key = 0;
       const bool inside = ComputePointKey(pts, cube, i, key);
-      pointKey[i] = key;
+      if (pointKey)
+      {
+        pointKey[i] = key;
+      }
       sortKey[i] = key >> leafShift;
       sortIndex[i] = static_cast<std::uint32_t>(i);
       return inside;
     });
     if (outside != kNoIndex)
     {
-      throw Error(OutsideCubeMessage(outside, StoredPosition(d, s, outside)));
+      throw Error(OutsideCubeMessage(outside, ReadPosition(d, pts, outside)));
     }
   }
   else
@@ -392,6 +401,27 @@ BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   return stats;
 }
 
+// What only updates read, freed once the nodes are built without
+// BuildOptions::keepPoints: the point copy, the sort's buffers, the
+// counters and the device's scratch (the next build or update reserves
+// them again).
+template <class Device>
+void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s)
+{
+  d.Release(s.points.xyzFloat);
+  d.Release(s.points.xyzDouble);
+  d.Release(s.points.color8);
+  d.Release(s.points.key);
+  ForEachAttribute([&](auto a) { d.Release(a.Of(s.points)); });
+  for (int b = 0; b < 2; ++b)
+  {
+    d.Release(scratch.sortKey[b]);
+    d.Release(scratch.sortIndex[b]);
+  }
+  d.Release(scratch.counters);
+  d.ReleaseScratch();
+}
+
 // Engine::Build: checks the input, makes it the point state (`current`, or
 // a new one that replaces it once complete where the device builds aside)
 // and builds the octree.
@@ -403,17 +433,30 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   ValidateDepth(options.depth);
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
+  auto phase = std::chrono::steady_clock::now();
   StagedPositions<Device> staged = StagePositions(d, points.xyzFloat, points.xyzDouble, n, "point positions");
-  const RootCube cube = CheckedCube(d, scratch, staged.View(n), points, options);
+  double uploadSeconds = SecondsSince(phase);
+  phase = std::chrono::steady_clock::now();
+  const RootCube cube = CheckedCube(d, scratch, staged.View(n), options);
+  const double boundsSeconds = SecondsSince(phase);
 
   std::unique_ptr<OctreeState<Device>> fresh;
   OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
   s.count = n;
   s.attributes = points.Attributes();
+  s.keepPoints = options.keepPoints;
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
+  phase = std::chrono::steady_clock::now();
   ForEachAttribute([&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, s.points); });
+  uploadSeconds += SecondsSince(phase);
   BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true);
+  stats.uploadSeconds = uploadSeconds;
+  stats.keySeconds += boundsSeconds;
+  if (!s.keepPoints)
+  {
+    ReleasePoints(d, scratch, s);
+  }
   if (fresh)
   {
     current = std::move(fresh);

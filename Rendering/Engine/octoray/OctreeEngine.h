@@ -40,7 +40,7 @@ public:
   UpdateStats Update(const PositionsView& positions) override
   {
     const auto scope = Dev.Scope();
-    ValidateUpdate(positions, State->count, DiscardedByUpdate);
+    ValidateUpdate(positions, State->count, DiscardedByUpdate, State->keepPoints);
     bool writing = false;
     try
     {

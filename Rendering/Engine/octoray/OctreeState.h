@@ -17,6 +17,9 @@ struct OctreeState
 {
   std::size_t count = 0;   // points
   unsigned attributes = 0; // AttributeBits of the points, and so of the nodes
+  // BuildOptions::keepPoints of the build: off, `points` is empty once the
+  // nodes are built (ReleasePoints, OctreeDriver.h).
+  bool keepPoints = true;
   PointArrays<Device::template Buffer> points;
 
   int depth = 0;

@@ -1,5 +1,8 @@
 // The engine's input: N points with optional attributes, as plain views of
-// the caller's arrays (nothing is copied until Build).
+// the caller's arrays (nothing is copied until Build). The arrays are host
+// memory; the CUDA backend also takes a build's arrays in device memory
+// (a CUDA simulation's, points generated on the GPU) and copies them on
+// the device. An update's positions and indices are host memory.
 #pragma once
 
 #include "Attributes.h"

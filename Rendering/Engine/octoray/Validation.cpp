@@ -39,7 +39,8 @@ void ValidateDepth(int depth)
   }
 }
 
-void ValidateUpdate(const PositionsView& positions, std::size_t pointCount, bool discardedByUpdate)
+void ValidateUpdate(
+  const PositionsView& positions, std::size_t pointCount, bool discardedByUpdate, bool pointsKept)
 {
   if (pointCount == 0 && discardedByUpdate)
   {
@@ -48,6 +49,11 @@ void ValidateUpdate(const PositionsView& positions, std::size_t pointCount, bool
   if (pointCount == 0)
   {
     throw Error("octoray: update before any build");
+  }
+  if (!pointsKept)
+  {
+    throw Error("octoray: update of an octree built without its points (BuildOptions::keepPoints off); "
+                "build again from the new positions");
   }
   if (!positions.xyzFloat == !positions.xyzDouble)
   {

@@ -18,8 +18,10 @@ void ValidateDepth(int depth);
 // Throws Error for an update that does not fit an octree of `pointCount`
 // points (wrong count, no positions, an index out of range or listed twice),
 // or that comes when there is no octree (before any build, or after an
-// update that failed part-way discarded it).
-void ValidateUpdate(const PositionsView& positions, std::size_t pointCount, bool discardedByUpdate);
+// update that failed part-way discarded it) or when its build released the
+// points (BuildOptions::keepPoints off).
+void ValidateUpdate(
+  const PositionsView& positions, std::size_t pointCount, bool discardedByUpdate, bool pointsKept);
 
 // Throws Error when there is no octree to draw (before any build, or after
 // an update that failed part-way discarded it).

@@ -1,0 +1,154 @@
+// Copies of a caller's arrays to the device at the speed of page-locked
+// memory. A VTK array lives in ordinary (pageable) host memory, from which
+// cudaMemcpy goes through the driver's own small bounce buffer at a
+// fraction of what the bus carries (octoray_bench_cuda measures both
+// beside the engine's own upload). Large arrays are cut into stripes,
+// one per host thread; each thread copies its stripe through two pinned
+// buffers of its own, filling one while the copy engine reads the other,
+// so the host copies and the DMA overlap and several host threads keep
+// the bus busy. Arrays already in device memory (a CUDA simulation's) and
+// page-locked host arrays are copied directly. Only compiled by nvcc.
+#pragma once
+
+#include "CudaSupport.h"
+#include "Parallel.h"
+
+#include <algorithm>
+#include <cstring>
+#include <vector>
+
+namespace octoray
+{
+namespace cuda
+{
+// Below this many bytes cudaMemcpy from pageable memory costs less than
+// starting the staging threads.
+constexpr std::size_t kStagingThreshold = std::size_t(16) << 20;
+// Each pinned buffer: large enough that a DMA's setup is small beside its
+// transfer, small enough that a stripe's first and last pieces (which do
+// not overlap) are a small part of it.
+constexpr std::size_t kStagingPiece = std::size_t(4) << 20;
+constexpr int kMaxStagingThreads = 8;
+
+// Whether CUDA can copy from `p` without staging: device, managed or
+// page-locked host memory.
+inline bool DirectlyCopyable(const void* p)
+{
+  cudaPointerAttributes attributes;
+  if (cudaPointerGetAttributes(&attributes, p) != cudaSuccess)
+  {
+    cudaGetLastError();
+    return false;
+  }
+  return attributes.type != cudaMemoryTypeUnregistered;
+}
+
+class HostStaging
+{
+public:
+  HostStaging() = default;
+  HostStaging(const HostStaging&) = delete;
+  HostStaging& operator=(const HostStaging&) = delete;
+  ~HostStaging() { Free(); }
+
+  // Copies `bytes` from `source` (host or device memory) to `device` on the
+  // current device; returns once the copy is complete.
+  void Copy(void* device, const void* source, std::size_t bytes, const char* what)
+  {
+    if (bytes < kStagingThreshold || DirectlyCopyable(source) || !Allocate())
+    {
+      CudaCheck(cudaMemcpy(device, source, bytes, cudaMemcpyDefault), what);
+      return;
+    }
+    int current = 0;
+    CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
+    // The destination may still be read by earlier work on the default
+    // stream, which the staging streams do not wait for.
+    CudaCheck(cudaStreamSynchronize(0), what);
+    const int stripes = static_cast<int>(Lanes.size());
+    ParallelChunks(bytes, stripes, [&](std::size_t begin, std::size_t end, int stripe) {
+      CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
+      CopyStripe(Lanes[stripe], static_cast<char*>(device) + begin, static_cast<const char*>(source) + begin,
+        end - begin, what);
+    });
+  }
+
+private:
+  // One staging thread's stream, pinned buffers and their events.
+  struct Lane
+  {
+    cudaStream_t stream = nullptr;
+    void* pinned[2] = { nullptr, nullptr };
+    cudaEvent_t copied[2] = { nullptr, nullptr };
+  };
+
+  static void CopyStripe(Lane& lane, char* device, const char* source, std::size_t bytes, const char* what)
+  {
+    for (std::size_t offset = 0, piece = 0; offset < bytes; offset += kStagingPiece, ++piece)
+    {
+      const int b = static_cast<int>(piece & 1);
+      const std::size_t n = std::min(kStagingPiece, bytes - offset);
+      CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
+      std::memcpy(lane.pinned[b], source + offset, n);
+      CudaCheck(cudaMemcpyAsync(device + offset, lane.pinned[b], n, cudaMemcpyHostToDevice, lane.stream), what);
+      CudaCheck(cudaEventRecord(lane.copied[b], lane.stream), what);
+    }
+    CudaCheck(cudaStreamSynchronize(lane.stream), what);
+  }
+
+  // The lanes, made at the first large copy and kept; false (and the plain
+  // copy taken) where page-locked memory cannot be had.
+  bool Allocate()
+  {
+    if (!Lanes.empty())
+    {
+      return true;
+    }
+    const int threads = std::min(kMaxStagingThreads, DefaultThreadCount());
+    Lanes.resize(threads);
+    for (Lane& lane : Lanes)
+    {
+      bool made = cudaStreamCreateWithFlags(&lane.stream, cudaStreamNonBlocking) == cudaSuccess;
+      for (int b = 0; b < 2; ++b)
+      {
+        made = made && cudaMallocHost(&lane.pinned[b], kStagingPiece) == cudaSuccess &&
+          cudaEventCreateWithFlags(&lane.copied[b], cudaEventDisableTiming) == cudaSuccess &&
+          cudaEventRecord(lane.copied[b], lane.stream) == cudaSuccess;
+      }
+      if (!made)
+      {
+        cudaGetLastError();
+        Free();
+        return false;
+      }
+    }
+    return true;
+  }
+
+  void Free()
+  {
+    for (Lane& lane : Lanes)
+    {
+      for (int b = 0; b < 2; ++b)
+      {
+        if (lane.copied[b])
+        {
+          cudaEventDestroy(lane.copied[b]);
+        }
+        if (lane.pinned[b])
+        {
+          cudaFreeHost(lane.pinned[b]);
+        }
+      }
+      if (lane.stream)
+      {
+        cudaStreamDestroy(lane.stream);
+      }
+    }
+    Lanes.clear();
+  }
+
+  std::vector<Lane> Lanes;
+};
+}
+}
