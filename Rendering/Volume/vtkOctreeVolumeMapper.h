@@ -312,9 +312,11 @@ public:
   /**
    * Keep the engine's copy of the points after a build, so that an input
    * whose positions alone changed (a point set animated in place) is
-   * updated rather than rebuilt. On by default. Off, the engine holds only
-   * the octree's nodes, about a third of the memory for a static scene, and
-   * moved points are rebuilt; it takes effect at the next build.
+   * updated rather than rebuilt, and (CUDA) the memory of a replaced octree
+   * for the next build, which then allocates nothing. On by default. Off,
+   * the engine holds only the octree's nodes, about a third of the memory
+   * for a static scene, and moved points are rebuilt; it takes effect at
+   * the next build.
    */
   vtkSetMacro(KeepPointsForUpdates, bool);
   vtkGetMacro(KeepPointsForUpdates, bool);

@@ -20,7 +20,9 @@
 # engine's CUDA tests: the slowest, about 3 minutes), bench (engine
 # benchmarks; BILLION points, default 1e9, generated on the device, 0: none),
 # profile (Nsight Compute on the render kernel: primary rays, and Phong with
-# shadows and a bounce, 10 M points at depth 10, 1920x1080), report (the
+# shadows and a bounce, 10 M points at depth 10, 1920x1080), variants (the
+# render benchmark built with other register caps, OCTORAY_RENDER_MIN_BLOCKS
+# 0 and 8, beside the default 6 of the main build), report (the
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
 # ORBIT_ARGS adds arguments).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
@@ -110,6 +112,15 @@ if want profile; then
   done
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
 fi
+if want variants; then
+  for blocks in 0 8; do
+    vb=build-gpu-blocks$blocks
+    step "variant-$blocks" bash -c "cmake -S . -B $vb -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
+      -DCMAKE_CUDA_ARCHITECTURES=90 -DVTK_DIR='$vtk/lib/cmake/vtk-9.2' -DCMAKE_CXX_FLAGS='-include cstdint' \
+      -DOCTORAY_GTEST_SOURCE_DIR='$carried/googletest' -DOCTORAY_RENDER_MIN_BLOCKS=$blocks >/dev/null &&
+      cmake --build $vb --target octoray_bench_cuda >/dev/null && $vb/bin/octoray_bench_cuda --only render"
+  done
+fi
 if want report; then
   # The CT scene is made here by `make report` (VTK reads the DICOM series)
   # and carried as build/report/scenes/ct5n.particles.
@@ -134,6 +145,9 @@ for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper
 done
 [ -f "$out/bench.log" ] && grep -E "^(device|upload|build|update|render)" "$out/bench.log"
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
+for blocks in 0 8; do
+  [ -f "$out/variant-$blocks.log" ] && grep -E "^render" "$out/variant-$blocks.log" | sed "s/^/min blocks $blocks: /"
+done
 [ -f "$out/orbit.log" ] && grep -E "points: generated|frame median|  =>|skipped" "$out/orbit.log" | cut -c1-220
 printf '%s\n' "${status[@]}"
 } | tee "$out/summary.txt"

@@ -123,6 +123,8 @@ public:
   void Synchronize(const char*) {}
   std::size_t ScratchBytes() const { return 0; }
   void ReleaseScratch() {}
+  std::size_t CachedBytes() const { return 0; }
+  void TrimCache() {}
 
   template <typename Fn>
   void ForEach(const char*, std::size_t n, Fn fn)

@@ -169,6 +169,8 @@ public:
     CubScratch.Release();
     ReduceResult.Release();
   }
+  std::size_t CachedBytes() const { return Memory.CachedBytes(); }
+  void TrimCache() { Memory.Trim(); }
 
   template <typename Fn>
   void ForEach(const char* name, std::size_t n, Fn fn)

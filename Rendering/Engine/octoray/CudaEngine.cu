@@ -13,9 +13,20 @@ namespace octoray
 {
 namespace
 {
+// Threads of one render block: 16 x 8 pixels.
+constexpr int kRenderBlockX = 16;
+constexpr int kRenderBlockY = 8;
+
+// The register cap that OCTORAY_RENDER_MIN_BLOCKS (CMake) asks for.
+#if defined(OCTORAY_RENDER_MIN_BLOCKS) && OCTORAY_RENDER_MIN_BLOCKS > 0
+#define OCTORAY_RENDER_BOUNDS __launch_bounds__(kRenderBlockX * kRenderBlockY, OCTORAY_RENDER_MIN_BLOCKS)
+#else
+#define OCTORAY_RENDER_BOUNDS
+#endif
+
 template <typename F>
-__global__ void RenderKernel(FrameConstants f, OctreeView tree, float* rgba, std::uint8_t* rgba8, float* depth,
-  unsigned long long* secondaryRays)
+__global__ void OCTORAY_RENDER_BOUNDS RenderKernel(FrameConstants f, OctreeView tree, float* rgba,
+  std::uint8_t* rgba8, float* depth, unsigned long long* secondaryRays)
 {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   if (x >= f.width)
@@ -129,7 +140,7 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   Dev.Reserve(ImageDepth, pixels, "image depth");
   Dev.Reserve(RayCounter, 1, "counters");
   Dev.FillBytes(RayCounter.Get(), 1, 0);
-  const dim3 block(16, 8);
+  const dim3 block(kRenderBlockX, kRenderBlockY);
   const unsigned rows = (settings.height + block.y - 1) / block.y;
   const dim3 grid((settings.width + block.x - 1) / block.x, rows < 65535u ? rows : 65535u);
   DispatchFeatures(frame, [&](auto features) {

@@ -80,11 +80,29 @@ private:
 
 // Every device allocation of one engine goes through this: it enforces a
 // budget (set to test and to live with out-of-memory) and reports what the
-// engine holds.
-struct DeviceMemoryPool
+// engine holds. Allocations come from a stream-ordered memory pool of the
+// engine's own that keeps freed memory for the next allocations: a rebuild
+// fills a new state while the old one lives (kBuildsAside), and mapping
+// fresh gigabytes with cudaMalloc and unmapping them with cudaFree (which
+// also waits for the whole device) at every rebuild cost more than the
+// build's own kernels. What the pool keeps is reported (CachedBytes), given
+// back by Trim, and given back before an allocation fails.
+class DeviceMemoryPool
 {
+public:
   std::size_t budget = ~std::size_t(0);
   std::size_t held = 0;
+
+  DeviceMemoryPool() = default;
+  DeviceMemoryPool(const DeviceMemoryPool&) = delete;
+  DeviceMemoryPool& operator=(const DeviceMemoryPool&) = delete;
+  ~DeviceMemoryPool()
+  {
+    if (Pool)
+    {
+      cudaMemPoolDestroy(Pool); // memory still being freed goes once its frees complete
+    }
+  }
 
   void* Allocate(std::size_t bytes, const char* what)
   {
@@ -92,17 +110,23 @@ struct DeviceMemoryPool
     {
       return nullptr;
     }
-    std::size_t freeBytes = 0, totalBytes = 0;
-    cudaMemGetInfo(&freeBytes, &totalBytes);
     if (held + bytes > budget)
     {
       throw Error(OutOfMemoryMessage(what, bytes, budget > held ? budget - held : 0) + " within the engine's budget");
     }
+    Create();
     void* p = nullptr;
-    if (cudaMalloc(&p, bytes) != cudaSuccess)
+    if (Get(&p, bytes) != cudaSuccess)
     {
       cudaGetLastError();
-      throw Error(OutOfMemoryMessage(what, bytes, freeBytes) + " on the GPU");
+      Trim();
+      if (Get(&p, bytes) != cudaSuccess)
+      {
+        cudaGetLastError();
+        std::size_t freeBytes = 0, totalBytes = 0;
+        cudaMemGetInfo(&freeBytes, &totalBytes);
+        throw Error(OutOfMemoryMessage(what, bytes, freeBytes) + " on the GPU");
+      }
     }
     held += bytes;
     return p;
@@ -111,10 +135,74 @@ struct DeviceMemoryPool
   {
     if (p)
     {
-      cudaFree(p);
+      if (Pool)
+      {
+        cudaFreeAsync(p, 0);
+      }
+      else
+      {
+        cudaFree(p);
+      }
       held -= bytes;
     }
   }
+
+  // Device memory the pool keeps for later allocations, beyond what is held.
+  std::size_t CachedBytes() const
+  {
+    std::uint64_t reserved = 0, used = 0;
+    if (Pool)
+    {
+      cudaMemPoolGetAttribute(Pool, cudaMemPoolAttrReservedMemCurrent, &reserved);
+      cudaMemPoolGetAttribute(Pool, cudaMemPoolAttrUsedMemCurrent, &used);
+    }
+    return reserved > used ? static_cast<std::size_t>(reserved - used) : 0;
+  }
+  // Gives what the pool keeps back to the device, once the frees queued so
+  // far have run.
+  void Trim()
+  {
+    if (Pool)
+    {
+      cudaStreamSynchronize(0);
+      cudaMemPoolTrimTo(Pool, 0);
+    }
+  }
+
+private:
+  cudaError_t Get(void** p, std::size_t bytes)
+  {
+    return Pool ? cudaMallocFromPoolAsync(p, bytes, Pool, 0) : cudaMalloc(p, bytes);
+  }
+
+  // The pool, on the current device (the engine's), made before the first
+  // allocation; it keeps all it frees until trimmed. Where the device has
+  // no memory pools, allocations are plain cudaMalloc.
+  void Create()
+  {
+    if (Tried)
+    {
+      return;
+    }
+    Tried = true;
+    int device = 0;
+    cudaGetDevice(&device);
+    cudaMemPoolProps props = {};
+    props.allocType = cudaMemAllocationTypePinned;
+    props.location.type = cudaMemLocationTypeDevice;
+    props.location.id = device;
+    if (cudaMemPoolCreate(&Pool, &props) != cudaSuccess)
+    {
+      cudaGetLastError();
+      Pool = nullptr;
+      return;
+    }
+    std::uint64_t keepAll = ~std::uint64_t(0);
+    cudaMemPoolSetAttribute(Pool, cudaMemPoolAttrReleaseThreshold, &keepAll);
+  }
+
+  bool Tried = false;
+  cudaMemPool_t Pool = nullptr;
 };
 
 template <typename T>

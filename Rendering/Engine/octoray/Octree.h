@@ -162,9 +162,11 @@ struct BuildOptions
   RootCube cube;
   // Keep the engine's copy of the points (positions, attributes, full-depth
   // keys) and the sort's buffers after the build, so that Update can move
-  // points without the caller's arrays. Off, the engine holds the node
-  // arrays alone, which is all that rendering reads: a static scene in a
-  // third of the memory, and Update refuses until the next build.
+  // points without the caller's arrays; CUDA also keeps the memory it
+  // frees for the next build (the "allocator cache" of the memory report).
+  // Off, the engine holds the node arrays alone, which is all that
+  // rendering reads: a static scene in a third of the memory, and Update
+  // refuses until the next build.
   bool keepPoints = true;
 };
 

@@ -16,6 +16,7 @@
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
 //   ReleaseScratch()                  frees the device's own scratch (CUB's temporary storage)
+//   CachedBytes(), TrimCache()        freed memory the device keeps for reuse; giving it back
 //   Scope()                           makes the device current while the returned object lives
 //   kBuildsAside                      whether a build fills a new state aside (each device says why)
 //
@@ -460,6 +461,10 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   if (fresh)
   {
     current = std::move(fresh);
+  }
+  if (!options.keepPoints)
+  {
+    d.TrimCache(); // a static scene: only its nodes stay
   }
   return stats;
 }

@@ -26,7 +26,16 @@ public:
   {
     const auto scope = Dev.Scope();
     const auto start = std::chrono::steady_clock::now();
-    BuildStats stats = BuildOctree(Dev, Scratch, State, points, options);
+    BuildStats stats;
+    try
+    {
+      stats = BuildOctree(Dev, Scratch, State, points, options);
+    }
+    catch (const Error&)
+    {
+      Dev.TrimCache(); // a failed build (out of memory, say) gives back what it took
+      throw;
+    }
     DiscardedByUpdate = false;
     stats.bytes = Memory().Total();
     stats.seconds = SecondsSince(start);
@@ -48,6 +57,7 @@ public:
     }
     catch (const Error& e)
     {
+      Dev.TrimCache();
       if (!writing)
       {
         throw;
@@ -71,7 +81,10 @@ public:
     ForEachNodeArray([&](auto a) { Dev.Download(a.Of(s.nodes), a.Of(out)); });
   }
 
-  MemoryReport Memory() const override { return ReportMemory(*State, Scratch.Bytes() + Dev.ScratchBytes()); }
+  MemoryReport Memory() const override
+  {
+    return ReportMemory(*State, Scratch.Bytes() + Dev.ScratchBytes(), Dev.CachedBytes());
+  }
 
   // The octree in the device's memory, for the renderer.
   OctreeView View() const { return State->View(); }

@@ -62,9 +62,10 @@ struct DriverScratch
 };
 
 // What the engine holds, array by array, under the labels of Attributes.h;
-// `sortBytes`: the scratch of the build and of the device.
+// `sortBytes`: the scratch of the build and of the device; `cachedBytes`:
+// freed memory the device keeps for the next allocations.
 template <class Device>
-MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes)
+MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, std::size_t cachedBytes)
 {
   MemoryReport m;
   ForEachNodeArray([&](auto a) { m.Add(std::string("node ") + a.kLabel, a.Of(s.nodes).Bytes()); });
@@ -76,6 +77,7 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes)
   });
   m.Add("point keys", s.points.key.Bytes());
   m.Add("sort buffers", sortBytes);
+  m.Add("allocator cache", cachedBytes);
   return m;
 }
 }
