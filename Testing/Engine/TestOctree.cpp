@@ -211,7 +211,7 @@ TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
   {
     labels.push_back(a.first);
   }
-  if (!labels.empty() && labels.back() == "allocator cache")
+  if (!labels.empty() && labels.back() == MemoryReport::kAllocatorCache)
   {
     EXPECT_EQ(GetParam(), Backend::CUDA);
     labels.pop_back();
@@ -250,7 +250,7 @@ TEST_P(OctreeBuild, WithoutItsPointsHoldsOnlyTheNodes)
   std::size_t nodeBytes = 0, cachedBytes = 0;
   for (const auto& a : engine->Memory().arrays)
   {
-    if (a.first == "allocator cache")
+    if (a.first == MemoryReport::kAllocatorCache)
     {
       cachedBytes = a.second;
       continue;
@@ -302,7 +302,7 @@ TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
   engine->Build(small.View(), options);
   HostOctree before;
   engine->CopyToHost(before);
-  const std::size_t held = engine->Memory().Total();
+  const std::size_t held = engine->Memory().ArrayBytes();
 
   engine->SetMemoryBudget(held + 200000); // far too little for 100 k points
   const Cloud big = UniformCloud(100000, 52);
@@ -350,7 +350,7 @@ TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
     engine->Build(first.View(), options);
     HostOctree before;
     engine->CopyToHost(before);
-    const std::size_t held = engine->Memory().Total();
+    const std::size_t held = engine->Memory().ArrayBytes();
     engine->SetMemoryBudget(held + budget);
     bool ok = true;
     try
@@ -391,7 +391,7 @@ TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
         engine->CopyToHost(after);
         EXPECT_EQ(after.key, before.key) << "budget " << budget;
         EXPECT_EQ(after.pointCount, before.pointCount) << "budget " << budget;
-        EXPECT_LE(engine->Memory().Total(), held + budget) << "budget " << budget;
+        EXPECT_LE(engine->Memory().ArrayBytes(), held + budget) << "budget " << budget;
       }
     }
     if (ok)

@@ -75,9 +75,10 @@ public:
   // Threads the CPU backend uses (ignored by CUDA); default: all cores.
   virtual void SetThreadCount(int threads) { (void)threads; }
 
-  // Device bytes the CUDA backend may hold (ignored by the CPU backend); an
-  // allocation past it fails with the out-of-memory error, as a full GPU
-  // would. Default: no limit but the device's.
+  // Device bytes of arrays the CUDA backend may hold (ignored by the CPU
+  // backend; MemoryReport::ArrayBytes); an allocation past it fails with
+  // the out-of-memory error, as a full GPU would, and the allocator's cache
+  // is given back. Default: no limit but the device's.
   virtual void SetMemoryBudget(std::size_t bytes) { (void)bytes; }
 };
 

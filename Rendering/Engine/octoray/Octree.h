@@ -129,9 +129,12 @@ struct HostOctree : NodeArrays<HostVector>
   OctreeView View();
 };
 
-// Bytes held by the engine, one entry per array.
+// Bytes held by the engine, one entry per array, and last the memory its
+// device's allocator keeps for reuse (kAllocatorCache), where it keeps some.
 struct MemoryReport
 {
+  static constexpr const char* kAllocatorCache = "allocator cache";
+
   std::vector<std::pair<std::string, std::size_t>> arrays;
   std::size_t Total() const
   {
@@ -139,6 +142,16 @@ struct MemoryReport
     for (const auto& a : arrays)
     {
       total += a.second;
+    }
+    return total;
+  }
+  // The arrays alone: what a memory budget (Engine::SetMemoryBudget) counts.
+  std::size_t ArrayBytes() const
+  {
+    std::size_t total = Total();
+    if (!arrays.empty() && arrays.back().first == kAllocatorCache)
+    {
+      total -= arrays.back().second;
     }
     return total;
   }

@@ -77,7 +77,7 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
   });
   m.Add("point keys", s.points.key.Bytes());
   m.Add("sort buffers", sortBytes);
-  m.Add("allocator cache", cachedBytes);
+  m.Add(MemoryReport::kAllocatorCache, cachedBytes);
   return m;
 }
 }
