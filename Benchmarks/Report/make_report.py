@@ -152,7 +152,8 @@ class Context:
                 if current.endswith("\\"):
                     current = current[:-1] + " "
                 else:
-                    commands.append(" ".join(current.split()))
+                    if current:  # a remark alone on its line is no command
+                        commands.append(" ".join(current.split()))
                     current = ""
         return "; ".join(commands)
 

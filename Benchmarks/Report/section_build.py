@@ -276,13 +276,25 @@ def _cuda(ctx):
     if records is None:
         return "CUDA build, update and memory: " + NOT_ON_GPU + ".\n", []
     builds = [r for r in records if r["name"] == "octree build"]
-    mem = {(r["n"], r["depth"]): r["seconds"] for r in records if r["name"] == "gpu bytes per point"}
+    mem_records = {(r["n"], r["depth"]): r for r in records if r["name"] == "gpu bytes per point"}
+    mem = {key: r["seconds"] for key, r in mem_records.items()}
     # Runs since the report exist record the device phases (BuildStats) too.
     phases = all("sort_seconds" in r for r in builds)
     # And since issue 16, the pinned host-to-device copy of the same input.
     upload = all(r.get("pinned_upload_seconds") for r in builds)
-    rows, csv_rows = [], []
+    # And since the pinned staging: the upload's own time beside the plain
+    # and registered copies, and the memory with and without kept points.
+    staging = all("pageable_upload_seconds" in r for r in builds)
+    rows, csv_rows, staging_rows = [], [], []
     for r in builds:
+        if staging:
+            m = mem_records.get((r["n"], r["depth"]), {})
+            staging_rows.append([count(r["n"]), r["depth"], seconds(r["upload_seconds"]),
+                                 seconds(r["pageable_upload_seconds"]), seconds(r["registered_upload_seconds"]),
+                                 seconds(r["pinned_upload_seconds"]),
+                                 "%.2f" % (r["upload_seconds"] / r["pinned_upload_seconds"]),
+                                 "%.1f" % m.get("array_bytes_per_point", 0), "%.1f" % m.get("seconds", 0),
+                                 seconds(r["lean_seconds"]), "%.1f" % m.get("lean_bytes_per_point", 0)])
         row = [count(r["n"]), r["depth"], seconds(r["seconds"])]
         if phases:
             device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
@@ -311,7 +323,7 @@ def _cuda(ctx):
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
         "events in the same run. Medians of 7 (3 at 100 M). GPU bytes per point include the sort buffers the engine "
-        "keeps for rebuilds. The pinned copy: the same input arrays as one block of page-locked host memory copied "
+        "keeps for rebuilds and the memory its allocator keeps for the next build (split in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
         "to the device (cudaMemcpy, median of 5), what a whole call from host arrays cannot beat.%s" % (gpu_source(ctx, name), "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),
         "",
@@ -324,6 +336,41 @@ def _cuda(ctx):
         "per level with a host round trip for the selected count, and the leaf kernel's gather of every point's "
         "attributes in random order. A caller with pinned or device-resident points would not pay the upload.",
         "",
+    ]
+    if staging:
+        text += [
+            "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
+            "16 MB and more through page-locked buffers on up to 8 host threads (Rendering/Engine/octoray/"
+            "CudaUpload.h); *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
+            "arrays in place for the copy, *pinned* is the floor above. GPU bytes per point: the arrays alone; "
+            "with the memory that the engine's allocator keeps for the next build (with the points kept, a "
+            "rebuild fills a new octree beside the old one and then reuses the old one's memory instead of "
+            "mapping new memory); and built without the points (`BuildOptions::keepPoints` off: node arrays "
+            "only, the allocator's cache given back), with that build's whole call.",
+            "",
+            ctx.table(["points", "depth", "upload", "plain cudaMemcpy", "cudaHostRegister + copy", "pinned copy",
+                       "upload / pinned", "B/point, arrays", "B/point, with cache", "whole call, points not kept",
+                       "B/point, points not kept"], staging_rows),
+            "",
+        ]
+    billion = [r for r in records if r["name"].startswith("device points")]
+    if billion:
+        b = {r["name"]: r for r in billion}
+        build, primary = b["device points build"], b["device points primary 1920x1080"]
+        full = b["device points shadows+bounce 1920x1080"]
+        text += [
+            "**%s points on one GPU** (`octoray_bench_cuda --billion`): Gaussian clusters like the ones above, "
+            "generated on the device from a fixed seed (xyz float and 8-bit RGB), built from device memory at "
+            "depth 10 without the points (the engine copies them on the device, then keeps the node arrays "
+            "alone), traced at 1920×1080. One build, the first, its allocations included: %s (sort %s, levels %s), "
+            "%s nodes, %.2f GPU bytes per point. Frames: primary rays %s (%.0f frames/s); Phong + shadows + one "
+            "bounce %s (%.0f frames/s)." % (
+                count(build["n"]), seconds(build["seconds"]), seconds(build["sort_seconds"]),
+                seconds(build["level_seconds"]), count(build["nodes"]), build["bytes_per_point"],
+                seconds(primary["seconds"]), 1 / primary["seconds"], seconds(full["seconds"]), 1 / full["seconds"]),
+            "",
+        ]
+    text += [
         "Update of moved points against a full rebuild of the same points (whole calls, positions uploaded from "
         "the host and checked for NaN/Inf on the device first); both moves change the topology, so the update "
         "re-sorts the stored keys in the same buffers rather than adjusting counts in place:",

@@ -170,4 +170,10 @@ def _cuda_cloud(ctx):
             "runs the kernel instantiated for its feature set; what remains is the traversal itself (a stack of "
             "(node, level, entry t) in local memory, a Morton decode per visited node, one thread per pixel). At "
             "depth 16 the clustered points are sparse and most rays cross the whole cube without a hit." % csv)
+    profile = ctx.gpu_file("profile.txt")
+    if profile:
+        text += ("\n\nNsight Compute on the render kernel, one depth-10 frame of each kind above (gpu-check.sh's "
+                 "`profile` part, `ncu --clock-control none`, [gpu/profile.txt](gpu/profile.txt); the kernel is "
+                 "built with the register cap OCTORAY_RENDER_MIN_BLOCKS, Rendering/Engine/CMakeLists.txt):\n\n"
+                 "```\n%s```\n" % open(profile).read())
     return text, summary
