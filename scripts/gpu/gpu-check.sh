@@ -22,7 +22,8 @@
 # profile (Nsight Compute on the render kernel: primary rays, and Phong with
 # shadows and a bounce, 10 M points at depth 10, 1920x1080), variants (the
 # render benchmark built with other register caps, OCTORAY_RENDER_MIN_BLOCKS
-# 0 and 6, beside the default 8 of the main build), report (the
+# from VARIANT_BLOCKS, default 0 and 6, beside the 8 of the main build),
+# report (the
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
 # ORBIT_ARGS adds arguments).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
@@ -113,7 +114,7 @@ if want profile; then
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
 fi
 if want variants; then
-  for blocks in 0 6; do
+  for blocks in ${VARIANT_BLOCKS:-0 6}; do
     vb=build-gpu-blocks$blocks
     step "variant-$blocks" bash -c "cmake -S . -B $vb -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
       -DCMAKE_CUDA_ARCHITECTURES=90 -DVTK_DIR='$vtk/lib/cmake/vtk-9.2' -DCMAKE_CXX_FLAGS='-include cstdint' \

@@ -26,7 +26,11 @@ OCTORAY_HD std::uint32_t ChildIndex(unsigned childMask, std::uint32_t firstChild
 #if defined(__CUDA_ARCH__)
   return firstChild + static_cast<std::uint32_t>(__popc(before));
 #else
-  return firstChild + static_cast<std::uint32_t>(__builtin_popcount(before));
+  // Bits of a byte summed in pairs, nibbles, then the byte: the builtin
+  // would be a libgcc call on the baseline x86-64 without POPCNT.
+  unsigned bits = before - ((before >> 1) & 0x55u);
+  bits = (bits & 0x33u) + ((bits >> 2) & 0x33u);
+  return firstChild + static_cast<std::uint32_t>((bits + (bits >> 4)) & 0x0Fu);
 #endif
 }
 

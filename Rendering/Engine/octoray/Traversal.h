@@ -105,93 +105,251 @@ struct NodeHit
   float size;
 };
 
-// A ray crosses each splitting plane of a node at most once, so it passes
-// through at most 4 of the 8 children (the stack then holds at most 3 per
-// level plus one); one that grazes the node's centre can touch all 8 with
-// zero length, so room is kept for 7 per level: the stack never overflows
-// (the check in Traverse is a guard only).
-constexpr int kTraversalStack = 7 * (kMaxLevel + 1) + 1;
-
-struct TraversalEntry
+// Where the ray crosses the plane x[a] = p. A ray parallel to the plane
+// never crosses it: -inf where it runs on the plane or beyond it (boxes are
+// half-open, so the plane belongs to the upper side), +inf below it.
+OCTORAY_HD_INLINE float Crossing(const Ray& ray, int a, float p)
 {
-  std::uint32_t node;
-  std::int32_t level;
-  float tEnter;
+  if (ray.direction[a] == 0.0f)
+  {
+    return p <= ray.origin[a] ? -INFINITY : INFINITY;
+  }
+  return (p - ray.origin[a]) * ray.inverse[a];
+}
+
+// The ray against one node, in the node's octants as the ray sees them:
+// octant bit a of a child is flipped where the ray runs towards -a, so that
+// on every axis the ray crosses the near face (the child's bit 0 side), the
+// mid plane, then the far face. A child's interval is thus picked from
+// these nine values without any arithmetic, and a child's near and far
+// faces are its parent's near face or mid plane and mid plane or far face.
+struct NodeCrossings
+{
+  Vec3f nearT, midT, farT;
 };
+
+// Octant bit a set where the ray runs towards -a (a zero component counts
+// as +, as the half-open boxes want).
+OCTORAY_HD_INLINE unsigned DirectionSigns(const Ray& ray)
+{
+  return (ray.direction.x < 0.0f ? 1u : 0u) | (ray.direction.y < 0.0f ? 2u : 0u) |
+    (ray.direction.z < 0.0f ? 4u : 0u);
+}
+
+OCTORAY_HD_INLINE float MidCrossing(const Ray& ray, int a, float lo, float size)
+{
+  return Crossing(ray, a, lo + 0.5f * size);
+}
+
+// The crossings of the node whose corner is cell * size.
+OCTORAY_HD_INLINE NodeCrossings CrossingsOf(
+  const Ray& ray, unsigned signs, const std::uint32_t cell[3], float size)
+{
+  NodeCrossings c;
+  for (int a = 0; a < 3; ++a)
+  {
+    const float lo = static_cast<float>(cell[a]) * size;
+    const bool towardsLow = (signs >> a) & 1u;
+    c.nearT[a] = Crossing(ray, a, towardsLow ? lo + size : lo);
+    c.farT[a] = Crossing(ray, a, towardsLow ? lo : lo + size);
+    c.midT[a] = MidCrossing(ray, a, lo, size);
+  }
+  return c;
+}
+
+// The entry, exit and entry axis of the child in mirrored octant m: the
+// latest near face and the earliest far face, the lowest axis on ties.
+struct ChildSpan
+{
+  float tEnter, tExit;
+  int axis;
+};
+
+OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
+{
+  ChildSpan s{ -INFINITY, INFINITY, -1 };
+  for (int a = 0; a < 3; ++a)
+  {
+    const bool upper = (m >> a) & 1u;
+    const float tNear = upper ? c.midT[a] : c.nearT[a];
+    const float tFar = upper ? c.farT[a] : c.midT[a];
+    if (tNear > s.tEnter)
+    {
+      s.tEnter = tNear;
+      s.axis = a;
+    }
+    s.tExit = tFar < s.tExit ? tFar : s.tExit;
+  }
+  return s;
+}
+
+// Mirrored octants whose every axis the ray can reach inside the node: the
+// near half where the mid plane comes no earlier than the node's entry, the
+// far half where it comes no later than its exit. A superset of the
+// children the ray meets, so only those get their span computed.
+OCTORAY_HD_INLINE unsigned ReachableOctants(const NodeCrossings& c)
+{
+  float tEnter = c.nearT.x, tExit = c.farT.x;
+  for (int a = 1; a < 3; ++a)
+  {
+    tEnter = c.nearT[a] > tEnter ? c.nearT[a] : tEnter;
+    tExit = c.farT[a] < tExit ? c.farT[a] : tExit;
+  }
+  unsigned reachable = 0xFFu;
+  for (int a = 0; a < 3; ++a)
+  {
+    const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
+    reachable &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
+  }
+  return reachable & 0xFFu;
+}
+
+// A child mask with octant bits flipped as in NodeCrossings.
+OCTORAY_HD_INLINE unsigned MirrorOctants(unsigned mask, unsigned signs)
+{
+  if (signs & 1u)
+  {
+    mask = ((mask & 0x55u) << 1) | ((mask & 0xAAu) >> 1);
+  }
+  if (signs & 2u)
+  {
+    mask = ((mask & 0x33u) << 2) | ((mask & 0xCCu) >> 2);
+  }
+  if (signs & 4u)
+  {
+    mask = ((mask & 0x0Fu) << 4) | ((mask & 0xF0u) >> 4);
+  }
+  return mask;
+}
+
+OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
+{
+#if defined(__CUDA_ARCH__)
+  return static_cast<unsigned>(__ffs(static_cast<int>(bits)) - 1);
+#else
+  return static_cast<unsigned>(__builtin_ctz(bits));
+#endif
+}
 
 // Visits the drawn voxels (leaves, or nodes where the level of detail
 // stops) that the ray meets within [tMin, tMax], nearest first, until the
 // visitor's Visit(const NodeHit&) returns true.
 //
-// Order: a ray moving towards +x crosses a node's x = mid plane from the low
-// half to the high one, never back; so the octants it meets form a chain in
-// which each next octant sets one more bit of (octant ^ signMask), where
-// signMask has bit a set for a negative direction component. Visiting
-// octants by increasing (octant ^ signMask) is thus the order the ray meets
-// them, and depth-first in that order is front to back overall (disjoint
-// boxes along a ray have disjoint intervals). No sorting is needed, and the
-// stack keeps only node, level and entry distance; a node's box comes back
-// from its key.
+// Order: a ray crosses each mid plane of a node at most once, from the near
+// half to the far one, so the children it meets form a chain in which each
+// next one sets one more bit of the mirrored octant (NodeCrossings).
+// Visiting the children by increasing mirrored octant is thus the order the
+// ray meets them, and depth-first in that order is front to back overall.
+//
+// Cost: a node's crossings come from its parent's (three new mid planes), a
+// child's span from selects, and only children reachable by the mid-plane
+// test are looked at. Going back up, the parent's crossings are computed
+// again from its cell, so the stack holds one node index per level and the
+// mirrored octant being visited at each level packed 3 bits to a level in
+// one 64-bit word: (kMaxLevel + 1) * 4 bytes instead of a box per entry.
+// Every value equals what slab tests of each child's box give, bit for bit
+// (the planes are exact dyadic fractions).
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
-  TraversalEntry stack[kTraversalStack];
-  int top = 0;
+  static_assert(3 * kMaxLevel <= 64, "the octant stack packs 3 bits per level into 64");
+  NodeHit hit;
+  if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) ||
+    hit.tExit < ray.tMin || hit.tEnter > ray.tMax)
   {
-    float t0, t1;
-    int axis;
-    if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax)
+    return;
+  }
+  if (tree.depth == 0 || lod.StopAt(1.0f, hit.tEnter))
+  {
+    hit.node = 0;
+    hit.level = 0;
+    hit.lo = Vec3f{ 0.0f, 0.0f, 0.0f };
+    hit.size = 1.0f;
+    visitor.Visit(hit);
+    return;
+  }
+  const unsigned signs = DirectionSigns(ray);
+  std::uint32_t parents[kMaxLevel + 1];
+  std::uint64_t visiting = 0; // mirrored octant being visited, per level
+  std::uint32_t node = 0;
+  std::uint32_t cell[3] = { 0u, 0u, 0u };
+  int level = 0;
+  float size = 1.0f;
+  NodeCrossings c = CrossingsOf(ray, signs, cell, size);
+  unsigned firstOctant = 0;
+  for (;;)
+  {
+    const unsigned childMask = tree.childMask[node];
+    unsigned todo = MirrorOctants(childMask, signs) & ReachableOctants(c) & (0xFFu << firstOctant);
+    const std::uint32_t firstChild = todo ? tree.firstChild[node] : 0u;
+    const float half = 0.5f * size;
+    bool descended = false;
+    while (todo)
+    {
+      const unsigned m = LowestBit(todo);
+      todo &= todo - 1u;
+      const ChildSpan span = SpanOf(c, m);
+      if (!(span.tEnter <= span.tExit) || span.tExit < ray.tMin)
+      {
+        continue;
+      }
+      if (span.tEnter > ray.tMax)
+      {
+        return; // everything after it is farther
+      }
+      const unsigned octant = m ^ signs;
+      std::uint32_t childCell[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        childCell[a] = 2u * cell[a] + ((octant >> a) & 1u);
+      }
+      const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
+      if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
+      {
+        hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, span.axis,
+          Vec3f{ static_cast<float>(childCell[0]), static_cast<float>(childCell[1]),
+            static_cast<float>(childCell[2]) } * half,
+          half };
+        if (visitor.Visit(hit))
+        {
+          return;
+        }
+        continue;
+      }
+      parents[level] = node;
+      visiting = (visiting & ~(std::uint64_t{ 7u } << (3 * level))) | (std::uint64_t{ m } << (3 * level));
+      for (int a = 0; a < 3; ++a)
+      {
+        const bool upper = (m >> a) & 1u;
+        c.nearT[a] = upper ? c.midT[a] : c.nearT[a];
+        c.farT[a] = upper ? c.farT[a] : c.midT[a];
+        cell[a] = childCell[a];
+        c.midT[a] = MidCrossing(ray, a, static_cast<float>(cell[a]) * half, half);
+      }
+      node = child;
+      ++level;
+      size = half;
+      firstOctant = 0;
+      descended = true;
+      break;
+    }
+    if (descended)
+    {
+      continue;
+    }
+    if (level == 0)
     {
       return;
     }
-    stack[top++] = TraversalEntry{ 0u, 0, t0 };
-  }
-  const unsigned signMask =
-    (ray.direction.x < 0.0f ? 1u : 0u) | (ray.direction.y < 0.0f ? 2u : 0u) | (ray.direction.z < 0.0f ? 4u : 0u);
-  while (top > 0)
-  {
-    const TraversalEntry e = stack[--top];
-    if (e.tEnter > ray.tMax)
+    --level;
+    node = parents[level];
+    firstOctant = static_cast<unsigned>((visiting >> (3 * level)) & 7u) + 1u;
+    size = PowerOfTwo(-level);
+    for (int a = 0; a < 3; ++a)
     {
-      return; // everything left on the stack is farther
+      cell[a] >>= 1;
     }
-    NodeHit hit;
-    hit.node = e.node;
-    hit.level = e.level;
-    hit.size = PowerOfTwo(-e.level);
-    std::uint32_t cell[3];
-    DecodeMorton(tree.key[e.node], cell[0], cell[1], cell[2]);
-    hit.lo = Vec3f{ static_cast<float>(cell[0]), static_cast<float>(cell[1]), static_cast<float>(cell[2]) } * hit.size;
-    if (e.level == tree.depth || lod.StopAt(hit.size, e.tEnter))
-    {
-      IntersectBox(ray, hit.lo, hit.size, hit.tEnter, hit.tExit, hit.axis);
-      if (visitor.Visit(hit))
-      {
-        return;
-      }
-      continue;
-    }
-    const float half = 0.5f * hit.size;
-    const unsigned mask = tree.childMask[e.node];
-    const std::uint32_t firstChild = tree.firstChild[e.node];
-    // Pushed farthest first, so that they pop nearest first.
-    for (int i = 7; i >= 0; --i)
-    {
-      const unsigned octant = static_cast<unsigned>(i) ^ signMask;
-      if (!(mask & (1u << octant)))
-      {
-        continue;
-      }
-      const Vec3f offset{ (octant & 1u) ? half : 0.0f, (octant & 2u) ? half : 0.0f, (octant & 4u) ? half : 0.0f };
-      const Vec3f lo = hit.lo + offset;
-      float t0, t1;
-      int axis;
-      if (!IntersectBox(ray, lo, half, t0, t1, axis) || t1 < ray.tMin || t0 > ray.tMax || top == kTraversalStack)
-      {
-        continue;
-      }
-      stack[top++] = TraversalEntry{ ChildIndex(mask, firstChild, octant), e.level + 1, t0 };
-    }
+    c = CrossingsOf(ray, signs, cell, size);
   }
 }
 
