@@ -81,31 +81,49 @@ OCTORAY_HD float WindowDepth(const FrameConstants& f, const Vec3d& p)
   return static_cast<float>(Clamp01(0.5 * clip[2] / clip[3] + 0.5));
 }
 
-// A pixel's primary ray, its origin moved to where it enters the root cube
-// (computed in double). `tBase` is that entry's distance from the near plane.
-// False when the ray misses the cube, or the clipping range or opaque
-// geometry ends it before.
-OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase, Vec3d& origin,
-  Vec3d& direction)
+// The line through the centre of pixel (x, y): its point on the near plane,
+// its unit direction and its length to the far plane, in double. False
+// for a degenerate projection.
+OCTORAY_HD Vec3d PixelNdc(const FrameConstants& f, int x, int y, double z)
 {
-  const double nx = 2.0 * (x + 0.5) / f.width - 1.0;
-  const double ny = 2.0 * (y + 0.5) / f.height - 1.0;
-  const Vec3d nearPoint = Unproject(f.unitFromNdc, nx, ny, -1.0);
-  const Vec3d farPoint = Unproject(f.unitFromNdc, nx, ny, 1.0);
-  Vec3d d = farPoint - nearPoint;
-  const double length = Length(d);
+  return Vec3d{ 2.0 * (x + 0.5) / f.width - 1.0, 2.0 * (y + 0.5) / f.height - 1.0, z };
+}
+
+OCTORAY_HD bool PixelLine(const FrameConstants& f, int x, int y, Vec3d& nearPoint, Vec3d& d, double& length)
+{
+  const Vec3d ndc = PixelNdc(f, x, y, -1.0);
+  const double nx = ndc.x, ny = ndc.y;
+  nearPoint = Unproject(f.unitFromNdc, nx, ny, -1.0);
+  d = Unproject(f.unitFromNdc, nx, ny, 1.0) - nearPoint;
+  length = Length(d);
   if (!(length > 0.0))
   {
     return false;
   }
   d /= length;
+  return true;
+}
+
+// A pixel's primary ray, its origin moved to where it enters the root cube
+// (computed in double). `tBase` is that entry's distance from the near plane.
+// False when the ray misses the cube, or the clipping range or opaque
+// geometry ends it before.
+OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase)
+{
+  Vec3d nearPoint, d;
+  double length;
+  if (!PixelLine(f, x, y, nearPoint, d, length))
+  {
+    return false;
+  }
   double tEnd = length;
   if (f.depthBuffer)
   {
     const float w = f.depthBuffer[static_cast<std::size_t>(y) * f.width + x];
     if (w < 1.0f)
     {
-      tEnd = Dot(Unproject(f.unitFromNdc, nx, ny, 2.0 * w - 1.0) - nearPoint, d);
+      const Vec3d ndc = PixelNdc(f, x, y, 2.0 * w - 1.0);
+      tEnd = Dot(Unproject(f.unitFromNdc, ndc.x, ndc.y, ndc.z) - nearPoint, d);
     }
   }
   // The root cube's slab interval, in double.
@@ -136,9 +154,7 @@ OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, doub
     return false;
   }
   tBase = t0;
-  origin = nearPoint + t0 * d;
-  direction = d;
-  ray.origin = ToFloat(origin);
+  ray.origin = ToFloat(nearPoint + t0 * d);
   SetDirection(ray, ToFloat(d));
   ray.tMin = 0.0f;
   ray.tMax = static_cast<float>(t1 - t0);
@@ -521,13 +537,18 @@ struct CameraRay
 {
   Ray ray;
   double tBase; // where the ray entered the root cube, from the near plane
-  Vec3d origin, direction;
+  int x, y;     // its pixel
   LevelOfDetail lod;
 
-  // Window depth of the point at distance t along the ray.
+  // Window depth of the point at distance t along the ray. The pixel's line
+  // is computed again in double rather than held through the traversal,
+  // where its twelve registers would crowd the traversal's own.
   OCTORAY_HD float DepthAt(const FrameConstants& f, float t) const
   {
-    return WindowDepth(f, origin + double(t) * direction);
+    Vec3d nearPoint, d;
+    double length;
+    PixelLine(f, x, y, nearPoint, d, length);
+    return WindowDepth(f, (nearPoint + tBase * d) + double(t) * d);
   }
 };
 
@@ -656,10 +677,12 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
   rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
   depth = 1.0f;
   CameraRay pixel;
-  if (!PrimaryRay(f, x, y, pixel.ray, pixel.tBase, pixel.origin, pixel.direction))
+  if (!PrimaryRay(f, x, y, pixel.ray, pixel.tBase))
   {
     return;
   }
+  pixel.x = x;
+  pixel.y = y;
   pixel.lod.pixels = f.lodPixels;
   pixel.lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(pixel.tBase);
   pixel.lod.footprintSlope = f.footprintSlope;

@@ -35,10 +35,19 @@ struct Ray
   float tMin, tMax;
 };
 
+// A component too small for its reciprocal to be finite (a zero of either
+// sign, a denormal) becomes +0 with the reciprocal +inf: the ray runs
+// parallel to that axis, on the + side of half-open boxes, and the sign
+// tests and the parallel test (inverse == +inf) agree on it.
 OCTORAY_HD void SetDirection(Ray& ray, const Vec3f& d)
 {
-  ray.direction = d;
-  ray.inverse = Vec3f{ 1.0f / d.x, 1.0f / d.y, 1.0f / d.z };
+  for (int a = 0; a < 3; ++a)
+  {
+    const float inverse = 1.0f / d[a];
+    const bool parallel = inverse == INFINITY || inverse == -INFINITY;
+    ray.direction[a] = parallel ? 0.0f : d[a];
+    ray.inverse[a] = parallel ? INFINITY : inverse;
+  }
 }
 
 // Entry and exit of the ray through the box [lo, lo + size); the axis of the
@@ -110,7 +119,7 @@ struct NodeHit
 // half-open, so the plane belongs to the upper side), +inf below it.
 OCTORAY_HD_INLINE float Crossing(const Ray& ray, int a, float p)
 {
-  if (ray.direction[a] == 0.0f)
+  if (ray.inverse[a] == INFINITY) // parallel (SetDirection)
   {
     return p <= ray.origin[a] ? -INFINITY : INFINITY;
   }
@@ -132,27 +141,24 @@ struct NodeCrossings
 // as +, as the half-open boxes want).
 OCTORAY_HD_INLINE unsigned DirectionSigns(const Ray& ray)
 {
-  return (ray.direction.x < 0.0f ? 1u : 0u) | (ray.direction.y < 0.0f ? 2u : 0u) |
-    (ray.direction.z < 0.0f ? 4u : 0u);
+  return (ray.inverse.x < 0.0f ? 1u : 0u) | (ray.inverse.y < 0.0f ? 2u : 0u) | (ray.inverse.z < 0.0f ? 4u : 0u);
 }
 
-OCTORAY_HD_INLINE float MidCrossing(const Ray& ray, int a, float lo, float size)
+// The plane through a node's corner `lo` that the ray leaves it by on axis a.
+OCTORAY_HD_INLINE float FarFace(unsigned signs, int a, float lo, float size)
 {
-  return Crossing(ray, a, lo + 0.5f * size);
+  return (signs >> a) & 1u ? lo : lo + size;
 }
 
-// The crossings of the node whose corner is cell * size.
-OCTORAY_HD_INLINE NodeCrossings CrossingsOf(
-  const Ray& ray, unsigned signs, const std::uint32_t cell[3], float size)
+// The crossings of the root cube [0, 1)^3.
+OCTORAY_HD_INLINE NodeCrossings RootCrossings(const Ray& ray, unsigned signs)
 {
   NodeCrossings c;
   for (int a = 0; a < 3; ++a)
   {
-    const float lo = static_cast<float>(cell[a]) * size;
-    const bool towardsLow = (signs >> a) & 1u;
-    c.nearT[a] = Crossing(ray, a, towardsLow ? lo + size : lo);
-    c.farT[a] = Crossing(ray, a, towardsLow ? lo : lo + size);
-    c.midT[a] = MidCrossing(ray, a, lo, size);
+    c.nearT[a] = Crossing(ray, a, (signs >> a) & 1u ? 1.0f : 0.0f);
+    c.midT[a] = Crossing(ray, a, 0.5f);
+    c.farT[a] = Crossing(ray, a, FarFace(signs, a, 0.0f, 1.0f));
   }
   return c;
 }
@@ -183,18 +189,13 @@ OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
   return s;
 }
 
-// Mirrored octants whose every axis the ray can reach inside the node: the
-// near half where the mid plane comes no earlier than the node's entry, the
-// far half where it comes no later than its exit. A superset of the
-// children the ray meets, so only those get their span computed.
-OCTORAY_HD_INLINE unsigned ReachableOctants(const NodeCrossings& c)
+// Mirrored octants whose every axis the ray can reach inside a node it
+// spans over [tEnter, tExit]: the near half where the mid plane comes no
+// earlier than the entry, the far half where it comes no later than the
+// exit. A superset of the children the ray meets, so only those get their
+// span computed.
+OCTORAY_HD_INLINE unsigned ReachableOctants(const NodeCrossings& c, float tEnter, float tExit)
 {
-  float tEnter = c.nearT.x, tExit = c.farT.x;
-  for (int a = 1; a < 3; ++a)
-  {
-    tEnter = c.nearT[a] > tEnter ? c.nearT[a] : tEnter;
-    tExit = c.farT[a] < tExit ? c.farT[a] : tExit;
-  }
   unsigned reachable = 0xFFu;
   for (int a = 0; a < 3; ++a)
   {
@@ -202,6 +203,14 @@ OCTORAY_HD_INLINE unsigned ReachableOctants(const NodeCrossings& c)
     reachable &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
   }
   return reachable & 0xFFu;
+}
+
+// The octants that hold every bit of m: those the ray can still meet after
+// the child m, which it met (a ray's children form a chain of growing bit
+// sets).
+OCTORAY_HD_INLINE unsigned OctantsAfter(unsigned m)
+{
+  return (m & 1u ? 0xAAu : 0xFFu) & (m & 2u ? 0xCCu : 0xFFu) & (m & 4u ? 0xF0u : 0xFFu);
 }
 
 // A child mask with octant bits flipped as in NodeCrossings.
@@ -231,6 +240,24 @@ OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
 #endif
 }
 
+// What the traversal keeps of a node while it is inside one of its
+// children, packed in 64 bits: how to find the children, which of them are
+// still to be looked at, and the one it is in.
+struct PausedNode
+{
+  std::uint64_t bits;
+
+  OCTORAY_HD_INLINE static PausedNode Of(std::uint32_t firstChild, unsigned childMask, unsigned todo, unsigned m)
+  {
+    return PausedNode{ std::uint64_t{ firstChild } | std::uint64_t{ childMask } << 32 |
+      std::uint64_t{ todo } << 40 | std::uint64_t{ m } << 48 };
+  }
+  OCTORAY_HD_INLINE std::uint32_t FirstChild() const { return static_cast<std::uint32_t>(bits); }
+  OCTORAY_HD_INLINE unsigned ChildMask() const { return static_cast<unsigned>(bits >> 32) & 0xFFu; }
+  OCTORAY_HD_INLINE unsigned Todo() const { return static_cast<unsigned>(bits >> 40) & 0xFFu; }
+  OCTORAY_HD_INLINE unsigned Visiting() const { return static_cast<unsigned>(bits >> 48) & 7u; }
+};
+
 // Visits the drawn voxels (leaves, or nodes where the level of detail
 // stops) that the ray meets within [tMin, tMax], nearest first, until the
 // visitor's Visit(const NodeHit&) returns true.
@@ -241,18 +268,18 @@ OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
 // Visiting the children by increasing mirrored octant is thus the order the
 // ray meets them, and depth-first in that order is front to back overall.
 //
-// Cost: a node's crossings come from its parent's (three new mid planes), a
-// child's span from selects, and only children reachable by the mid-plane
-// test are looked at. Going back up, the parent's crossings are computed
-// again from its cell, so the stack holds one node index per level and the
-// mirrored octant being visited at each level packed 3 bits to a level in
-// one 64-bit word: (kMaxLevel + 1) * 4 bytes instead of a box per entry.
-// Every value equals what slab tests of each child's box give, bit for bit
-// (the planes are exact dyadic fractions).
+// Cost, one candidate child per step of a single loop (threads of a warp
+// stay in step): a child's span is picked from its parent's crossings, a
+// node's crossings are its parent's with three new mid planes, and only
+// the children the mid planes let the ray reach are looked at. Going back
+// up, the parent's crossings come back from the child's (its near face and
+// mid plane, or mid plane and far face, per axis) with at most three far
+// faces computed again; the parent itself is one 64-bit word per level
+// (PausedNode). Every value equals what a slab test of each child's box
+// gives, bit for bit: the planes are exact dyadic fractions.
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
-  static_assert(3 * kMaxLevel <= 64, "the octant stack packs 3 bits per level into 64");
   NodeHit hit;
   if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) ||
     hit.tExit < ray.tMin || hit.tEnter > ray.tMax)
@@ -269,87 +296,84 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     return;
   }
   const unsigned signs = DirectionSigns(ray);
-  std::uint32_t parents[kMaxLevel + 1];
-  std::uint64_t visiting = 0; // mirrored octant being visited, per level
-  std::uint32_t node = 0;
-  std::uint32_t cell[3] = { 0u, 0u, 0u };
-  int level = 0;
+  PausedNode parents[kMaxLevel];
+  NodeCrossings c = RootCrossings(ray, signs);
+  Vec3f lo{ 0.0f, 0.0f, 0.0f }; // the current node's corner and side
   float size = 1.0f;
-  NodeCrossings c = CrossingsOf(ray, signs, cell, size);
-  unsigned firstOctant = 0;
+  int level = 0;
+  unsigned childMask = tree.childMask[0];
+  std::uint32_t firstChild = tree.firstChild[0];
+  unsigned todo = MirrorOctants(childMask, signs) & ReachableOctants(c, hit.tEnter, hit.tExit);
   for (;;)
   {
-    const unsigned childMask = tree.childMask[node];
-    unsigned todo = MirrorOctants(childMask, signs) & ReachableOctants(c) & (0xFFu << firstOctant);
-    const std::uint32_t firstChild = todo ? tree.firstChild[node] : 0u;
-    const float half = 0.5f * size;
-    bool descended = false;
-    while (todo)
+    if (!todo)
     {
-      const unsigned m = LowestBit(todo);
-      todo &= todo - 1u;
-      const ChildSpan span = SpanOf(c, m);
-      if (!(span.tEnter <= span.tExit) || span.tExit < ray.tMin)
+      if (level == 0)
       {
-        continue;
+        return;
       }
-      if (span.tEnter > ray.tMax)
-      {
-        return; // everything after it is farther
-      }
-      const unsigned octant = m ^ signs;
-      std::uint32_t childCell[3];
+      const PausedNode parent = parents[--level];
+      const unsigned m = parent.Visiting();
+      firstChild = parent.FirstChild();
+      childMask = parent.ChildMask();
+      todo = parent.Todo() & OctantsAfter(m);
       for (int a = 0; a < 3; ++a)
       {
-        childCell[a] = 2u * cell[a] + ((octant >> a) & 1u);
-      }
-      const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
-      if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
-      {
-        hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, span.axis,
-          Vec3f{ static_cast<float>(childCell[0]), static_cast<float>(childCell[1]),
-            static_cast<float>(childCell[2]) } * half,
-          half };
-        if (visitor.Visit(hit))
+        lo[a] -= ((m ^ signs) >> a) & 1u ? size : 0.0f;
+        if ((m >> a) & 1u)
         {
-          return;
+          c.midT[a] = c.nearT[a]; // the parent's near face is not needed again
         }
-        continue;
+        else
+        {
+          c.midT[a] = c.farT[a];
+          c.farT[a] = Crossing(ray, a, FarFace(signs, a, lo[a], 2.0f * size));
+        }
       }
-      parents[level] = node;
-      visiting = (visiting & ~(std::uint64_t{ 7u } << (3 * level))) | (std::uint64_t{ m } << (3 * level));
-      for (int a = 0; a < 3; ++a)
-      {
-        const bool upper = (m >> a) & 1u;
-        c.nearT[a] = upper ? c.midT[a] : c.nearT[a];
-        c.farT[a] = upper ? c.farT[a] : c.midT[a];
-        cell[a] = childCell[a];
-        c.midT[a] = MidCrossing(ray, a, static_cast<float>(cell[a]) * half, half);
-      }
-      node = child;
-      ++level;
-      size = half;
-      firstOctant = 0;
-      descended = true;
-      break;
+      size *= 2.0f;
+      continue;
     }
-    if (descended)
+    const unsigned m = LowestBit(todo);
+    todo &= todo - 1u;
+    const ChildSpan span = SpanOf(c, m);
+    if (!(span.tEnter <= span.tExit) || span.tExit < ray.tMin)
     {
       continue;
     }
-    if (level == 0)
+    if (span.tEnter > ray.tMax)
     {
-      return;
+      return; // everything after it is farther
     }
-    --level;
-    node = parents[level];
-    firstOctant = static_cast<unsigned>((visiting >> (3 * level)) & 7u) + 1u;
-    size = PowerOfTwo(-level);
+    const unsigned octant = m ^ signs;
+    const float half = 0.5f * size;
+    Vec3f childLo = lo;
     for (int a = 0; a < 3; ++a)
     {
-      cell[a] >>= 1;
+      childLo[a] += (octant >> a) & 1u ? half : 0.0f;
     }
-    c = CrossingsOf(ray, signs, cell, size);
+    const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
+    if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
+    {
+      hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, span.axis, childLo, half };
+      if (visitor.Visit(hit))
+      {
+        return;
+      }
+      continue;
+    }
+    parents[level++] = PausedNode::Of(firstChild, childMask, todo, m);
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool upper = (m >> a) & 1u;
+      c.nearT[a] = upper ? c.midT[a] : c.nearT[a];
+      c.farT[a] = upper ? c.farT[a] : c.midT[a];
+      c.midT[a] = Crossing(ray, a, childLo[a] + 0.5f * half);
+    }
+    lo = childLo;
+    size = half;
+    childMask = tree.childMask[child];
+    firstChild = tree.firstChild[child];
+    todo = MirrorOctants(childMask, signs) & ReachableOctants(c, span.tEnter, span.tExit);
   }
 }
 
