@@ -7,7 +7,9 @@
 //                        [--sphere-points N] [--parts modes,off] [--json PATH]
 //
 // --parts picks what runs: `modes` (throughput per mode and scene), `off`
-// (the everything-off frames); default both. Image error against time is
+// (the everything-off frames), `traversal` (one core's primary rays through
+// Traverse against the plain slab-test traversal of ReferenceTraversal.h,
+// in the same run); default modes and off. Image error against time is
 // octoray_bench_quality's.
 //
 // Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
@@ -21,11 +23,14 @@
 #include "PointFile.h"
 
 #include <octoray/Engine.h>
+#include <octoray/Frame.h>
+#include <octoray/ReferenceTraversal.h>
 #include <octoray/RenderModes.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -96,6 +101,67 @@ struct Scene
 };
 }
 
+// One core tracing every pixel's primary ray to its first voxel with
+// `traverse`, in a plain loop (no shading, no picture): what is left is
+// the ray setup and the traversal. Returns the best of `repeats` in seconds
+// and the hit voxels' sum, by which the traversals must agree.
+template <typename TraverseFn>
+double PrimaryRaySeconds(const FrameConstants& f, const OctreeView& tree, int repeats, TraverseFn traverse,
+  std::uint64_t& hitSum)
+{
+  double best = 0.0;
+  for (int r = 0; r <= repeats; ++r) // the first is a warm-up
+  {
+    hitSum = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (int y = 0; y < f.height; ++y)
+    {
+      for (int x = 0; x < f.width; ++x)
+      {
+        Ray ray;
+        double tBase;
+        FirstHitVisitor first;
+        if (PrimaryRay(f, x, y, ray, tBase))
+        {
+          LevelOfDetail lod;
+          traverse(tree, ray, lod, first);
+        }
+        hitSum += first.found ? first.hit.node + 1u : 0u;
+      }
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = r == 1 || (r > 1 && seconds < best) ? seconds : best;
+  }
+  return best;
+}
+
+// The `traversal` part for one scene built on `engine`.
+Record CompareTraversals(Engine& engine, const Scene& scene, int w, int h, int repeats)
+{
+  BuildOptions options;
+  options.depth = scene.depth;
+  const BuildStats build = engine.Build(scene.points, options);
+  HostOctree tree;
+  engine.CopyToHost(tree);
+  const OctreeView view = tree.View();
+  const FrameConstants f = MakeFrame(MakeSettings(scene.points, w, h, kModes[0], build.depth), view);
+  std::uint64_t fastSum = 0, referenceSum = 0;
+  const double fast = PrimaryRaySeconds(f, view, repeats,
+    [](const OctreeView& t, const Ray& r, const LevelOfDetail& l, FirstHitVisitor& v) { Traverse(t, r, l, v); },
+    fastSum);
+  const double reference = PrimaryRaySeconds(f, view, repeats,
+    [](const OctreeView& t, const Ray& r, const LevelOfDetail& l, FirstHitVisitor& v) { ReferenceTraverse(t, r, l, v); },
+    referenceSum);
+  const double rays = double(w) * h;
+  std::printf("| %s | %zu | %d | %.2f | %.2f | %.2fx | %s |\n", scene.name.c_str(), build.points, build.depth,
+    rays / fast * 1e-6, rays / reference * 1e-6, reference / fast, fastSum == referenceSum ? "yes" : "NO");
+  std::fflush(stdout);
+  Record r{ "traversal." + scene.name, "cpu-1-core", std::size_t(w) * h, build.depth, fast,
+    "reference slab-test traversal", reference };
+  r.With("same_first_hits", fastSum == referenceSum ? 1.0 : 0.0).With("nodes", double(build.nodes));
+  return r;
+}
+
 int main(int argc, char** argv)
 {
   int w = 1920, h = 1080, repeats = 3, threads = 0;
@@ -159,6 +225,19 @@ int main(int argc, char** argv)
             .With("points", double(build.points))
             .With("nodes", double(build.nodes));
           records.push_back(r);
+        }
+      }
+
+      if (wanted("traversal") && b == Backend::CPU)
+      {
+        std::printf("\nprimary rays on one core, %dx%d, best of %d after a warm-up: Traverse against the plain "
+                    "slab-test traversal (ReferenceTraversal.h)\n",
+          w, h, repeats);
+        std::printf("| scene | points | depth | Mrays/s, Traverse | Mrays/s, reference | speed-up | same first hits |\n");
+        std::printf("| --- | ---: | ---: | ---: | ---: | ---: | --- |\n");
+        for (const Scene& scene : scenes)
+        {
+          records.push_back(CompareTraversals(*engine, scene, w, h, repeats));
         }
       }
 

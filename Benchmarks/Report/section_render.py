@@ -21,6 +21,9 @@ def produce(ctx):
     ctx.run("render-modes", [os.path.join(ctx.bin, "octoray_bench_render"), "--size", SIZE, "--repeats", REPEATS,
                              "--backend", "cpu", "--parts", "modes",
                              "--json", fresh(ctx.work_path("render-modes.json"))])
+    ctx.run("render-traversal", [os.path.join(ctx.bin, "octoray_bench_render"), "--size", "1920x1080",
+                                 "--repeats", 3, "--backend", "cpu", "--parts", "traversal",
+                                 "--json", fresh(ctx.work_path("render-traversal.json"))])
     record_machine(ctx, "render", "end")
 
 
@@ -75,6 +78,8 @@ def render(ctx):
         "--parts modes --json OUTDIR/%s` fills it." % (NOT_ON_GPU, GPU_RENDER_FILE))
 
     cuda_text, summary = _cuda_cloud(ctx)
+    traversal_text, traversal_summary = _one_core(ctx)
+    summary = traversal_summary + summary
     text = """
 {machine}
 
@@ -104,12 +109,16 @@ Reading these tables:
   per ray, only per frame.
 - How level of detail and the bounce limit trade error for time is in the quality section.
 
+### One core: Traverse against the plain slab-test traversal
+
+{traversal}
+
 ### CUDA, 10 M points at 1920×1080 (GPU run)
 
 {cuda}
 """.format(machine=machine_text(ctx, "render"), cmd=ctx.command("render-modes"), repeats=REPEATS, size=SIZE,
            engine=cpu_name, tables="\n\n".join(parts) or "No render records.", csv=csv, link=link, gpu_line=gpu_line,
-           cuda=cuda_text)
+           cuda=cuda_text, traversal=traversal_text)
     return Section(text, summary)
 
 
@@ -141,6 +150,35 @@ def _plot(png, plot, cpu_name):
     plt.close(fig)
 
 
+def _one_core(ctx):
+    """Primary rays on one core through Traverse and through the reference
+    slab-test traversal, timed in the same run (`--parts traversal`)."""
+    records = [r for r in load_records(ctx.work_path("render-traversal.json")) if r["name"].startswith("traversal.")]
+    rows, summary = [], []
+    for r in records:
+        rays = r["n"]
+        fast, reference = rays / r["seconds"] / 1e6, rays / r["peer_seconds"] / 1e6
+        rows.append([r["name"].split(".", 1)[1], r["depth"], count(r["nodes"]), "%.2f" % fast, "%.2f" % reference,
+                     "%.2f×" % (r["peer_seconds"] / r["seconds"]), "yes" if r["same_first_hits"] else "NO"])
+        summary.append(("CPU, one core, primary rays 1920×1080, %s" % r["name"].split(".", 1)[1],
+                        "%.2f Mrays/s (%.2f× the reference loop)" % (fast, r["peer_seconds"] / r["seconds"]),
+                        "issue 16's goal 5 Mrays/s per core", "%.2f×" % (fast / 5)))
+    if not rows:
+        return "No traversal records.", []
+    text = ("Command:\n\n    %s\n\nEach pixel's primary ray to its first voxel in a plain loop on one core (no "
+            "shading, no picture), 1920×1080, best of 3 after a warm-up: through `Traverse` (Traversal.h: each "
+            "child's span picked from its parent's near, mid and far plane crossings, only the children the mid "
+            "planes let the ray reach looked at, one 64-bit word per level on the stack) and through "
+            "`ReferenceTraverse` (ReferenceTraversal.h: a slab test of every child's box, each node's box decoded "
+            "from its Morton key, a stack entry per child met), which is what the engine traced with before. "
+            "\"Same first hits\" compares the sums of the hit voxels' indices over the frame; the engine tests "
+            "compare the two traversals visit by visit.\n\n" % ctx.command("render-traversal") +
+            ctx.table(["scene", "depth", "nodes", "Mrays/s, Traverse", "Mrays/s, reference", "speed-up",
+                       "same first hits"], rows) +
+            "\n\nThe traversal is scalar: one ray at a time, no SIMD across rays.")
+    return text, summary
+
+
 def _cuda_cloud(ctx):
     name = "bench-results-cuda.json"
     records = gpu_records(ctx, name)
@@ -166,10 +204,10 @@ def _cuda_cloud(ctx):
             "the VTK mapper draws it); median of 9. Mpixels/s = 1920·1080 / time: for primary rays it is Mrays/s; "
             "the shadow and bounce row casts more rays per pixel than it counts.\n\n" % gpu_source(ctx, name) +
             ctx.table(["depth", "mode", "device time", "Mpixels/s", "frames/s"], rows) +
-            "\n\n[CSV](%s)\n\nIssue 4's goals: ≥ 2 000 Mrays/s primary, ≥ 500 with shadows and a bounce. Each frame "
-            "runs the kernel instantiated for its feature set; what remains is the traversal itself (a stack of "
-            "(node, level, entry t) in local memory, a Morton decode per visited node, one thread per pixel). At "
-            "depth 16 the clustered points are sparse and most rays cross the whole cube without a hit." % csv)
+            "\n\n[CSV](%s)\n\nIssue 16's goals: ≥ 2 000 Mrays/s primary at depth 10 and ≥ 1 000 at depth 16, "
+            "≥ 1 000 with shadows and a bounce. Each frame runs the kernel instantiated for its feature set, one "
+            "thread per pixel, through the traversal of the section above. At depth 16 the clustered points are "
+            "sparse and most rays cross the whole cube without a hit." % csv)
     profile = ctx.gpu_file("profile.txt")
     if profile:
         text += ("\n\nNsight Compute on the render kernel, one depth-10 frame of each kind above (gpu-check.sh's "

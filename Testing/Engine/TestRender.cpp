@@ -3,6 +3,7 @@
 #include "TestRenderSupport.h"
 
 #include <octoray/DepthSignature.h>
+#include <octoray/ReferenceTraversal.h>
 
 using namespace octoray;
 using namespace octoray::test;
@@ -57,6 +58,96 @@ TEST_P(RenderTest, SurfaceMatchesBruteForceVoxelHits)
     // Ties where a ray meets two voxels at the same face aside.
     EXPECT_GE(agree, hits * 99 / 100) << agree << " of " << hits;
   }
+}
+
+namespace
+{
+// Every voxel a traversal visits, none refused, zero-length touches aside:
+// a ray through an edge or corner of mid planes touches some children with
+// tEnter == tExit, which the slab tests of the reference visit and
+// Traverse may pass by; they hold no length of the ray.
+struct VisitLog
+{
+  std::vector<NodeHit> hits;
+  bool Visit(const NodeHit& h)
+  {
+    if (h.tEnter < h.tExit)
+    {
+      hits.push_back(h);
+    }
+    return false;
+  }
+};
+
+bool SameHit(const NodeHit& a, const NodeHit& b)
+{
+  return a.node == b.node && a.level == b.level && a.tEnter == b.tEnter && a.tExit == b.tExit && a.axis == b.axis &&
+    a.lo.x == b.lo.x && a.lo.y == b.lo.y && a.lo.z == b.lo.z && a.size == b.size;
+}
+}
+
+// Traverse against ReferenceTraversal.h's slab test of every child box:
+// the same voxels in the same order with bit-identical spans, entry axes
+// and boxes, for rays from everywhere (inside the cube, outside, clipped by
+// tMin and tMax), parallel to one or two axes and lying on grid planes,
+// diagonal through the mid planes' edges, and with level of detail.
+TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
+{
+  const Cloud c = GaussianClusters(3000, 47);
+  BuildOptions options;
+  options.depth = 7;
+  engine->Build(c.View(), options);
+  HostOctree t;
+  engine->CopyToHost(t);
+  const OctreeView view = t.View();
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> around(-0.5f, 1.5f), unit(-1.0f, 1.0f), share(0.0f, 1.0f);
+  std::size_t visits = 0;
+  for (int r = 0; r < 20000; ++r)
+  {
+    // Aimed at a leaf's corner, so that most rays meet the clusters.
+    const std::uint32_t leaf = view.levelBegin[7] + static_cast<std::uint32_t>(rng() % view.LevelSize(7));
+    std::uint32_t cell[3];
+    DecodeMorton(t.key[leaf], cell[0], cell[1], cell[2]);
+    const Vec3f corner{ cell[0] / 128.0f, cell[1] / 128.0f, cell[2] / 128.0f };
+    Ray ray;
+    ray.origin = Vec3f{ around(rng), around(rng), around(rng) };
+    Vec3f d = corner + Vec3f{ share(rng), share(rng), share(rng) } * (1.0f / 128.0f) - ray.origin;
+    const int kind = r % 8;
+    if (kind == 1 || kind == 2) // parallel to one or two axes, on the leaf's grid planes
+    {
+      for (int a = 0; a < kind; ++a)
+      {
+        d[(r / 8 + a) % 3] = 0.0f;
+        ray.origin[(r / 8 + a) % 3] = corner[(r / 8 + a) % 3];
+      }
+    }
+    else if (kind == 3) // diagonal: x and y cross every mid plane together
+    {
+      ray.origin = Vec3f{ 0.0f, 0.0f, share(rng) };
+      d = Vec3f{ 1.0f, 1.0f, unit(rng) * 0.5f };
+    }
+    SetDirection(ray, Normalize(d));
+    ray.tMin = kind == 4 ? share(rng) : 0.0f;
+    ray.tMax = kind == 5 ? share(rng) * 2.0f : INFINITY;
+    LevelOfDetail lod;
+    if (kind == 6)
+    {
+      lod.pixels = 1.0f;
+      lod.footprint0 = 0.002f;
+      lod.footprintSlope = 0.01f;
+    }
+    VisitLog fast, reference;
+    Traverse(view, ray, lod, fast);
+    ReferenceTraverse(view, ray, lod, reference);
+    ASSERT_EQ(fast.hits.size(), reference.hits.size()) << "ray " << r;
+    for (std::size_t i = 0; i < fast.hits.size(); ++i)
+    {
+      ASSERT_TRUE(SameHit(fast.hits[i], reference.hits[i])) << "ray " << r << ", visit " << i;
+    }
+    visits += fast.hits.size();
+  }
+  EXPECT_GT(visits, 30000u); // the rays meet the clusters, not only empty space
 }
 
 TEST_P(RenderTest, FullPlaneHasNoCracksAtAnyAngle)
