@@ -146,7 +146,7 @@ for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper
 done
 [ -f "$out/bench.log" ] && grep -E "^(device|upload|build|update|render)" "$out/bench.log"
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
-for blocks in 0 6; do
+for blocks in ${VARIANT_BLOCKS:-0 6}; do
   [ -f "$out/variant-$blocks.log" ] && grep -E "^render" "$out/variant-$blocks.log" | sed "s/^/min blocks $blocks: /"
 done
 [ -f "$out/orbit.log" ] && grep -E "points: generated|frame median|  =>|skipped" "$out/orbit.log" | cut -c1-220
