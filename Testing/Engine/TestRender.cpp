@@ -18,11 +18,7 @@ const double kUp[3] = { 0, 0, 1 };
 TEST_P(RenderTest, SurfaceMatchesBruteForceVoxelHits)
 {
   const Cloud c = GaussianClusters(400, 41);
-  BuildOptions options;
-  options.depth = 5;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 5);
   const int w = 64, h = 48;
   const double eye[3] = { 25, -30, 18 }, target[3] = { 2, 1, 1 };
   for (bool parallel : { false, true })
@@ -94,11 +90,7 @@ bool SameHit(const NodeHit& a, const NodeHit& b)
 TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
 {
   const Cloud c = GaussianClusters(3000, 47);
-  BuildOptions options;
-  options.depth = 7;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 7);
   const OctreeView view = t.View();
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<float> around(-0.5f, 1.5f), unit(-1.0f, 1.0f), share(0.0f, 1.0f);
@@ -160,11 +152,7 @@ TEST_P(RenderTest, FullPlaneHasNoCracksAtAnyAngle)
       c.Add(i + 0.5, j + 0.5, 0.0, rng);
   c.Add(0, 0, 0, rng);
   c.Add(32, 32, 0, rng);
-  BuildOptions options;
-  options.depth = 5;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 5);
   const int w = 96, h = 96;
   const double target[3] = { 16, 16, 0 };
   const double eyes[][3] = { { 16, 16, 60 }, { 16.0, -20, 25 }, { 50, -30, 5 }, { 16, 16.0001, 80 } };
@@ -194,11 +182,7 @@ TEST_P(RenderTest, FullPlaneHasNoCracksAtAnyAngle)
 TEST_P(RenderTest, MaximumIntensityMatchesBruteForce)
 {
   const Cloud c = UniformCloud(300, 43);
-  BuildOptions options;
-  options.depth = 4;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 4);
   const int w = 40, h = 40;
   const double eye[3] = { 3, -4, 2 }, target[3] = { 0, 0, 0 };
   const Matrix vp = ViewProjection(eye, target, kUp, 45, 1.0, 0.5, 20);

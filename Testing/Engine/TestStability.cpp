@@ -422,11 +422,7 @@ TEST_P(Stability, GrazingRays)
 TEST_P(Stability, CameraInsideTheData)
 {
   const Cloud c = UniformCloud(150, 49);
-  BuildOptions options;
-  options.depth = 4;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 4);
   const int w = 48, h = 48;
   // From the cube's centre, in six directions, against brute force.
   const double eye[3] = { t.cube.origin[0] + 0.5 * t.cube.size, t.cube.origin[1] + 0.5 * t.cube.size,
@@ -477,11 +473,7 @@ TEST_P(Stability, CameraInsideTheData)
 TEST_P(Stability, CameraAMillionBoxSizesAway)
 {
   const Cloud c = UniformCloud(400, 50);
-  BuildOptions options;
-  options.depth = 5;
-  engine->Build(c.View(), options);
-  HostOctree t;
-  engine->CopyToHost(t);
+  HostOctree t = BuildOnHost(*engine, c.View(), 5);
   const double size = t.cube.size;
   const double centre[3] = { t.cube.origin[0] + 0.5 * size, t.cube.origin[1] + 0.5 * size,
     t.cube.origin[2] + 0.5 * size };

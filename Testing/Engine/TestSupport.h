@@ -74,6 +74,18 @@ inline Cloud UniformCloud(std::size_t n, std::uint64_t seed, double lo = -1.0, d
   return c;
 }
 
+// The octree `engine` builds from `points` at `depth` (0: chosen from the
+// data), copied to the host for a test to inspect or trace.
+inline HostOctree BuildOnHost(Engine& engine, const PointCloudView& points, int depth)
+{
+  BuildOptions options;
+  options.depth = depth;
+  engine.Build(points, options);
+  HostOctree t;
+  engine.CopyToHost(t);
+  return t;
+}
+
 inline Cloud GaussianClusters(std::size_t n, std::uint64_t seed)
 {
   std::mt19937_64 rng(seed);
