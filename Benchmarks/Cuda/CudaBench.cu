@@ -10,7 +10,9 @@
 //    cudaHostRegister of the same arrays (--only build skips the rest);
 //  - with --billion N: N points generated on the device, built without
 //    their points, and traced at 1920x1080 (build time, bytes per point,
-//    frame time).
+//    frame time);
+//  - with --profile-build N: two builds of N points at depth 10 and nothing
+//    else, for a profiler to list the build's kernels (gpu-check.sh profile-build).
 // Times are medians of repeated runs after a warm-up; device work is timed
 // with CUDA events (the sort) or synchronised wall clock (whole engine calls).
 #include <octoray/Engine.h>
@@ -378,6 +380,7 @@ int Run(int argc, char** argv)
   std::string json;
   std::string only; // "build" or "render": that section alone
   std::size_t billion = 0;
+  std::size_t profileBuild = 0; // points: two builds at depth 10 alone, for a profiler's kernel list
   std::vector<std::size_t> sizes = { 1000000, 10000000, 100000000 };
   for (int a = 1; a < argc; ++a)
   {
@@ -389,6 +392,8 @@ int Run(int argc, char** argv)
       only = argv[++a];
     else if (!std::strcmp(argv[a], "--billion") && a + 1 < argc)
       billion = static_cast<std::size_t>(std::stod(argv[++a]));
+    else if (!std::strcmp(argv[a], "--profile-build") && a + 1 < argc)
+      profileBuild = static_cast<std::size_t>(std::stod(argv[++a]));
   }
   auto section = [&](const char* name) { return only.empty() || only == name; };
   std::string why;
@@ -399,6 +404,20 @@ int Run(int argc, char** argv)
   }
   auto engine = CreateEngine(Backend::CUDA);
   std::printf("device: %s\n", engine->Description().c_str());
+  if (profileBuild)
+  {
+    const Cloud c = MakeCloud(profileBuild, 1);
+    BuildOptions o;
+    o.depth = 10;
+    for (int b = 0; b < 2; ++b) // the first one fills the allocator's pool
+    {
+      const BuildStats last = engine->Build(c.View(), o);
+      std::printf("build %d of n=%zu depth=10: upload %.3f, keys %.3f, sort %.3f, levels %.3f ms\n", b + 1,
+        profileBuild, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
+        last.levelSeconds * 1e3);
+    }
+    return 0;
+  }
   std::vector<Record> records;
 
   // Build against the sort floor.

@@ -25,7 +25,9 @@
 # from VARIANT_BLOCKS, default 0 and 6, beside the 8 of the main build),
 # report (the
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
-# ORBIT_ARGS adds arguments).
+# ORBIT_ARGS adds arguments), profile-build (ncu's time of every kernel of a
+# build of PROFILE_BUILD points, default 1e8), sass (the primary-ray render
+# kernel's machine code, from cuobjdump).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Benchmarks/gpu/).
 set -uo pipefail
@@ -113,6 +115,18 @@ if want profile; then
   done
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
 fi
+if want profile-build; then
+  # Every kernel of two 100 M-point builds at depth 10, timed by ncu; the
+  # table is the second build's time per kernel.
+  step profile-build ncu --clock-control none --metrics gpu__time_duration.sum --csv --page raw \
+    --log-file "$out/profile-build.csv" $build/bin/octoray_bench_cuda --profile-build "${PROFILE_BUILD:-1e8}"
+  python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build.csv" 2 > "$out/profile-build.txt" 2>&1
+fi
+if want sass; then
+  # The render kernel's machine code (primary rays), to count what one
+  # traversal step costs.
+  step sass bash -c "cuobjdump -sass $build/bin/octoray_bench_cuda | awk '/Function : .*RenderKernel.*FeaturesILb0ELb0ELb0ELb0E/{p=1} p&&/Function : /&&!/FeaturesILb0ELb0ELb0ELb0E/{p=0} p' > '$out/sass-primary.txt'"
+fi
 if want variants; then
   for blocks in ${VARIANT_BLOCKS:-0 6}; do
     vb=build-gpu-blocks$blocks
@@ -146,6 +160,8 @@ for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper
 done
 [ -f "$out/bench.log" ] && grep -E "^(device|upload|build|update|render)" "$out/bench.log"
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
+[ -f "$out/profile-build.txt" ] && head -25 "$out/profile-build.txt"
+[ -f "$out/sass-primary.txt" ] && echo "sass-primary.txt: $(grep -c '/\*[0-9a-f]*\*/' "$out/sass-primary.txt") instructions"
 for blocks in ${VARIANT_BLOCKS:-0 6}; do
   [ -f "$out/variant-$blocks.log" ] && grep -E "^render" "$out/variant-$blocks.log" | sed "s/^/min blocks $blocks: /"
 done
@@ -157,7 +173,7 @@ printf '%s\n' "${status[@]}"
 files=()
 for f in summary.txt gpu.txt engine-tests.xml mapper-tests.xml bench-results-cuda.json quality-cuda.json \
   bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json orbit.json profile.txt \
-  profile-primary.csv profile-full.csv; do
+  profile-primary.csv profile-full.csv profile-build.txt; do
   [ -e "$out/$f" ] && files+=("$f")
 done
 (cd "$out" && tar czf report-files.tgz "${files[@]}")

@@ -81,20 +81,20 @@ OCTORAY_HD float WindowDepth(const FrameConstants& f, const Vec3d& p)
   return static_cast<float>(Clamp01(0.5 * clip[2] / clip[3] + 0.5));
 }
 
-// The line through the centre of pixel (x, y): its point on the near plane,
-// its unit direction and its length to the far plane, in double. False
-// for a degenerate projection.
+// The centre of pixel (x, y) in normalised device coordinates, at depth z.
 OCTORAY_HD Vec3d PixelNdc(const FrameConstants& f, int x, int y, double z)
 {
   return Vec3d{ 2.0 * (x + 0.5) / f.width - 1.0, 2.0 * (y + 0.5) / f.height - 1.0, z };
 }
 
+// The line through the centre of pixel (x, y): its point on the near plane,
+// its unit direction and its length to the far plane, in double. False
+// for a degenerate projection.
 OCTORAY_HD bool PixelLine(const FrameConstants& f, int x, int y, Vec3d& nearPoint, Vec3d& d, double& length)
 {
   const Vec3d ndc = PixelNdc(f, x, y, -1.0);
-  const double nx = ndc.x, ny = ndc.y;
-  nearPoint = Unproject(f.unitFromNdc, nx, ny, -1.0);
-  d = Unproject(f.unitFromNdc, nx, ny, 1.0) - nearPoint;
+  nearPoint = Unproject(f.unitFromNdc, ndc.x, ndc.y, -1.0);
+  d = Unproject(f.unitFromNdc, ndc.x, ndc.y, 1.0) - nearPoint;
   length = Length(d);
   if (!(length > 0.0))
   {

@@ -144,7 +144,13 @@ OCTORAY_HD_INLINE unsigned DirectionSigns(const Ray& ray)
   return (ray.inverse.x < 0.0f ? 1u : 0u) | (ray.inverse.y < 0.0f ? 2u : 0u) | (ray.inverse.z < 0.0f ? 4u : 0u);
 }
 
-// The plane through a node's corner `lo` that the ray leaves it by on axis a.
+// The planes by which the ray enters and leaves, on axis a, the node whose
+// corner is `lo`.
+OCTORAY_HD_INLINE float NearFace(unsigned signs, int a, float lo, float size)
+{
+  return (signs >> a) & 1u ? lo + size : lo;
+}
+
 OCTORAY_HD_INLINE float FarFace(unsigned signs, int a, float lo, float size)
 {
   return (signs >> a) & 1u ? lo : lo + size;
@@ -156,7 +162,7 @@ OCTORAY_HD_INLINE NodeCrossings RootCrossings(const Ray& ray, unsigned signs)
   NodeCrossings c;
   for (int a = 0; a < 3; ++a)
   {
-    c.nearT[a] = Crossing(ray, a, (signs >> a) & 1u ? 1.0f : 0.0f);
+    c.nearT[a] = Crossing(ray, a, NearFace(signs, a, 0.0f, 1.0f));
     c.midT[a] = Crossing(ray, a, 0.5f);
     c.farT[a] = Crossing(ray, a, FarFace(signs, a, 0.0f, 1.0f));
   }
