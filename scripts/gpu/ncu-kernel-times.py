@@ -25,7 +25,10 @@ def launches(path):
     for row in table:
         if not row["ID"].strip().isdigit():
             continue
-        name = re.sub(r"\(.*", "", row["Kernel Name"]).strip()
+        full = row["Kernel Name"]
+        # Lambdas of one function differ only in their number: keep it.
+        lambdas = re.findall(r"\{lambda\([^)]*\)#(\d+)\}", full)
+        name = re.sub(r"\(.*", "", full).strip()[:100] + "".join(" lambda #" + n for n in lambdas[-1:])
         yield name, float(row["gpu__time_duration.sum"].replace(",", "")) * scale
 
 
@@ -41,7 +44,7 @@ def main():
     total = sum(t for t, _ in per.values())
     print(f"{path}: the last of {builds} builds, {len(last)} kernel launches, {total:.3f} ms of kernels")
     for name, (ms, count) in sorted(per.items(), key=lambda kv: -kv[1][0]):
-        print(f"  {ms:9.3f} ms {100 * ms / total:5.1f}%  {count:4d}x  {name[:110]}")
+        print(f"  {ms:9.3f} ms {100 * ms / total:5.1f}%  {count:4d}x  {name}")
 
 
 if __name__ == "__main__":
