@@ -25,11 +25,22 @@ def launches(path):
     for row in table:
         if not row["ID"].strip().isdigit():
             continue
-        full = row["Kernel Name"]
-        # Lambdas of one function differ only in their number: keep it.
-        lambdas = re.findall(r"\{lambda\([^)]*\)#(\d+)\}", full)
-        name = re.sub(r"\(.*", "", full).strip()[:100] + "".join(" lambda #" + n for n in lambdas[-1:])
-        yield name, float(row["gpu__time_duration.sum"].replace(",", "")) * scale
+        yield row["Kernel Name"], float(row["gpu__time_duration.sum"].replace(",", "")) * scale
+
+
+def short_names(full_names):
+    """Each full kernel name shortened to its template head; names that
+    shorten alike (a function's lambdas, which differ only in how the
+    profiler numbers them) are told apart by a variant number."""
+    heads = {}
+    for full in full_names:
+        heads.setdefault(re.sub(r"\(.*", "", full).strip()[:100], []).append(full)
+    out = {}
+    for head, fulls in heads.items():
+        for k, full in enumerate(fulls):
+            out[full] = head if len(fulls) == 1 else f"{head} (variant {k + 1})"
+    return out
+
 
 
 def main():
@@ -37,8 +48,10 @@ def main():
     builds = int(sys.argv[2]) if len(sys.argv) > 2 else 2
     everything = list(launches(path))
     last = everything[len(everything) - len(everything) // builds:]
+    names = short_names(dict.fromkeys(full for full, _ in everything))
     per = {}
-    for name, ms in last:
+    for full, ms in last:
+        name = names[full]
         total, count = per.get(name, (0.0, 0))
         per[name] = (total + ms, count + 1)
     total = sum(t for t, _ in per.values())
