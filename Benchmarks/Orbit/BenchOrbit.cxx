@@ -25,6 +25,10 @@
 //     [--methods octoray,octoray-host,pointgauss,points,smart-256,smart-512]
 //     [--file particles.txt|cloud.pcd] [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json]
 //     [--images DIR]   (each method's first frame as a PNG)
+//     [--tile N [--tile-depth D]]   (the file's cloud tiled to N points on a
+//                      square grid, drawn by octoray at leaf depth D, default
+//                      12, without keeping the points: a real scan at a
+//                      billion points)
 #include "BenchUtil.h"
 
 #include "vtkActor.h"
@@ -60,7 +64,10 @@
 
 #include <cuda_runtime_api.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <thread>
@@ -86,6 +93,42 @@ double DeviceBytesUsed()
 // Clustered points with a colour from their position: `n` points in 64
 // Gaussian blobs (fixed seed), made on every core; deterministic for a given
 // n whatever the thread count.
+// fn(b, begin, end) for the blocks [b * block, min(n, (b + 1) * block)) of
+// [0, n), spread over the machine's threads.
+template <typename Fn>
+void ForEachBlock(std::size_t n, std::size_t block, Fn fn)
+{
+  const std::size_t blocks = (n + block - 1) / block;
+  std::vector<std::thread> workers;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned t = 0; t < threads; ++t)
+  {
+    workers.emplace_back([&, t] {
+      for (std::size_t b = t; b < blocks; b += threads)
+      {
+        fn(b, b * block, std::min(n, (b + 1) * block));
+      }
+    });
+  }
+  for (std::thread& w : workers)
+  {
+    w.join();
+  }
+}
+
+// A cloud of float positions and 8-bit RGB colours, as the generated and
+// tiled scenes hand them to every method.
+vtkSmartPointer<vtkPolyData> CloudOf(vtkFloatArray* xyz, vtkUnsignedCharArray* rgb)
+{
+  auto cloud = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetData(xyz);
+  cloud->SetPoints(points);
+  rgb->SetName("Colors");
+  cloud->GetPointData()->SetScalars(rgb);
+  return cloud;
+}
+
 vtkSmartPointer<vtkPolyData> ClusteredPoints(std::size_t n)
 {
   const int clusters = 64;
@@ -106,40 +149,68 @@ vtkSmartPointer<vtkPolyData> ClusteredPoints(std::size_t n)
   rgb->SetName("Colors");
   rgb->SetNumberOfComponents(3);
   rgb->SetNumberOfTuples(static_cast<vtkIdType>(n));
-  const std::size_t block = 1 << 20;
-  const std::size_t blocks = (n + block - 1) / block;
-  std::vector<std::thread> workers;
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  for (unsigned t = 0; t < threads; ++t)
-  {
-    workers.emplace_back([&, t] {
-      for (std::size_t b = t; b < blocks; b += threads)
+  ForEachBlock(n, std::size_t{ 1 } << 20, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    Random random(kDefaultSeed + 1 + b);
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      const std::size_t k = random.Next() % clusters;
+      float* p = xyz->GetPointer(3 * static_cast<vtkIdType>(i));
+      unsigned char* c = rgb->GetPointer(3 * static_cast<vtkIdType>(i));
+      for (int a = 0; a < 3; ++a)
       {
-        Random random(kDefaultSeed + 1 + b);
-        for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-        {
-          const std::size_t k = random.Next() % clusters;
-          float* p = xyz->GetPointer(3 * static_cast<vtkIdType>(i));
-          unsigned char* c = rgb->GetPointer(3 * static_cast<vtkIdType>(i));
-          for (int a = 0; a < 3; ++a)
-          {
-            p[a] = static_cast<float>(centre[3 * k + a] + sigma[k] * random.Normal());
-            c[a] = static_cast<unsigned char>(40 + 215 * std::min(1.0, std::max(0.0, static_cast<double>(p[a]))));
-          }
-        }
+        p[a] = static_cast<float>(centre[3 * k + a] + sigma[k] * random.Normal());
+        c[a] = static_cast<unsigned char>(40 + 215 * std::min(1.0, std::max(0.0, static_cast<double>(p[a]))));
       }
-    });
-  }
-  for (std::thread& w : workers)
+    }
+  });
+  return CloudOf(xyz, rgb);
+}
+
+// `n` points from copies of `cloud` (positions and its "Colors") laid side
+// by side on a square grid in x and y, a tenth of its extent apart; the
+// last copy is cut at n. How a real scan reaches a billion points.
+vtkSmartPointer<vtkPolyData> TiledCloud(vtkPolyData* cloud, std::size_t n)
+{
+  const std::size_t m = static_cast<std::size_t>(cloud->GetNumberOfPoints());
+  double b[6];
+  cloud->GetBounds(b);
+  const std::size_t copies = (n + m - 1) / m;
+  const std::size_t side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(copies))));
+  const double step[2] = { 1.1 * (b[1] - b[0]), 1.1 * (b[3] - b[2]) };
+  std::vector<float> from(3 * m);
+  for (std::size_t k = 0; k < m; ++k)
   {
-    w.join();
+    const double* p = cloud->GetPoint(static_cast<vtkIdType>(k));
+    for (int a = 0; a < 3; ++a)
+    {
+      from[3 * k + a] = static_cast<float>(p[a]);
+    }
   }
-  auto cloud = vtkSmartPointer<vtkPolyData>::New();
-  vtkNew<vtkPoints> points;
-  points->SetData(xyz);
-  cloud->SetPoints(points);
-  cloud->GetPointData()->SetScalars(rgb);
-  return cloud;
+  auto* colours = vtkUnsignedCharArray::SafeDownCast(cloud->GetPointData()->GetArray("Colors"));
+  if (!colours || colours->GetNumberOfComponents() != 3)
+  {
+    std::fprintf(stderr, "--tile: the file's \"Colors\" are not 8-bit RGB; tiling copies those only\n");
+    std::exit(2);
+  }
+  vtkNew<vtkFloatArray> xyz;
+  xyz->SetNumberOfComponents(3);
+  xyz->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  vtkNew<vtkUnsignedCharArray> rgb;
+  rgb->SetNumberOfComponents(3);
+  rgb->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  ForEachBlock(n, m, [&](std::size_t copy, std::size_t begin, std::size_t end) {
+    const float offset[3] = { static_cast<float>(step[0] * (copy % side)), static_cast<float>(step[1] * (copy / side)),
+      0.0f };
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        xyz->GetPointer(0)[3 * i + a] = from[3 * (i - begin) + a] + offset[a];
+        rgb->GetPointer(0)[3 * i + a] = colours->GetPointer(0)[3 * (i - begin) + a];
+      }
+    }
+  });
+  return CloudOf(xyz, rgb);
 }
 
 // One vertex cell per point (vtkPolyDataMapper draws cells), 32-bit ids.
@@ -169,6 +240,8 @@ struct Scene
   double Bounds[6];
   double Radius; // splat radius: about the mean point spacing on the surface
   double PrepareSeconds = 0.0; // reading or generating the points
+  int LeafDepth = 0;           // octoray's leaf level; 0: chosen from the data
+  bool KeepPoints = true;      // octoray's KeepPointsForUpdates
 };
 
 struct Method
@@ -186,7 +259,8 @@ Method Octree(const Scene& scene, bool interop)
   mapper->SetRequestedBackendToCuda();
   mapper->SetUseCudaGLInterop(interop);
   mapper->SetInputData(scene.Cloud);
-  mapper->SetLeafDepth(0); // chosen from the data, as a user gets it
+  mapper->SetLeafDepth(scene.LeafDepth); // 0 unless --tile: chosen from the data, as a user gets it
+  mapper->SetKeepPointsForUpdates(scene.KeepPoints);
   auto volume = vtkSmartPointer<vtkVolume>::New();
   volume->SetMapper(mapper);
   vtkNew<vtkVolumeProperty> property;
@@ -525,6 +599,8 @@ struct Options
 {
   std::string Points = "1e6,1e7,1e8", Sizes = "1920x1080,3840x2160",
               Methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", File, Json, Images;
+  double Tile = 0.0; // points: the file's cloud tiled to that many (a static scene, points not kept)
+  int TileDepth = 12;
   int Frames = 60;
   double Seconds = 6.0, MaxPrepare = 90.0;
 };
@@ -575,6 +651,10 @@ std::vector<Scene> LoadScenes(const Options& o)
   for (const std::string& count : SplitList(o.Points))
   {
     const auto n = static_cast<std::size_t>(std::strtod(count.c_str(), nullptr));
+    if (n == 0)
+    {
+      continue; // --points 0: the file's scene alone
+    }
     const double t0 = Now();
     vtkSmartPointer<vtkPolyData> cloud = ClusteredPoints(n);
     scenes.push_back(MakeScene("clusters", cloud, Now() - t0));
@@ -598,7 +678,18 @@ std::vector<Scene> LoadScenes(const Options& o)
     cloud->ShallowCopy(reader->GetOutput());
     cloud->SetVerts(nullptr);
     ColourIfUncoloured(cloud);
-    scenes.push_back(MakeScene(o.File.substr(o.File.find_last_of('/') + 1), cloud, Now() - t0));
+    std::string name = o.File.substr(o.File.find_last_of('/') + 1);
+    if (o.Tile > 0)
+    {
+      cloud = TiledCloud(cloud, static_cast<std::size_t>(o.Tile));
+      name += ".tiled";
+    }
+    scenes.push_back(MakeScene(name, cloud, Now() - t0));
+    if (o.Tile > 0)
+    {
+      scenes.back().LeafDepth = o.TileDepth;
+      scenes.back().KeepPoints = false;
+    }
   }
   return scenes;
 }
@@ -719,12 +810,13 @@ int main(int argc, char* argv[])
   CommandLine cli;
   cli.Text("--points", o.Points).Text("--sizes", o.Sizes).Text("--methods", o.Methods).Text("--file", o.File);
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
-  cli.Real("--max-prepare", o.MaxPrepare);
+  cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);
   if (!cli.Parse(argc, argv))
   {
     std::fprintf(stderr,
       "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] [--file particles.txt|cloud.pcd]\n"
-      "          [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json] [--images DIR]\n",
+      "          [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json] [--images DIR]\n"
+      "          [--tile N [--tile-depth 12]]\n",
       argv[0]);
     return 2;
   }
