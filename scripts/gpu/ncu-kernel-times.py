@@ -7,18 +7,14 @@ profile-build part on `octoray_bench_cuda --profile-build N` (two builds).
 
     ncu-kernel-times.py PROFILE.csv [BUILDS]
 """
-import csv
 import re
 import sys
 
+from ncu_csv import rows
+
 
 def launches(path):
-    with open(path, newline="") as f:
-        lines = f.read().splitlines()
-    start = next((i for i, line in enumerate(lines) if line.startswith('"ID"')), None)
-    if start is None:
-        raise SystemExit(f"{path}: no CSV header; is it ncu --csv output?")
-    table = list(csv.DictReader(lines[start:]))
+    table = rows(path)
     units = table[0] if table and not table[0]["ID"].strip().isdigit() else None
     scale = {"nsecond": 1e-6, "usecond": 1e-3, "msecond": 1.0, "second": 1e3}.get(
         (units or {}).get("gpu__time_duration.sum", "nsecond"), 1e-6)

@@ -6,8 +6,9 @@ per issued instruction spent in each). Used by gpu-check.sh's profile part.
 
     ncu-summary.py PROFILE.csv...
 """
-import csv
 import sys
+
+from ncu_csv import rows
 
 # (label, ncu's metric name as the details page writes it)
 FIGURES = [
@@ -24,15 +25,6 @@ FIGURES = [
 ]
 STALL_PREFIX = "smsp__average_warps_issue_stalled_"
 STALL_SUFFIX = "_per_issue_active.ratio"
-
-
-def rows(path):
-    with open(path, newline="") as f:
-        lines = f.read().splitlines()
-    start = next((i for i, line in enumerate(lines) if line.startswith('"ID"')), None)
-    if start is None:
-        raise SystemExit(f"{path}: no CSV header; is it ncu --csv output?")
-    return list(csv.DictReader(lines[start:]))
 
 
 def summarise(path):
