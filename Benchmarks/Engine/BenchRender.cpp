@@ -27,10 +27,10 @@
 #include <octoray/ReferenceTraversal.h>
 #include <octoray/RenderModes.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>

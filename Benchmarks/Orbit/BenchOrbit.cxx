@@ -198,17 +198,16 @@ vtkSmartPointer<vtkPolyData> TiledCloud(vtkPolyData* cloud, std::size_t n)
   vtkNew<vtkUnsignedCharArray> rgb;
   rgb->SetNumberOfComponents(3);
   rgb->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  const unsigned char* colour = colours->GetPointer(0);
   ForEachBlock(n, m, [&](std::size_t copy, std::size_t begin, std::size_t end) {
     const float offset[3] = { static_cast<float>(step[0] * (copy % side)), static_cast<float>(step[1] * (copy / side)),
       0.0f };
-    for (std::size_t i = begin; i < end; ++i)
+    float* p = xyz->GetPointer(3 * static_cast<vtkIdType>(begin));
+    for (std::size_t v = 0; v < 3 * (end - begin); ++v)
     {
-      for (int a = 0; a < 3; ++a)
-      {
-        xyz->GetPointer(0)[3 * i + a] = from[3 * (i - begin) + a] + offset[a];
-        rgb->GetPointer(0)[3 * i + a] = colours->GetPointer(0)[3 * (i - begin) + a];
-      }
+      p[v] = from[v] + offset[v % 3];
     }
+    std::copy(colour, colour + 3 * (end - begin), rgb->GetPointer(3 * static_cast<vtkIdType>(begin)));
   });
   return CloudOf(xyz, rgb);
 }
