@@ -22,8 +22,9 @@
 # profile (Nsight Compute on the render kernel: primary rays, and Phong with
 # shadows and a bounce, 10 M points at depth 10, 1920x1080), variants (the
 # render benchmark built with other register caps, OCTORAY_RENDER_MIN_BLOCKS
-# from VARIANT_BLOCKS, default 0 and 8, beside the main build's 6),
-# report (the
+# from VARIANT_BLOCKS, default 0 and 8, beside the main build's 6, and with
+# other block shapes, OCTORAY_RENDER_BLOCK from VARIANT_SHAPES, default
+# 8x16, beside the main build's 16x8), report (the
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
 # ORBIT_ARGS adds arguments), profile-build (ncu's time of every kernel of a
 # build of PROFILE_BUILD points, default 1e8), sass (the primary-ray render
@@ -116,9 +117,10 @@ if want profile; then
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
 fi
 if want profile-build; then
-  # Every kernel of two 100 M-point builds at depth 10, timed by ncu; the
-  # table is the second build's time per kernel.
-  step profile-build ncu --clock-control none --metrics gpu__time_duration.sum --csv --page raw \
+  # Every kernel of two 100 M-point builds at depth 10, timed by ncu with
+  # its DRAM traffic; the table is the second build's time per kernel.
+  step profile-build ncu --clock-control none \
+    --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum --csv --page raw \
     --log-file "$out/profile-build.csv" $build/bin/octoray_bench_cuda --profile-build "${PROFILE_BUILD:-1e8}"
   python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build.csv" 2 > "$out/profile-build.txt" 2>&1
 fi
@@ -128,12 +130,19 @@ if want sass; then
   step sass bash -c "cuobjdump -sass $build/bin/octoray_bench_cuda | awk '/Function : .*RenderKernel.*FeaturesILb0ELb0ELb0ELb0E/{p=1} p&&/Function : /&&!/FeaturesILb0ELb0ELb0ELb0E/{p=0} p' > '$out/sass-primary.txt'"
 fi
 if want variants; then
-  for blocks in ${VARIANT_BLOCKS:-0 8}; do
-    vb=build-gpu-blocks$blocks
-    step "variant-$blocks" bash -c "cmake -S . -B $vb -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
+  variant() { # name, CMake definitions...
+    local name=$1; shift
+    local vb=build-gpu-$name
+    step "variant-$name" bash -c "cmake -S . -B $vb -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
       -DCMAKE_CUDA_ARCHITECTURES=90 -DVTK_DIR='$vtk/lib/cmake/vtk-9.2' -DCMAKE_CXX_FLAGS='-include cstdint' \
-      -DOCTORAY_GTEST_SOURCE_DIR='$carried/googletest' -DOCTORAY_RENDER_MIN_BLOCKS=$blocks >/dev/null &&
+      -DOCTORAY_GTEST_SOURCE_DIR='$carried/googletest' $* >/dev/null &&
       cmake --build $vb --target octoray_bench_cuda >/dev/null && $vb/bin/octoray_bench_cuda --only render"
+  }
+  for blocks in ${VARIANT_BLOCKS:-0 8}; do
+    variant "blocks$blocks" -DOCTORAY_RENDER_MIN_BLOCKS=$blocks
+  done
+  for shape in ${VARIANT_SHAPES:-8x16}; do
+    variant "shape$shape" -DOCTORAY_RENDER_BLOCK=$shape
   done
 fi
 if want report; then
@@ -162,8 +171,8 @@ done
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
 [ -f "$out/profile-build.txt" ] && head -25 "$out/profile-build.txt"
 [ -f "$out/sass-primary.txt" ] && echo "sass-primary.txt: $(grep -c '/\*[0-9a-f]*\*/' "$out/sass-primary.txt") instructions"
-for blocks in ${VARIANT_BLOCKS:-0 8}; do
-  [ -f "$out/variant-$blocks.log" ] && grep -E "^render" "$out/variant-$blocks.log" | sed "s/^/min blocks $blocks: /"
+for log in "$out"/variant-*.log; do
+  [ -f "$log" ] && grep -E "^render" "$log" | sed "s/^/$(basename "$log" .log): /"
 done
 [ -f "$out/orbit.log" ] && grep -E "points: generated|frame median|  =>|skipped" "$out/orbit.log" | cut -c1-220
 printf '%s\n' "${status[@]}"

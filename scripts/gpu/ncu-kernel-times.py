@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Where a build's device time goes: from an Nsight Compute CSV of every
-kernel of a program (ncu --csv --page raw --metrics gpu__time_duration.sum),
-the time per kernel name summed over the launches of the last of BUILDS
-equal runs, longest first, with the launch count. Used by gpu-check.sh's
-profile-build part on `octoray_bench_cuda --profile-build N` (two builds).
+kernel of a program (ncu --csv --page raw --metrics
+gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum), the
+time per kernel name summed over the launches of the last of BUILDS equal
+runs, longest first, with the launch count and, where the CSV has the DRAM
+bytes, the DRAM traffic and its rate. Used by gpu-check.sh's profile-build
+part on `octoray_bench_cuda --profile-build N` (two builds).
 
     ncu-kernel-times.py PROFILE.csv [BUILDS]
 """
@@ -12,16 +14,24 @@ import sys
 
 from ncu_csv import rows
 
+TIME_TO_MS = {"nsecond": 1e-6, "usecond": 1e-3, "msecond": 1.0, "second": 1e3}
+BYTES_TO_GB = {"byte": 1e-9, "Kbyte": 1e-6, "Mbyte": 1e-3, "Gbyte": 1.0}
+DRAM = ("dram__bytes_read.sum", "dram__bytes_write.sum")
+
 
 def launches(path):
+    """(kernel name, ms, DRAM GB or None) per launch."""
     table = rows(path)
-    units = table[0] if table and not table[0]["ID"].strip().isdigit() else None
-    scale = {"nsecond": 1e-6, "usecond": 1e-3, "msecond": 1.0, "second": 1e3}.get(
-        (units or {}).get("gpu__time_duration.sum", "nsecond"), 1e-6)
+    units = table[0] if table and not table[0]["ID"].strip().isdigit() else {}
+
+    def value(row, metric, scales, default_unit):
+        return float(row[metric].replace(",", "")) * scales[units.get(metric, default_unit)]
+
     for row in table:
         if not row["ID"].strip().isdigit():
             continue
-        yield row["Kernel Name"], float(row["gpu__time_duration.sum"].replace(",", "")) * scale
+        gb = sum(value(row, m, BYTES_TO_GB, "byte") for m in DRAM) if all(m in row for m in DRAM) else None
+        yield row["Kernel Name"], value(row, "gpu__time_duration.sum", TIME_TO_MS, "nsecond"), gb
 
 
 def short_names(full_names):
@@ -44,16 +54,16 @@ def main():
     builds = int(sys.argv[2]) if len(sys.argv) > 2 else 2
     everything = list(launches(path))
     last = everything[len(everything) - len(everything) // builds:]
-    names = short_names(dict.fromkeys(full for full, _ in everything))
+    names = short_names(dict.fromkeys(full for full, _, _ in everything))
     per = {}
-    for full, ms in last:
-        name = names[full]
-        total, count = per.get(name, (0.0, 0))
-        per[name] = (total + ms, count + 1)
-    total = sum(t for t, _ in per.values())
+    for full, ms, gb in last:
+        total, count, traffic = per.get(names[full], (0.0, 0, 0.0))
+        per[names[full]] = (total + ms, count + 1, None if gb is None or traffic is None else traffic + gb)
+    total = sum(t for t, _, _ in per.values())
     print(f"{path}: the last of {builds} builds, {len(last)} kernel launches, {total:.3f} ms of kernels")
-    for name, (ms, count) in sorted(per.items(), key=lambda kv: -kv[1][0]):
-        print(f"  {ms:9.3f} ms {100 * ms / total:5.1f}%  {count:4d}x  {name}")
+    for name, (ms, count, gb) in sorted(per.items(), key=lambda kv: -kv[1][0]):
+        dram = f"  {gb:7.3f} GB DRAM {gb / ms:6.2f} TB/s" if gb is not None and ms > 0 else ""
+        print(f"  {ms:9.3f} ms {100 * ms / total:5.1f}%  {count:4d}x{dram}  {name}")
 
 
 if __name__ == "__main__":

@@ -97,9 +97,10 @@ enum AttributeSlot : int
     kSlotCount
 };
 
-// Descriptors that loops receive: the array's value type, presence bit (0:
-// always present), first slot, label, and Of(arrays), the array of that
-// name in any of the structures declared from these lists.
+// Descriptors that loops receive: the array's value type, index in its
+// list (attributes), presence bit (0: always present), first slot, label,
+// and Of(arrays), the array of that name in any of the structures declared
+// from these lists.
 template <int I>
 struct TopologyArray;
 template <int I>
@@ -138,6 +139,7 @@ OCTORAY_NODE_TOPOLOGY(OCTORAY_DESCRIBE_TOPOLOGY)
   {                                                                                                                  \
     using Type = Type_;                                                                                              \
     using Input = Input_;                                                                                            \
+    static constexpr int kIndex = kAttribute##Name;                                                                  \
     static constexpr unsigned kBit = kHas##Name;                                                                     \
     static constexpr int kSlot = kSlot##Name;                                                                        \
     static constexpr const char* kLabel = label;                                                                     \

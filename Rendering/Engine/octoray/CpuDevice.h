@@ -8,6 +8,7 @@
 #include "RadixSort.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <memory>
 #include <numeric>
@@ -58,8 +59,23 @@ public:
   template <typename T>
   struct Staged
   {
-    const T* data;
+    const T* data = nullptr;
     const T* Get() const { return data; }
+  };
+
+  // Marks the host's time: loops have run when they return.
+  class Clock
+  {
+  public:
+    int Mark()
+    {
+      Marks.push_back(std::chrono::steady_clock::now());
+      return static_cast<int>(Marks.size()) - 1;
+    }
+    double Seconds(int from, int to) const { return std::chrono::duration<double>(Marks[to] - Marks[from]).count(); }
+
+  private:
+    std::vector<std::chrono::steady_clock::time_point> Marks;
   };
 
   // Host allocations do not fail short of the whole process failing, so a
@@ -88,6 +104,15 @@ public:
   Staged<T> Stage(const T* host, std::size_t, const char*)
   {
     return Staged<T>{ host };
+  }
+  template <typename T>
+  Staged<T> Prepare(const T* host, std::size_t n, const char* what)
+  {
+    return Stage(host, n, what);
+  }
+  template <typename T>
+  void Fill(Staged<T>&, const T*, std::size_t, const char*)
+  {
   }
   template <typename T>
   void Adopt(const Staged<T>& staged, Buffer<T>& buffer, std::size_t n)

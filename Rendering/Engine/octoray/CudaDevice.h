@@ -25,6 +25,7 @@ namespace octoray
 namespace cuda
 {
 constexpr int kBlock = 256;
+static_assert(kBlock % 32 == 0, "HistogramKernel counts in full warps");
 
 inline unsigned Blocks(std::size_t n)
 {
@@ -41,8 +42,23 @@ __global__ void ForEachKernel(std::size_t n, Fn fn)
   }
 }
 
+// Adds one to local[bin] for each lane of the warp that names bin (< 0:
+// none). The lanes that name the same bin add once, by their count:
+// sorted keys give neighbouring threads the same bins, whose shared-memory
+// atomics would otherwise serialise.
+__device__ inline void CountInWarp(unsigned int* local, int bin)
+{
+  const unsigned same = __match_any_sync(0xFFFFFFFFu, bin);
+  const unsigned lane = threadIdx.x & 31u;
+  if (bin >= 0 && lane == static_cast<unsigned>(__ffs(static_cast<int>(same)) - 1))
+  {
+    atomicAdd(&local[bin], static_cast<unsigned>(__popc(same)));
+  }
+}
+
 // Counts per block in shared memory first: a few dozen bins hit by every
-// thread would serialise on global atomics.
+// thread would serialise on global atomics. Every lane of a block's (full)
+// warps takes part in CountInWarp; those past n name no bin.
 template <int Bins, typename Fn>
 __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* counts)
 {
@@ -53,18 +69,15 @@ __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* co
   }
   __syncthreads();
   const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+  int first = -1, second = -1;
   if (i < n)
   {
     const auto bins = binsOf(i);
-    if (bins.first >= 0)
-    {
-      atomicAdd(&local[bins.first], 1u);
-    }
-    if (bins.second >= 0)
-    {
-      atomicAdd(&local[bins.second], 1u);
-    }
+    first = bins.first;
+    second = bins.second;
   }
+  CountInWarp(local, first);
+  CountInWarp(local, second);
   __syncthreads();
   for (int b = threadIdx.x; b < Bins; b += blockDim.x)
   {
@@ -83,6 +96,42 @@ public:
   using Buffer = DeviceBuffer<T>;
   template <typename T>
   using Staged = DeviceBuffer<T>;
+
+  // Marks points in the order of the default stream, where every loop
+  // runs: the time between two is the device's, however the host's calls
+  // interleave with its work.
+  class Clock
+  {
+  public:
+    Clock() = default;
+    Clock(const Clock&) = delete;
+    Clock& operator=(const Clock&) = delete;
+    ~Clock()
+    {
+      for (cudaEvent_t e : Events)
+      {
+        cudaEventDestroy(e);
+      }
+    }
+    int Mark()
+    {
+      cudaEvent_t e = nullptr;
+      CudaCheck(cudaEventCreate(&e), "cudaEventCreate");
+      Events.push_back(e);
+      CudaCheck(cudaEventRecord(e, 0), "cudaEventRecord");
+      return static_cast<int>(Events.size()) - 1;
+    }
+    // Once the host has waited for the device past `to`.
+    double Seconds(int from, int to) const
+    {
+      float ms = 0.0f;
+      CudaCheck(cudaEventElapsedTime(&ms, Events[from], Events[to]), "cudaEventElapsedTime");
+      return 1e-3 * ms;
+    }
+
+  private:
+    std::vector<cudaEvent_t> Events;
+  };
 
   // Running out of device memory is an expected failure (a full GPU, the
   // engine's budget): a build fills a new state aside and replaces the
@@ -131,6 +180,28 @@ public:
       Upload(staged, source, n, what);
     }
     return staged;
+  }
+  // Stage in two steps, for a copy that overlaps loops: Prepare takes the
+  // device memory before those loops are queued (memory taken after them
+  // is, in the stream's order, only free once they have run), and Fill
+  // copies into it without waiting for them.
+  template <typename T>
+  Staged<T> Prepare(const T* source, std::size_t n, const char* what)
+  {
+    Staged<T> staged;
+    if (source)
+    {
+      Reserve(staged, n, what);
+    }
+    return staged;
+  }
+  template <typename T>
+  void Fill(Staged<T>& staged, const T* source, std::size_t n, const char* what)
+  {
+    if (source)
+    {
+      Staging.Copy(staged.Get(), source, n * sizeof(T), what, cuda::QueuedLoops::MayRun);
+    }
   }
   template <typename T>
   void Adopt(Staged<T>&& staged, Buffer<T>& buffer, std::size_t)

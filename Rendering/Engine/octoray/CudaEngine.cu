@@ -13,9 +13,18 @@ namespace octoray
 {
 namespace
 {
-// Threads of one render block: 16 x 8 pixels.
+// Threads of one render block (CMake's OCTORAY_RENDER_BLOCK): 16 x 8
+// pixels unless set. The warps of a block are its rows taken 32 threads at
+// a time, so the block's width is the width of the tile a warp traces.
+#if defined(OCTORAY_RENDER_BLOCK_X) && defined(OCTORAY_RENDER_BLOCK_Y)
+constexpr int kRenderBlockX = OCTORAY_RENDER_BLOCK_X;
+constexpr int kRenderBlockY = OCTORAY_RENDER_BLOCK_Y;
+#else
 constexpr int kRenderBlockX = 16;
 constexpr int kRenderBlockY = 8;
+#endif
+static_assert(kRenderBlockX * kRenderBlockY == 128 && (32 % kRenderBlockX == 0 || kRenderBlockX % 32 == 0),
+  "128 threads (the register cap counts on it), each warp a rectangle of pixels");
 
 // The register cap that OCTORAY_RENDER_MIN_BLOCKS (CMake) asks for.
 #if defined(OCTORAY_RENDER_MIN_BLOCKS) && OCTORAY_RENDER_MIN_BLOCKS > 0

@@ -43,6 +43,15 @@ inline bool DirectlyCopyable(const void* p)
   return attributes.type != cudaMemoryTypeUnregistered;
 }
 
+// Whether a copy must first wait for the loops queued on the default
+// stream: it must where its destination may be memory that one of them
+// still reads (freed and taken again in the stream's order).
+enum class QueuedLoops
+{
+  WaitFor,
+  MayRun
+};
+
 class HostStaging
 {
 public:
@@ -53,7 +62,8 @@ public:
 
   // Copies `bytes` from `source` (host or device memory) to `device` on the
   // current device; returns once the copy is complete.
-  void Copy(void* device, const void* source, std::size_t bytes, const char* what)
+  void Copy(void* device, const void* source, std::size_t bytes, const char* what,
+    QueuedLoops queued = QueuedLoops::WaitFor)
   {
     if (bytes < kStagingThreshold || DirectlyCopyable(source) || !Allocate())
     {
@@ -62,9 +72,11 @@ public:
     }
     int current = 0;
     CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
-    // The destination may still be read by earlier work on the default
-    // stream, which the staging streams do not wait for.
-    CudaCheck(cudaStreamSynchronize(0), what);
+    // The staging streams do not wait for the default stream by themselves.
+    if (queued == QueuedLoops::WaitFor)
+    {
+      CudaCheck(cudaStreamSynchronize(0), what);
+    }
     const int stripes = static_cast<int>(Lanes.size());
     ParallelChunks(bytes, stripes, [&](std::size_t begin, std::size_t end, int stripe) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread

@@ -196,9 +196,13 @@ struct BuildStats
   std::size_t nodes = 0;
   std::size_t bytes = 0;     // MemoryReport::Total() after the build
   double seconds = 0.0;      // whole build, wall clock
-  double uploadSeconds = 0.0; // the caller's arrays copied to the device and converted (colours, normals)
-  double keySeconds = 0.0;   // bounds and Morton keys
-  double sortSeconds = 0.0;  // radix sort of (key, index)
+  // The host's time copying the caller's arrays to the device and queueing
+  // their conversion (colours, normals); the attributes are copied while
+  // the device sorts.
+  double uploadSeconds = 0.0;
+  // The device's time (the host's on the CPU backend) of each phase:
+  double keySeconds = 0.0;   // bounds (with their copy to the host) and Morton keys
+  double sortSeconds = 0.0;  // radix sort of (key, index) and the neighbour histogram
   double levelSeconds = 0.0; // unique keys per level, links and averages
 };
 

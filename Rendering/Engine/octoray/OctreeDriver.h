@@ -7,6 +7,7 @@
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
 //   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
+//   Prepare(host, n, what), Fill(staged, host, n, what)   Stage in two steps; the copy overlaps loops queued between
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
@@ -15,6 +16,7 @@
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
+//   Clock                             Mark(): a point in the order of the loops; Seconds(a, b) once waited for
 //   ReleaseScratch()                  frees the device's own scratch (CUB's temporary storage)
 //   CachedBytes(), TrimCache()        freed memory the device keeps for reuse; giving it back
 //   Scope()                           makes the device current while the returned object lives
@@ -31,7 +33,9 @@
 #include "OctreeState.h"
 #include "Validation.h"
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -142,65 +146,121 @@ Vec3d ReadPosition(Device& d, const PointArraysView& positions, std::size_t i)
   return Vec3d{ p[0], p[1], p[2] };
 }
 
+// The caller's float array an attribute is made from (colours given as
+// 8-bit aside), and its length in values.
+struct InputFloats
+{
+  const float* data;
+  std::size_t count;
+};
+
+template <class A>
+InputFloats InputFloatsOf(CopiedInput, A, const PointCloudView& points)
+{
+  static_assert(std::is_same<typename A::Type, float>::value, "a copied attribute is one float per point");
+  return InputFloats{ A::Of(points), points.count };
+}
+
+template <class A>
+InputFloats InputFloatsOf(UnitNormalInput, A, const PointCloudView& points)
+{
+  return InputFloats{ A::Of(points), 3 * points.count };
+}
+
+template <class A>
+InputFloats InputFloatsOf(ColorInput, A, const PointCloudView& points)
+{
+  return InputFloats{ points.colorFloat, points.colorComponents * points.count };
+}
+
+// A caller's attribute arrays, as given, where the device's loops read them.
+template <class Device>
+struct StagedAttributes
+{
+  typename Device::template Staged<std::uint8_t> color8;
+  typename Device::template Staged<float> values[kAttributeCount];
+};
+
+// The attributes' staged arrays in two steps (Device::Prepare, Fill): a
+// build takes their memory before it queues the sort and copies them while
+// the device sorts, which needs only the positions.
+template <class Device>
+StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points)
+{
+  StagedAttributes<Device> staged;
+  staged.color8 = d.Prepare(points.color8, points.colorComponents * points.count, "point colours");
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
+    staged.values[A::kIndex] = d.Prepare(in.data, in.count, (std::string("point ") + A::kLabel).c_str());
+  });
+  return staged;
+}
+
+template <class Device>
+void FillAttributes(Device& d, const PointCloudView& points, StagedAttributes<Device>& staged)
+{
+  d.Fill(staged.color8, points.color8, points.colorComponents * points.count, "point colours");
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
+    d.Fill(staged.values[A::kIndex], in.data, in.count, (std::string("point ") + A::kLabel).c_str());
+  });
+}
+
 // How each kind of attribute input becomes the engine's copy (Attributes.h
 // names the kind of each); an absent attribute releases its arrays.
 template <class A, class Device, class Points>
-void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, Points& s)
+void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
 {
-  const std::string what = std::string("point ") + A::kLabel;
-  const auto* in = A::Of(points);
-  d.Adopt(d.Stage(in, in ? points.count : 0, what.c_str()), A::Of(s), points.count);
+  d.Adopt(std::move(staged.values[A::kIndex]), A::Of(s), points.count);
 }
 
 template <class A, class Device, class Points>
-void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, Points& s)
+void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged,
+  Points& s)
 {
+  const std::size_t n = points.count;
   auto& out = A::Of(s);
-  if (!A::Of(points))
+  const float* in = staged.values[A::kIndex].Get();
+  if (!in)
   {
     d.Release(out);
     return;
   }
-  const std::string what = std::string("point ") + A::kLabel;
-  const auto raw = d.Stage(A::Of(points), 3 * points.count, what.c_str());
-  d.Reserve(out, points.count, what.c_str());
-  const float* in = raw.Get();
+  d.Reserve(out, n, (std::string("point ") + A::kLabel).c_str());
   Vec3f* unit = out.Get();
-  d.ForEach("UnitNormalKernel", points.count,
+  d.ForEach("UnitNormalKernel", n,
     OCTORAY_LAMBDA(std::size_t i) { unit[i] = UnitNormal(in[3 * i], in[3 * i + 1], in[3 * i + 2]); });
 }
 
 // Colours become RGBA: 8-bit ones in color8, float ones in the attribute's
 // array; a missing alpha is opaque.
 template <class A, class Device, class Points>
-void Ingest(ColorInput, A, Device& d, const PointCloudView& points, Points& s)
+void Ingest(ColorInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
 {
   const std::size_t n = points.count;
   const int cc = points.colorComponents;
   auto& rgba = A::Of(s);
-  if (points.color8)
+  const std::uint8_t* in8 = staged.color8.Get();
+  const float* inFloat = staged.values[A::kIndex].Get();
+  if (in8)
   {
-    const auto raw = d.Stage(points.color8, cc * n, "point colours");
     d.Release(rgba);
-    d.Reserve(s.color8, 4 * n, "point colours");
-    const std::uint8_t* in = raw.Get();
-    std::uint8_t* out = s.color8.Get();
+    d.Reserve(s.color8, n, "point colours");
+    Rgba8* out = s.color8.Get();
     d.ForEach("WidenColor8Kernel", n, OCTORAY_LAMBDA(std::size_t i) {
-      for (int c = 0; c < 4; ++c)
-      {
-        out[4 * i + c] = c < cc ? in[cc * i + c] : 255;
-      }
+      const std::uint8_t* c = in8 + cc * i;
+      out[i] = Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) };
     });
   }
-  else if (points.colorFloat)
+  else if (inFloat)
   {
-    const auto raw = d.Stage(points.colorFloat, cc * n, "point colours");
     d.Release(s.color8);
     d.Reserve(rgba, n, "point colours");
-    const float* in = raw.Get();
     Rgba* out = rgba.Get();
     d.ForEach("WidenColorFloatKernel", n, OCTORAY_LAMBDA(std::size_t i) {
-      const float* c = in + cc * i;
+      const float* c = inFloat + cc * i;
       out[i] = Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f };
     });
   }
@@ -209,6 +269,13 @@ void Ingest(ColorInput, A, Device& d, const PointCloudView& points, Points& s)
     d.Release(s.color8);
     d.Release(rgba);
   }
+}
+
+// The state's point attributes from the staged arrays.
+template <class Device, class Points>
+void IngestAttributes(Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
+{
+  ForEachAttribute([&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, staged, s); });
 }
 
 // The cube a build uses: fitted to the staged positions, or the caller's
@@ -252,14 +319,18 @@ struct SortedPoints
 
 // Keys (computed, or the stored ones when they are current), sort, and one
 // histogram of neighbouring keys: the node count of every level and, for an
-// automatic depth (requestedDepth 0), the depth. Two copies to the host:
-// the key check, the histogram.
+// automatic depth (requestedDepth 0), the depth. The loops are queued
+// first, then whileSorting() runs on the host, then one copy to the host
+// brings the histogram and the key check. Marks on `clock`: the keys, and
+// the sort with the histogram, each its own span.
+// (A std::function: nvcc does not let a host lambda's type be a template
+// argument of a function that holds device lambdas.)
 template <class Device>
 SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, BuildStats& stats)
+  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[3],
+  const std::function<void()>& whileSorting)
 {
   const std::size_t n = s.count;
-  auto phase = std::chrono::steady_clock::now();
   if (s.keepPoints)
   {
     d.Reserve(s.points.key, n, "point keys");
@@ -273,26 +344,28 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
   std::uint64_t* sortKey = scratch.sortKey[0].Get();
   std::uint32_t* sortIndex = scratch.sortIndex[0].Get();
+  std::uint64_t* counters = scratch.counters.Get();
   // Only the leaf level's bits need sorting when the depth is known.
   const int leafShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
+  phases[0] = clock.Mark();
+  d.FillBytes(counters + kCounterFirst, 1, 0xFF);
   if (computeKeys)
   {
-    // The cube holds every point (fitted or checked): a failure here is a bug.
-    const std::uint64_t outside = FirstFailedStep(d, scratch, "KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+    // The cube holds every point (fitted or checked): a point outside is a bug.
+    std::uint64_t* first = counters + kCounterFirst;
+    d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
       std::uint64_t key = 0;
-      const bool inside = ComputePointKey(pts, cube, i, key);
+      if (!ComputePointKey(pts, cube, i, key))
+      {
+        AtomicMin(first, i);
+      }
       if (pointKey)
       {
         pointKey[i] = key;
       }
       sortKey[i] = key >> leafShift;
       sortIndex[i] = static_cast<std::uint32_t>(i);
-      return inside;
     });
-    if (outside != kNoIndex)
-    {
-      throw Error(OutsideCubeMessage(outside, ReadPosition(d, pts, outside)));
-    }
   }
   else
   {
@@ -301,9 +374,8 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
       sortIndex[i] = static_cast<std::uint32_t>(i);
     });
   }
-  stats.keySeconds = SecondsSince(phase);
+  phases[1] = clock.Mark();
 
-  phase = std::chrono::steady_clock::now();
   SortedPoints sorted;
   std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
   std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
@@ -313,11 +385,25 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   sorted.key = sortedKey;
   sorted.index = values[result];
   sorted.spare = values[1 - result];
-  std::uint64_t* histogram = scratch.counters.Get() + kCounterHistogram;
-  d.FillBytes(histogram, 2 * kDepthHistogramBins, 0);
+  d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(sortedKey, n, i, leafShift); }, histogram);
-  d.ToHost(histogram, 2 * kDepthHistogramBins, sorted.histogram, "NeighbourHistogramKernel");
+    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(sortedKey, n, i, leafShift); },
+    counters + kCounterHistogram);
+  phases[2] = clock.Mark();
+  if (whileSorting)
+  {
+    whileSorting();
+  }
+
+  static_assert(kCounterFirst == kCounterHistogram + 2 * kDepthHistogramBins, "one copy: histograms, key check");
+  std::uint64_t report[2 * kDepthHistogramBins + 1];
+  d.ToHost(counters + kCounterHistogram, 2 * kDepthHistogramBins + 1, report, "NeighbourHistogramKernel");
+  if (report[2 * kDepthHistogramBins] != kNoIndex)
+  {
+    const std::size_t outside = report[2 * kDepthHistogramBins];
+    throw Error(OutsideCubeMessage(outside, ReadPosition(d, pts, outside)));
+  }
+  std::copy_n(report, 2 * kDepthHistogramBins, sorted.histogram);
   sorted.depth = requestedDepth;
   if (sorted.depth == 0)
   {
@@ -325,7 +411,6 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     const int shift = 3 * (kMaxLevel - sorted.depth);
     d.ForEach("ShiftKernel", n, OCTORAY_LAMBDA(std::size_t i) { sortedKey[i] >>= shift; });
   }
-  stats.sortSeconds = SecondsSince(phase);
   return sorted;
 }
 
@@ -378,20 +463,28 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
       ReduceChildren(view, begin + static_cast<std::uint32_t>(j), view.key[c0] >> 3, c0, childBegin + starts[j + 1]);
     });
   }
-  d.Synchronize("octree build");
 }
 
 // Keys, sort and levels of the state's points inside `cube`: the octree.
+// whileSorting(), if given, runs on the host while the device sorts. The phases'
+// times are the device's (Device::Clock).
 template <class Device>
 BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys)
+  int requestedDepth, bool computeKeys, const std::function<void()>& whileSorting = nullptr)
 {
   BuildStats stats;
   stats.points = s.count;
-  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, stats);
-  const auto phase = std::chrono::steady_clock::now();
+  typename Device::Clock clock;
+  int phases[3];
+  const SortedPoints sorted =
+    SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, clock, phases, whileSorting);
+  const int levelsBegin = clock.Mark();
   LinkLevels(d, scratch, s, sorted, cube);
-  stats.levelSeconds = SecondsSince(phase);
+  const int levelsEnd = clock.Mark();
+  d.Synchronize("octree build");
+  stats.keySeconds = clock.Seconds(phases[0], phases[1]);
+  stats.sortSeconds = clock.Seconds(phases[1], phases[2]);
+  stats.levelSeconds = clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
   stats.cube = cube;
   stats.nodes = s.levelBegin[s.depth + 1];
@@ -448,10 +541,15 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.keepPoints = options.keepPoints;
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
-  phase = std::chrono::steady_clock::now();
-  ForEachAttribute([&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, s.points); });
-  uploadSeconds += SecondsSince(phase);
-  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true);
+  StagedAttributes<Device> attributes = PrepareAttributes(d, points);
+  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true, [&] {
+    // The leaf level needs the attributes, the sort does not: they are
+    // copied while the device sorts.
+    phase = std::chrono::steady_clock::now();
+    FillAttributes(d, points, attributes);
+    IngestAttributes(d, points, attributes, s.points);
+    uploadSeconds += SecondsSince(phase);
+  });
   stats.uploadSeconds = uploadSeconds;
   stats.keySeconds += boundsSeconds;
   if (!s.keepPoints)

@@ -4,6 +4,7 @@
 #include "Config.h"
 #include "VecMath.h"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +13,12 @@ namespace octoray
 struct alignas(16) Rgba
 {
   float r, g, b, a;
+};
+
+// A colour of 8-bit channels, read and written as one 4-byte word.
+struct alignas(4) Rgba8
+{
+  std::uint8_t r, g, b, a;
 };
 
 // Every error the engine reports: bad input, exhausted memory, a failed
