@@ -442,7 +442,7 @@ int Run(int argc, char** argv)
       BuildOptions o;
       o.depth = depth;
       BuildStats last;
-      const int repeats = n >= 100000000 ? 3 : 7;
+      const int repeats = 7;
       const double t = TimeMedian(repeats, [&] { last = engine->Build(c.View(), o); });
       const double floor = SortFloorSeconds(c, 3 * depth);
       const double bytesPerPoint = double(engine->Memory().Total()) / n;

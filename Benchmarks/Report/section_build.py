@@ -327,7 +327,7 @@ def _cuda(ctx):
         "From %s. Gaussian clusters with colour and reflectivity, float positions. \"Whole call\" is `Engine::Build` "
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
-        "events in the same run. Medians of 7 (3 at 100 M). GPU bytes per point include the sort buffers the engine "
+        "events in the same run. Medians of 7. GPU bytes per point include the sort buffers the engine "
         "keeps for rebuilds and the memory its allocator keeps for the next build (split in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
         "to the device (cudaMemcpy, median of 5), what a whole call from host arrays cannot beat.%s" % (gpu_source(ctx, name), "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),

@@ -548,6 +548,7 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
     phase = std::chrono::steady_clock::now();
     FillAttributes(d, points, attributes);
     IngestAttributes(d, points, attributes, s.points);
+    attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
     uploadSeconds += SecondsSince(phase);
   });
   stats.uploadSeconds = uploadSeconds;
