@@ -138,10 +138,10 @@ if want variants; then
       -DOCTORAY_GTEST_SOURCE_DIR='$carried/googletest' $* >/dev/null &&
       cmake --build $vb --target octoray_bench_cuda >/dev/null && $vb/bin/octoray_bench_cuda --only render"
   }
-  for blocks in ${VARIANT_BLOCKS:-0 8}; do
+  for blocks in ${VARIANT_BLOCKS-0 8}; do
     variant "blocks$blocks" -DOCTORAY_RENDER_MIN_BLOCKS=$blocks
   done
-  for shape in ${VARIANT_SHAPES:-8x16}; do
+  for shape in ${VARIANT_SHAPES-8x16}; do
     variant "shape$shape" -DOCTORAY_RENDER_BLOCK=$shape
   done
 fi
