@@ -14,8 +14,11 @@ import sys
 
 from ncu_csv import rows
 
-TIME_TO_MS = {"nsecond": 1e-6, "usecond": 1e-3, "msecond": 1.0, "second": 1e3}
-BYTES_TO_GB = {"byte": 1e-9, "Kbyte": 1e-6, "Mbyte": 1e-3, "Gbyte": 1.0}
+# The units row's names, as this ncu writes them ("ns", "byte") and as
+# older ones did ("nsecond", "Kbyte").
+TIME_TO_MS = {"ns": 1e-6, "nsecond": 1e-6, "us": 1e-3, "usecond": 1e-3, "ms": 1.0, "msecond": 1.0, "s": 1e3,
+              "second": 1e3}
+BYTES_TO_GB = {"byte": 1e-9, "Kbyte": 1e-6, "KB": 1e-6, "Mbyte": 1e-3, "MB": 1e-3, "Gbyte": 1.0, "GB": 1.0}
 DRAM = ("dram__bytes_read.sum", "dram__bytes_write.sum")
 
 

@@ -16,6 +16,7 @@
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,9 +57,14 @@ __device__ inline void CountInWarp(unsigned int* local, int bin)
   }
 }
 
-// Counts per block in shared memory first: a few dozen bins hit by every
-// thread would serialise on global atomics. Every lane of a block's (full)
-// warps takes part in CountInWarp; those past n name no bin.
+// Counts per block in shared memory first, over a grid of at most
+// kHistogramBlocks blocks that stride through the items: a few dozen bins
+// hit by every thread would serialise on global atomics, and so would the
+// blocks' own totals, were there one block per 256 items. The stride is
+// the same for every lane of a block, so every lane of its (full) warps
+// takes part in CountInWarp; those past n name no bin.
+constexpr unsigned kHistogramBlocks = 1024;
+
 template <int Bins, typename Fn>
 __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* counts)
 {
@@ -68,16 +74,20 @@ __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* co
     local[b] = 0;
   }
   __syncthreads();
-  const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
-  int first = -1, second = -1;
-  if (i < n)
+  const std::size_t stride = gridDim.x * std::size_t(blockDim.x);
+  for (std::size_t base = blockIdx.x * std::size_t(blockDim.x); base < n; base += stride)
   {
-    const auto bins = binsOf(i);
-    first = bins.first;
-    second = bins.second;
+    const std::size_t i = base + threadIdx.x;
+    int first = -1, second = -1;
+    if (i < n)
+    {
+      const auto bins = binsOf(i);
+      first = bins.first;
+      second = bins.second;
+    }
+    CountInWarp(local, first);
+    CountInWarp(local, second);
   }
-  CountInWarp(local, first);
-  CountInWarp(local, second);
   __syncthreads();
   for (int b = threadIdx.x; b < Bins; b += blockDim.x)
   {
@@ -272,8 +282,8 @@ public:
     static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit counts");
     if (n)
     {
-      Launch(name, cuda::HistogramKernel<Bins, Fn>, cuda::Blocks(n), cuda::kBlock, n, binsOf,
-        reinterpret_cast<unsigned long long*>(counts));
+      Launch(name, cuda::HistogramKernel<Bins, Fn>, std::min(cuda::Blocks(n), cuda::kHistogramBlocks), cuda::kBlock,
+        n, binsOf, reinterpret_cast<unsigned long long*>(counts));
     }
   }
 
