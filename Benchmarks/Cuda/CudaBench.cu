@@ -145,29 +145,71 @@ double SortFloorSeconds(const Cloud& c, int bits)
 
 // The copy a whole build call from host arrays cannot beat: every input
 // array the build reads, as one block of pinned host memory copied to the
-// device (median of 5). 0 where the memory cannot be had.
-double PinnedUploadSeconds(const Cloud& c, double& megabytes)
+// device. Seconds() times one copy; 0 where the memory cannot be had.
+class PinnedCopy
 {
-  const std::size_t bytes = sizeof(float) * (c.xyz.size() + c.reflectivity.size()) + c.rgb.size();
-  megabytes = bytes / 1e6;
-  void* host = nullptr;
-  void* device = nullptr;
-  if (cudaMallocHost(&host, bytes) != cudaSuccess || cudaMalloc(&device, bytes) != cudaSuccess)
+public:
+  explicit PinnedCopy(const Cloud& c)
+    : Bytes(sizeof(float) * (c.xyz.size() + c.reflectivity.size()) + c.rgb.size())
   {
-    cudaFreeHost(host);
-    return 0.0;
+    if (cudaMallocHost(&Host, Bytes) != cudaSuccess || cudaMalloc(&Device, Bytes) != cudaSuccess)
+    {
+      cudaGetLastError();
+      return;
+    }
+    std::memset(Host, 1, Bytes); // pages touched before timing
   }
-  std::memset(host, 1, bytes); // pages touched before timing
-  std::vector<double> times;
-  for (int r = 0; r < 5; ++r)
+  ~PinnedCopy()
   {
+    cudaFree(Device);
+    cudaFreeHost(Host);
+  }
+  PinnedCopy(const PinnedCopy&) = delete;
+  PinnedCopy& operator=(const PinnedCopy&) = delete;
+
+  double Megabytes() const { return Bytes / 1e6; }
+  double Seconds()
+  {
+    if (!Host || !Device)
+    {
+      return 0.0;
+    }
     const auto t0 = std::chrono::steady_clock::now();
-    cudaMemcpy(device, host, bytes, cudaMemcpyHostToDevice);
-    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    cudaMemcpy(Device, Host, Bytes, cudaMemcpyHostToDevice);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  cudaFree(device);
-  cudaFreeHost(host);
-  return Median(times);
+
+private:
+  std::size_t Bytes;
+  void* Host = nullptr;
+  void* Device = nullptr;
+};
+
+// A build's whole call against the pinned copy, measured pair by pair
+// (build, then copy, `repeats` times after a warm-up build): the medians of
+// each and the median of the pairs' ratios, which the host's drift between
+// pairs does not move.
+struct PairedBuild
+{
+  double seconds = 0.0;
+  double copySeconds = 0.0;
+  double ratio = 0.0;
+};
+
+PairedBuild TimeBuildAgainstCopy(int repeats, PinnedCopy& copy, const std::function<void()>& build)
+{
+  build();
+  std::vector<double> builds, copies, ratios;
+  for (int r = 0; r < repeats; ++r)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    build();
+    cudaDeviceSynchronize();
+    builds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    copies.push_back(copy.Seconds());
+    ratios.push_back(copies.back() > 0 ? builds.back() / copies.back() : 0.0);
+  }
+  return PairedBuild{ Median(builds), Median(copies), Median(ratios) };
 }
 
 // The same input arrays copied as a caller's pageable arrays go without the
@@ -425,8 +467,14 @@ int Run(int argc, char** argv)
   for (std::size_t n : section("build") ? sizes : std::vector<std::size_t>())
   {
     Cloud c = MakeCloud(n, 1);
-    double uploadMegabytes = 0.0;
-    const double pinnedUpload = PinnedUploadSeconds(c, uploadMegabytes);
+    PinnedCopy pinned(c);
+    const double uploadMegabytes = pinned.Megabytes();
+    std::vector<double> pinnedTimes;
+    for (int r = 0; r < 5; ++r)
+    {
+      pinnedTimes.push_back(pinned.Seconds());
+    }
+    const double pinnedUpload = Median(pinnedTimes);
     const UploadPeers peers = MeasureUploadPeers(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms\n",
@@ -443,7 +491,8 @@ int Run(int argc, char** argv)
       o.depth = depth;
       BuildStats last;
       const int repeats = 7;
-      const double t = TimeMedian(repeats, [&] { last = engine->Build(c.View(), o); });
+      const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { last = engine->Build(c.View(), o); });
+      const double t = paired.seconds;
       const double floor = SortFloorSeconds(c, 3 * depth);
       const double bytesPerPoint = double(engine->Memory().Total()) / n;
       const double arrayBytesPerPoint = double(engine->Memory().ArrayBytes()) / n;
@@ -454,15 +503,16 @@ int Run(int argc, char** argv)
       const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
       std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
                   "sort %.3f ms, ratio %.2f, %zu nodes, %.1f GPU bytes/point (%.1f in arrays, the rest the "
-                  "allocator's cache); pinned copy of its %.0f MB input %.3f ms, whole call %.2fx that; without the "
-                  "points %.3f ms, %.1f GPU bytes/point\n",
+                  "allocator's cache); pinned copy of its %.0f MB input %.3f ms beside it, whole call %.2fx that "
+                  "(median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
         n, depth, t * 1e3, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
         last.levelSeconds * 1e3, floor * 1e3, t / floor, last.nodes, bytesPerPoint, arrayBytesPerPoint, uploadMegabytes,
-        pinnedUpload * 1e3, pinnedUpload > 0 ? t / pinnedUpload : 0.0, leanSeconds * 1e3, leanBytesPerPoint);
+        paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3, leanBytesPerPoint);
       records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
         { { "upload_seconds", last.uploadSeconds }, { "key_seconds", last.keySeconds },
           { "sort_seconds", last.sortSeconds }, { "level_seconds", last.levelSeconds },
-          { "nodes", double(last.nodes) }, { "pinned_upload_seconds", pinnedUpload },
+          { "nodes", double(last.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
+          { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
           { "lean_seconds", leanSeconds } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
