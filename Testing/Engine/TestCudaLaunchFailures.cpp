@@ -109,8 +109,8 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   fixedDepth.depth = 6;
   BuildOptions automaticDepth; // depth 0: the depth histogram and the key shift run too
 
-  for (const char* kernel : { "WidenColor8Kernel", "WidenColorFloatKernel", "UnitNormalKernel", "KeysKernel",
-         "NeighbourHistogramKernel", "ShiftKernel", "LeafKernel", "InnerKernel" })
+  for (const char* kernel : { "WidenColor8Kernel", "WidenColorFloatKernel", "CopyAttributeKernel", "UnitNormalKernel",
+         "KeysKernel", "NeighbourHistogramKernel", "ShiftKernel", "LeafKernel", "InnerKernel" })
   {
     SCOPED_TRACE(kernel);
     auto engine = CreateEngine(Backend::CUDA);

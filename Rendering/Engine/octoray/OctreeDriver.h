@@ -208,74 +208,87 @@ void FillAttributes(Device& d, const PointCloudView& points, StagedAttributes<De
   });
 }
 
-// How each kind of attribute input becomes the engine's copy (Attributes.h
-// names the kind of each); an absent attribute releases its arrays.
-template <class A, class Device, class Points>
-void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
+// The record layout of a cloud's attributes: those it has, in the list's
+// order, colours given as 8-bit in one word.
+inline PointRecordLayout RecordLayoutOf(const PointCloudView& points)
 {
-  d.Adopt(std::move(staged.values[A::kIndex]), A::Of(s), points.count);
+  PointRecordLayout layout;
+  layout.color8 = points.color8 != nullptr;
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    if (!A::Input::template Present<A>(points))
+    {
+      return;
+    }
+    layout.offset[A::kIndex] = layout.stride;
+    layout.words[A::kIndex] =
+      A::kIndex == kAttributeColor && layout.color8 ? 1 : AttributeValue<typename A::Type>::kSlots;
+    layout.stride += layout.words[A::kIndex];
+  });
+  return layout;
 }
 
-template <class A, class Device, class Points>
-void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged,
-  Points& s)
+// How each kind of attribute input becomes its words of the engine's point
+// records (Attributes.h names the kind of each); absent ones have none.
+template <class A, class Device>
+void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
+  std::uint32_t* records, const PointRecordLayout& layout)
 {
-  const std::size_t n = points.count;
-  auto& out = A::Of(s);
   const float* in = staged.values[A::kIndex].Get();
-  if (!in)
+  if (in)
   {
-    d.Release(out);
-    return;
+    d.ForEach("CopyAttributeKernel", points.count,
+      OCTORAY_LAMBDA(std::size_t i) { StoreInRecord(records, layout, i, A::kIndex, in[i]); });
   }
-  d.Reserve(out, n, (std::string("point ") + A::kLabel).c_str());
-  Vec3f* unit = out.Get();
-  d.ForEach("UnitNormalKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) { unit[i] = UnitNormal(in[3 * i], in[3 * i + 1], in[3 * i + 2]); });
 }
 
-// Colours become RGBA: 8-bit ones in color8, float ones in the attribute's
-// array; a missing alpha is opaque.
-template <class A, class Device, class Points>
-void Ingest(ColorInput, A, Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
+template <class A, class Device>
+void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
+  std::uint32_t* records, const PointRecordLayout& layout)
 {
-  const std::size_t n = points.count;
+  const float* in = staged.values[A::kIndex].Get();
+  if (in)
+  {
+    d.ForEach("UnitNormalKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
+      StoreInRecord(records, layout, i, A::kIndex, UnitNormal(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
+    });
+  }
+}
+
+// Colours become RGBA: 8-bit ones one word, float ones four; a missing
+// alpha is opaque.
+template <class A, class Device>
+void Ingest(ColorInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
+  std::uint32_t* records, const PointRecordLayout& layout)
+{
   const int cc = points.colorComponents;
-  auto& rgba = A::Of(s);
   const std::uint8_t* in8 = staged.color8.Get();
   const float* inFloat = staged.values[A::kIndex].Get();
   if (in8)
   {
-    d.Release(rgba);
-    d.Reserve(s.color8, n, "point colours");
-    Rgba8* out = s.color8.Get();
-    d.ForEach("WidenColor8Kernel", n, OCTORAY_LAMBDA(std::size_t i) {
+    d.ForEach("WidenColor8Kernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
       const std::uint8_t* c = in8 + cc * i;
-      out[i] = Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) };
+      StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
     });
   }
   else if (inFloat)
   {
-    d.Release(s.color8);
-    d.Reserve(rgba, n, "point colours");
-    Rgba* out = rgba.Get();
-    d.ForEach("WidenColorFloatKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+    d.ForEach("WidenColorFloatKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
       const float* c = inFloat + cc * i;
-      out[i] = Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f };
+      StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
     });
-  }
-  else
-  {
-    d.Release(s.color8);
-    d.Release(rgba);
   }
 }
 
-// The state's point attributes from the staged arrays.
+// The state's point records from the staged arrays.
 template <class Device, class Points>
-void IngestAttributes(Device& d, const PointCloudView& points, StagedAttributes<Device>& staged, Points& s)
+void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged, Points& s)
 {
-  ForEachAttribute([&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, staged, s); });
+  s.layout = RecordLayoutOf(points);
+  d.Reserve(s.records, points.count * s.layout.stride, "point attributes");
+  std::uint32_t* records = s.records.Get();
+  ForEachAttribute(
+    [&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, staged, records, s.layout); });
 }
 
 // The cube a build uses: fitted to the staged positions, or the caller's
@@ -504,9 +517,8 @@ void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
 {
   d.Release(s.points.xyzFloat);
   d.Release(s.points.xyzDouble);
-  d.Release(s.points.color8);
+  d.Release(s.points.records);
   d.Release(s.points.key);
-  ForEachAttribute([&](auto a) { d.Release(a.Of(s.points)); });
   for (int b = 0; b < 2; ++b)
   {
     d.Release(scratch.sortKey[b]);

@@ -8,7 +8,6 @@
 #include "PointCloud.h"
 
 #include <string>
-#include <type_traits>
 
 namespace octoray
 {
@@ -33,8 +32,8 @@ struct OctreeState
     v.count = count;
     v.xyzFloat = DataOrNull(points.xyzFloat);
     v.xyzDouble = DataOrNull(points.xyzDouble);
-    v.color8 = DataOrNull(points.color8);
-    ForEachAttribute([&](auto a) { a.Of(v) = DataOrNull(a.Of(points)); });
+    v.records = DataOrNull(points.records);
+    v.layout = points.layout;
     return v;
   }
 
@@ -70,11 +69,10 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
   MemoryReport m;
   ForEachNodeArray([&](auto a) { m.Add(std::string("node ") + a.kLabel, a.Of(s.nodes).Bytes()); });
   m.Add("point positions", s.points.xyzFloat.Bytes() + s.points.xyzDouble.Bytes());
-  ForEachAttribute([&](auto a) {
-    using A = decltype(a);
-    const std::size_t compact = std::is_same<typename A::Input, ColorInput>::value ? s.points.color8.Bytes() : 0;
-    m.Add(std::string("point ") + a.kLabel, a.Of(s.points).Bytes() + compact);
-  });
+  // Each attribute's words of the records.
+  const PointRecordLayout& layout = s.points.layout;
+  const std::size_t perWord = layout.stride ? s.points.records.Bytes() / layout.stride : 0;
+  ForEachAttribute([&](auto a) { m.Add(std::string("point ") + a.kLabel, layout.words[a.kIndex] * perWord); });
   m.Add("point keys", s.points.key.Bytes());
   m.Add("sort buffers", sortBytes);
   m.Add(MemoryReport::kAllocatorCache, cachedBytes);

@@ -1,27 +1,57 @@
 // The engine's own copy of the points it was built from: positions in the
-// caller's precision, attributes in compact form, and each point's
-// full-depth Morton key. Kept so that updates and rebuilds need no input.
+// caller's precision, attributes in compact form (one record per point),
+// and each point's full-depth Morton key. Kept so that updates and
+// rebuilds need no input.
 #pragma once
 
 #include "Attributes.h"
 #include "Config.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace octoray
 {
+// Where each attribute lies in a point's record of 4-byte words. A point's
+// attributes sit side by side: the build's leaf pass reads the points in
+// sorted order, which is random in memory, and a record of up to 64 bytes
+// (aligned) then costs one DRAM burst where separate arrays cost one per
+// attribute (Benchmarks/gpu/profile-build.txt).
+struct PointRecordLayout
+{
+  int offset[kAttributeCount]; // first word of each attribute; -1: absent
+  int words[kAttributeCount];  // words of each attribute; 0: absent
+  int stride = 0;              // words per point
+  bool color8 = false;         // colour as one RGBA8 word (given as 8-bit), else 4 floats
+
+  OCTORAY_HD PointRecordLayout()
+  {
+    for (int a = 0; a < kAttributeCount; ++a)
+    {
+      offset[a] = -1;
+      words[a] = 0;
+    }
+  }
+};
+
+// A value of type T into a point's record.
+template <typename T>
+OCTORAY_HD void StoreInRecord(std::uint32_t* records, const PointRecordLayout& layout, std::size_t i, int attribute,
+  const T& value)
+{
+  static_assert(sizeof(T) % sizeof(std::uint32_t) == 0, "whole words");
+  memcpy(records + i * layout.stride + layout.offset[attribute], &value, sizeof(T));
+}
+
 // The point arrays a backend holds, each a Buffer<its type>.
 template <template <typename> class Buffer>
 struct PointArrays
 {
   Buffer<float> xyzFloat; // exactly one of the two, 3 values per point
   Buffer<double> xyzDouble;
-  // Colours given as 8-bit stay 8-bit (a quarter of float RGBA's bytes);
-  // the attribute `color` holds those given as float.
-  Buffer<Rgba8> color8;
-#define OCTORAY_MEMBER(member, Name, Type, ...) Buffer<Type> member;
-  OCTORAY_ATTRIBUTES(OCTORAY_MEMBER)
-#undef OCTORAY_MEMBER
+  Buffer<std::uint32_t> records; // the attributes, layout.stride words per point
+  PointRecordLayout layout;
   Buffer<std::uint64_t> key; // full-depth key of each point
 };
 
@@ -32,10 +62,8 @@ struct PointArraysView
   std::size_t count = 0;
   const float* xyzFloat = nullptr;
   const double* xyzDouble = nullptr;
-  const Rgba8* color8 = nullptr;
-#define OCTORAY_POINTER(member, Name, Type, ...) const Type* member = nullptr;
-  OCTORAY_ATTRIBUTES(OCTORAY_POINTER)
-#undef OCTORAY_POINTER
+  const std::uint32_t* records = nullptr;
+  PointRecordLayout layout;
 
   OCTORAY_HD Vec3d Position(std::size_t i) const
   {
@@ -46,20 +74,25 @@ struct PointArraysView
   // The point's attribute vector (slots of absent attributes are left alone).
   OCTORAY_HD void Attributes(std::size_t i, float v[kSlotCount]) const
   {
-    if (color8)
-    {
-      const Rgba8 c = color8[i]; // one load: the gather of a build's leaf pass is random
-      v[kSlotColor + 0] = c.r * (1.0f / 255.0f);
-      v[kSlotColor + 1] = c.g * (1.0f / 255.0f);
-      v[kSlotColor + 2] = c.b * (1.0f / 255.0f);
-      v[kSlotColor + 3] = c.a * (1.0f / 255.0f);
-    }
+    const std::uint32_t* record = records + i * layout.stride;
     ForEachAttribute([&](auto a) {
       using A = decltype(a);
-      if (A::Of(*this))
+      const int offset = layout.offset[A::kIndex];
+      if (offset < 0)
       {
-        AttributeValue<typename A::Type>::ToSlots(A::Of(*this)[i], v + A::kSlot);
+        return;
       }
+      if (A::kIndex == kAttributeColor && layout.color8)
+      {
+        Rgba8 c;
+        memcpy(&c, record + offset, sizeof c);
+        v[A::kSlot + 0] = c.r * (1.0f / 255.0f);
+        v[A::kSlot + 1] = c.g * (1.0f / 255.0f);
+        v[A::kSlot + 2] = c.b * (1.0f / 255.0f);
+        v[A::kSlot + 3] = c.a * (1.0f / 255.0f);
+        return;
+      }
+      memcpy(v + A::kSlot, record + offset, sizeof(typename A::Type));
     });
   }
 };
