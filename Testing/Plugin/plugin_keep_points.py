@@ -10,16 +10,10 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403
 
+from plugin_checks import check, finish
+
 plugin, data = sys.argv[1:3]
 LoadPlugin(plugin, remote=False, ns=globals())
-failures = []
-
-
-def check(what, ok):
-    print("%s: %s" % ("ok" if ok else "FAILED", what))
-    if not ok:
-        failures.append(what)
-
 
 import octoray  # noqa: E402  (the build's Python package, on PYTHONPATH)
 
@@ -51,7 +45,4 @@ Render(view)
 cost = (mapper.GetNumberOfBuilds() - builds, mapper.GetNumberOfUpdates() - updates)
 check("a move in place is a build: (builds, updates) = %s" % (cost,), cost == (1, 0))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("OK")
+finish()

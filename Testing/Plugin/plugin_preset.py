@@ -17,17 +17,10 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403
 
+from plugin_checks import check, finish
+
 plugin, data, out = sys.argv[1:4]
 LoadPlugin(plugin, remote=False, ns=globals())
-failures = []
-
-
-def check(what, ok):
-    print("%s: %s" % ("ok" if ok else "FAILED", what))
-    if not ok:
-        failures.append(what)
-
-
 import octoray  # noqa: E402  (the build's Python package, on PYTHONPATH)
 
 known = [octoray.vtkOctreeVolumePresets.GetName(i) for i in range(octoray.vtkOctreeVolumePresets.GetNumberOfPresets())]
@@ -124,7 +117,4 @@ check("an unknown name leaves no preset: the panel's ImageBackground",
 check("an unknown name leaves no preset: ParaView's colour map",
       actor.GetProperty().GetRGBTransferFunction(0) is paraview_colour)
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("OK")
+finish()
