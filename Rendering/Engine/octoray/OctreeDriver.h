@@ -38,6 +38,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 namespace octoray
 {
@@ -479,8 +480,8 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
 }
 
 // Keys, sort and levels of the state's points inside `cube`: the octree.
-// whileSorting(), if given, runs on the host while the device sorts. The phases'
-// times are the device's (Device::Clock).
+// whileSorting(), if given, runs on the host while the device sorts. The
+// phases' times are the device's (Device::Clock).
 template <class Device>
 BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
   int requestedDepth, bool computeKeys, const std::function<void()>& whileSorting = nullptr)
