@@ -229,67 +229,72 @@ inline PointRecordLayout RecordLayoutOf(const PointCloudView& points)
   return layout;
 }
 
-// How each kind of attribute input becomes its words of the engine's point
-// records (Attributes.h names the kind of each); absent ones have none.
-template <class A, class Device>
-void Ingest(CopiedInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
-  std::uint32_t* records, const PointRecordLayout& layout)
+// The staged attribute arrays as plain pointers, for the record loop.
+struct AttributeInputs
 {
-  const float* in = staged.values[A::kIndex].Get();
-  if (in)
-  {
-    d.ForEach("CopyAttributeKernel", points.count,
-      OCTORAY_LAMBDA(std::size_t i) { StoreInRecord(records, layout, i, A::kIndex, in[i]); });
-  }
+  const std::uint8_t* color8;
+  const float* values[kAttributeCount];
+  int colorComponents;
+};
+
+// What each kind of attribute input stores in point i's words of the
+// record (Attributes.h names the kind of each).
+template <class A>
+OCTORAY_HD void StoreInput(CopiedInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
+{
+  StoreInRecord(records, layout, i, A::kIndex, in.values[A::kIndex][i]);
 }
 
-template <class A, class Device>
-void Ingest(UnitNormalInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
-  std::uint32_t* records, const PointRecordLayout& layout)
+template <class A>
+OCTORAY_HD void StoreInput(UnitNormalInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
-  const float* in = staged.values[A::kIndex].Get();
-  if (in)
-  {
-    d.ForEach("UnitNormalKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
-      StoreInRecord(records, layout, i, A::kIndex, UnitNormal(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
-    });
-  }
+  const float* n = in.values[A::kIndex] + 3 * i;
+  StoreInRecord(records, layout, i, A::kIndex, UnitNormal(n[0], n[1], n[2]));
 }
 
 // Colours become RGBA: 8-bit ones one word, float ones four; a missing
 // alpha is opaque.
-template <class A, class Device>
-void Ingest(ColorInput, A, Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
-  std::uint32_t* records, const PointRecordLayout& layout)
+template <class A>
+OCTORAY_HD void StoreInput(ColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
-  const int cc = points.colorComponents;
-  const std::uint8_t* in8 = staged.color8.Get();
-  const float* inFloat = staged.values[A::kIndex].Get();
-  if (in8)
+  const int cc = in.colorComponents;
+  if (in.color8)
   {
-    d.ForEach("WidenColor8Kernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
-      const std::uint8_t* c = in8 + cc * i;
-      StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
-    });
+    const std::uint8_t* c = in.color8 + cc * i;
+    StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
   }
-  else if (inFloat)
+  else
   {
-    d.ForEach("WidenColorFloatKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
-      const float* c = inFloat + cc * i;
-      StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
-    });
+    const float* c = in.values[A::kIndex] + cc * i;
+    StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
   }
 }
 
-// The state's point records from the staged arrays.
+// The state's point records from the staged arrays: one loop writes each
+// point's whole record.
 template <class Device, class Points>
 void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged, Points& s)
 {
-  s.layout = RecordLayoutOf(points);
-  d.Reserve(s.records, points.count * s.layout.stride, "point attributes");
+  const PointRecordLayout layout = s.layout = RecordLayoutOf(points);
+  d.Reserve(s.records, points.count * layout.stride, "point attributes");
+  if (layout.stride == 0)
+  {
+    return;
+  }
+  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents };
+  ForEachAttribute([&](auto a) { in.values[a.kIndex] = staged.values[a.kIndex].Get(); });
   std::uint32_t* records = s.records.Get();
-  ForEachAttribute(
-    [&](auto a) { Ingest(typename decltype(a)::Input(), a, d, points, staged, records, s.layout); });
+  d.ForEach("PointRecordsKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
+    ForEachAttribute([&](auto a) {
+      if (layout.offset[decltype(a)::kIndex] >= 0)
+      {
+        StoreInput(typename decltype(a)::Input(), a, in, i, records, layout);
+      }
+    });
+  });
 }
 
 // The cube a build uses: fitted to the staged positions, or the caller's
