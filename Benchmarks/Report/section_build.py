@@ -3,6 +3,7 @@ points, same run), the engine alone (phases, memory), the CUDA backend from
 the committed GPU run, and the octree's quantisation error against depth."""
 import json
 import os
+import re
 
 from make_report import Section
 import scenes
@@ -122,6 +123,21 @@ def count(n):
 # octoray_bench_orbit --tile 1e9 on the GPU machine: a real scan tiled to a
 # billion points through the mapper (the second-to-last call of COMMAND.md).
 TILED_FILE = "orbit-tiled.json"
+
+
+# More runs of the CUDA build benchmark on the same machine (COMMAND.md):
+# lines "run N: build n=... depth=10: ... whole call R.RRx that ...".
+REPEATS_FILE = "bench-build-repeats.txt"
+
+
+def repeated_call_ratios(ctx, n):
+    """The whole call / pinned copy ratios of the repeated runs at n points."""
+    path = ctx.gpu_file(REPEATS_FILE)
+    if not path:
+        return []
+    with open(path) as f:
+        return [float(m.group(1)) for line in f if "build n=%d depth=10:" % n in line
+                for m in [re.search(r"whole call ([0-9.]+)x", line)] if m]
 
 
 def gpu_records(ctx, name):
@@ -349,6 +365,20 @@ def _cuda(ctx):
         "burst for each point's 8-byte record of colour and reflectivity; with one array per attribute, two "
         "bursts a point, it moved 16 GB in 7.8 ms: profile-build-arrays.txt). A caller with pinned or device-resident points would not "
         "pay the upload.",
+        "",
+    ]
+    repeats = {n: repeated_call_ratios(ctx, n) for n in (10000000, 100000000)}
+    if all(repeats.values()):
+        both = [r["call_over_pinned_copy"] for r in builds if r["depth"] == 10 and r["n"] == 100000000
+                and r.get("call_over_pinned_copy")]
+        ratios = sorted(both + repeats[100000000])
+        text += [
+            "Call / copy moves with the host's copy speed from run to run: at 100 M points and depth 10 it was %s "
+            "in this run and %s in %d more runs on the same machine ([gpu/%s](gpu/%s)), %.2f–%.2f in all; at 10 M, "
+            "%s in those runs." % (", ".join("%.2f" % r for r in both),
+                                   ", ".join("%.2f" % r for r in repeats[100000000]), len(repeats[100000000]),
+                                   REPEATS_FILE, REPEATS_FILE, ratios[0], ratios[-1],
+                                   ", ".join("%.2f" % r for r in repeats[10000000])),
         "",
     ]
     if staging:
