@@ -197,8 +197,8 @@ struct BuildStats
   std::size_t bytes = 0;     // MemoryReport::Total() after the build
   double seconds = 0.0;      // whole build, wall clock
   // The host's time copying the caller's arrays to the device and queueing
-  // their conversion (colours, normals); the attributes are copied while
-  // the device sorts.
+  // the attributes' conversion into point records (colours, normals); the
+  // attributes are copied while the device sorts.
   double uploadSeconds = 0.0;
   // The device's time (the host's on the CPU backend) of each phase:
   double keySeconds = 0.0;   // bounds (with their copy to the host) and Morton keys

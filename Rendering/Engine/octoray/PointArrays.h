@@ -92,7 +92,9 @@ struct PointArraysView
         v[A::kSlot + 3] = c.a * (1.0f / 255.0f);
         return;
       }
-      memcpy(v + A::kSlot, record + offset, sizeof(typename A::Type));
+      typename A::Type value;
+      memcpy(&value, record + offset, sizeof value);
+      AttributeValue<typename A::Type>::ToSlots(value, v + A::kSlot);
     });
   }
 };
