@@ -187,8 +187,9 @@ private:
 
 // A build's whole call against the pinned copy, measured pair by pair
 // (build, then copy, `repeats` times after a warm-up build): the medians of
-// each and the median of the pairs' ratios, which the host's drift between
-// pairs does not move.
+// each and the median of the pairs' ratios, which a drift of the host's
+// copy speed moves less than it moves either median (both halves of a pair
+// copy through the same host at nearly the same time).
 struct PairedBuild
 {
   double seconds = 0.0;
