@@ -15,7 +15,6 @@
 //    else, for a profiler to list the build's kernels (gpu-check.sh profile-build).
 // Times are medians of repeated runs after a warm-up; device work is timed
 // with CUDA events (the sort) or synchronised wall clock (whole engine calls).
-#include <octoray/CudaUpload.h>
 #include <octoray/Engine.h>
 #include <octoray/Frame.h>
 #include <octoray/Morton.h>
@@ -222,11 +221,7 @@ struct UploadPeers
 {
   double pageable = 0.0;
   double registered = 0.0;
-  double staged[2] = { 0.0, 0.0 }; // the engine's staging with kStagingThreads[0] and [1] threads at most
 };
-
-// The engine's staging (octoray/CudaUpload.h) with these thread counts.
-constexpr int kStagingThreads[2] = { 8, 16 };
 
 UploadPeers MeasureUploadPeers(Cloud& c)
 {
@@ -270,24 +265,6 @@ UploadPeers MeasureUploadPeers(Cloud& c)
     }
     cudaGetLastError();
     (registerFirst ? peers.registered : peers.pageable) = ok ? Median(times) : 0.0;
-  }
-  for (int k = 0; k < 2; ++k)
-  {
-    octoray::cuda::HostStaging staging(kStagingThreads[k]);
-    std::vector<double> times;
-    for (int r = 0; r < 4; ++r) // the first makes the staging buffers
-    {
-      const auto t0 = std::chrono::steady_clock::now();
-      char* to = static_cast<char*>(device);
-      for (const Array& a : arrays)
-      {
-        staging.Copy(to, a.data, a.bytes, "staged upload");
-        to += a.bytes;
-      }
-      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
-    times.erase(times.begin());
-    peers.staged[k] = Median(times);
   }
   cudaFree(device);
   return peers;
@@ -501,10 +478,8 @@ int Run(int argc, char** argv)
     const double pinnedUpload = Median(pinnedTimes);
     const UploadPeers peers = MeasureUploadPeers(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
-                "%.3f ms, cudaHostRegister + copy %.3f ms, the engine's staging with at most %d threads %.3f ms, %d "
-                "threads %.3f ms\n",
-      n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3, kStagingThreads[0],
-      peers.staged[0] * 1e3, kStagingThreads[1], peers.staged[1] * 1e3);
+                "%.3f ms, cudaHostRegister + copy %.3f ms\n",
+      n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
@@ -540,8 +515,6 @@ int Run(int argc, char** argv)
           { "nodes", double(last.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
           { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
-          { "staged_8_threads_upload_seconds", peers.staged[0] },
-          { "staged_16_threads_upload_seconds", peers.staged[1] },
           { "lean_seconds", leanSeconds } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
         { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });

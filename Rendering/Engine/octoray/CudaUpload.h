@@ -28,7 +28,7 @@ constexpr std::size_t kStagingThreshold = std::size_t(16) << 20;
 // transfer, small enough that a stripe's first and last pieces (which do
 // not overlap) are a small part of it.
 constexpr std::size_t kStagingPiece = std::size_t(4) << 20;
-constexpr int kMaxStagingThreads = 16;
+constexpr int kMaxStagingThreads = 8;
 
 // Whether CUDA can copy from `p` without staging: device, managed or
 // page-locked host memory.
@@ -55,12 +55,7 @@ enum class QueuedLoops
 class HostStaging
 {
 public:
-  // At most `maxThreads` staging threads (fewer on a host with fewer
-  // cores); octoray_bench_cuda times the upload with several.
-  explicit HostStaging(int maxThreads = kMaxStagingThreads)
-    : MaxThreads(maxThreads)
-  {
-  }
+  HostStaging() = default;
   HostStaging(const HostStaging&) = delete;
   HostStaging& operator=(const HostStaging&) = delete;
   ~HostStaging() { Free(); }
@@ -121,7 +116,7 @@ private:
     {
       return true;
     }
-    const int threads = std::min(MaxThreads, DefaultThreadCount());
+    const int threads = std::min(kMaxStagingThreads, DefaultThreadCount());
     Lanes.resize(threads);
     for (Lane& lane : Lanes)
     {
@@ -165,7 +160,6 @@ private:
     Lanes.clear();
   }
 
-  int MaxThreads;
   std::vector<Lane> Lanes;
 };
 }
