@@ -141,12 +141,16 @@ class Context:
         path = os.path.join(self.gpu, "COMMAND.md")
         if not os.path.exists(path):
             return None
-        # The indented lines are the commands (a trailing backslash continues
-        # one; a '#' starts a remark on how long it took), joined by "; ".
+        # The indented lines of the first block of commands (blank lines
+        # between them; the prose after it tells of earlier calls) are the
+        # commands (a trailing backslash continues one; a '#' starts a remark
+        # on how long it took), joined by "; ".
         commands, current = [], ""
         with open(path) as f:
             for line in f:
                 if not line.startswith("    "):
+                    if commands and line.strip():
+                        break
                     continue
                 current += line.split("#")[0].strip()
                 if current.endswith("\\"):
