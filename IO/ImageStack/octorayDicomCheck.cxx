@@ -81,8 +81,15 @@ private:
       return this->E.Fail("DICOM file meta element " + h.Name() + " at byte " +
         std::to_string(h.Start) + " has an undefined length");
     }
-    if (h.Element == 0x0000 && h.Length == 4)
+    if (h.Element == 0x0000)
     {
+      // GDCM 3.0 asserts (aborts) on a group length of another VR or size.
+      if (std::string(h.VR, 2) != "UL" || h.Length != 4)
+      {
+        return this->E.Fail("the DICOM file meta group length (0002,0000) at byte " + std::to_string(h.Start) +
+          " is a " + std::string(h.VR, 2) + " of " + std::to_string(h.Length) +
+          " bytes; it must be a UL of 4 bytes");
+      }
       return this->GroupLength(h);
     }
     if (h.Element == 0x0010)

@@ -366,8 +366,8 @@ void TestEnclosing()
 }
 
 // The file meta group: its length past the end of the file, a length
-// that does not end where its elements end, a transfer syntax UID
-// longer than a UID can be.
+// that does not end where its elements end, a group length that is not a
+// 4-byte UL, a transfer syntax UID longer than a UID can be.
 void TestFileMeta()
 {
   Dicom d = Part10(ExplicitLE);
@@ -385,6 +385,19 @@ void TestFileMeta()
   CHECK_EQ_STR(m.Check(),
     "the DICOM file meta group length (0002,0000) at byte 132 says the group ends at byte " +
       std::to_string(metaEnd - 2) + ", but its elements end at byte " + std::to_string(metaEnd));
+  // A group length of another size or VR, on which GDCM 3.0 asserts (a
+  // fuzzer's find: Testing/Fuzz/regressions/slice_stack/dicom_meta_length_assert).
+  Dicom l = Part10(ExplicitLE);
+  Image(l);
+  l.Bytes[138] = 8;
+  CHECK_EQ_STR(l.Check(),
+    "the DICOM file meta group length (0002,0000) at byte 132 is a UL of 8 bytes; it must be a UL of 4 bytes");
+  Dicom v = Part10(ExplicitLE);
+  Image(v);
+  v.Bytes[136] = 'U';
+  v.Bytes[137] = 'S';
+  CHECK_EQ_STR(v.Check(),
+    "the DICOM file meta group length (0002,0000) at byte 132 is a US of 4 bytes; it must be a UL of 4 bytes");
   Dicom u = Part10(std::string(70, '1'));
   CHECK_EQ_STR(u.Check().substr(0, 52), "the DICOM transfer syntax UID (0002,0010) at byte 15");
   CHECK_CONTAINS(u.Check(), "is 70 bytes long; a UID has at most 64");
