@@ -135,9 +135,9 @@ def repeated_call_ratios(ctx, n):
     path = ctx.gpu_file(REPEATS_FILE)
     if not path:
         return []
+    pattern = re.compile(r"build n=%d depth=10: .* whole call ([0-9.]+)x" % n)
     with open(path) as f:
-        return [float(m.group(1)) for line in f if "build n=%d depth=10:" % n in line
-                for m in [re.search(r"whole call ([0-9.]+)x", line)] if m]
+        return [float(m.group(1)) for m in map(pattern.search, f) if m]
 
 
 def gpu_records(ctx, name):
