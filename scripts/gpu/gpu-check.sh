@@ -110,8 +110,10 @@ if want profile; then
   for run in primary:12 full:22; do
     step "profile-${run%%:*}" ncu --clock-control none -k regex:RenderKernel --launch-skip "${run##*:}" \
       --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
-      --section MemoryWorkloadAnalysis --section WarpStateStats \
-      --metrics 'regex:smsp__average_warps_issue_stalled_.*_per_issue_active\.ratio$' --csv --page details \
+      --section MemoryWorkloadAnalysis --section WarpStateStats --section ComputeWorkloadAnalysis \
+      --section InstructionStats \
+      --metrics 'regex:smsp__average_warps_issue_stalled_.*_per_issue_active\.ratio$,regex:sm__inst_executed_pipe_[a-z0-9_]*\.avg\.pct_of_peak_sustained_active$' \
+      --csv --page details \
       --log-file "$out/profile-${run%%:*}.csv" $build/bin/octoray_bench_cuda --only render
   done
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1

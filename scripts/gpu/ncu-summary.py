@@ -22,9 +22,27 @@ FIGURES = [
     ("theoretical occupancy", "Theoretical Occupancy"),
     ("registers per thread", "Registers Per Thread"),
     ("warp cycles per issued instruction", "Warp Cycles Per Issued Instruction"),
+    ("executed instructions", "Executed Instructions"),
+    ("issue slots busy", "Issue Slots Busy"),
+    ("active threads per warp", "Avg. Active Threads Per Warp"),
 ]
 STALL_PREFIX = "smsp__average_warps_issue_stalled_"
 STALL_SUFFIX = "_per_issue_active.ratio"
+PIPE_PREFIX = "sm__inst_executed_pipe_"
+PIPE_SUFFIX = ".avg.pct_of_peak_sustained_active"
+
+
+def top(values, prefix, suffix, skip=()):
+    """The five largest figures of the metrics named prefix + X + suffix."""
+    found = []
+    for name, (value, _) in values.items():
+        reason = name[len(prefix):-len(suffix)]
+        if name.startswith(prefix) and name.endswith(suffix) and reason not in skip:
+            try:
+                found.append((float(value.replace(",", "")), reason))
+            except ValueError:
+                pass
+    return sorted(found, reverse=True)[:5], sum(v for v, _ in found)
 
 
 def summarise(path):
@@ -39,20 +57,15 @@ def summarise(path):
         if name in values:
             value, unit = values[name]
             print(f"  {label:36s} {value} {unit}")
-    stalls = []
-    for name, (value, _) in values.items():
-        # "selected" is the cycle a warp issues, not a stall.
-        if name.startswith(STALL_PREFIX) and name.endswith(STALL_SUFFIX) and name != STALL_PREFIX + "selected" + STALL_SUFFIX:
-            try:
-                stalls.append((float(value.replace(",", "")), name[len(STALL_PREFIX):-len(STALL_SUFFIX)]))
-            except ValueError:
-                pass
-    stalls.sort(reverse=True)
+    # "selected" is the cycle a warp issues, not a stall.
+    stalls, total = top(values, STALL_PREFIX, STALL_SUFFIX, skip=("selected",))
     if stalls:
-        total = sum(s for s, _ in stalls)
-        top = ", ".join(f"{reason} {cycles:.1f} ({100 * cycles / total:.0f}%)" for cycles, reason in stalls[:5])
-        print(f"  {'top stalls, cycles per issue':36s} {top}")
-
+        listed = ", ".join(f"{reason} {cycles:.1f} ({100 * cycles / total:.0f}%)" for cycles, reason in stalls)
+        print(f"  {'top stalls, cycles per issue':36s} {listed}")
+    pipes, _ = top(values, PIPE_PREFIX, PIPE_SUFFIX)
+    if pipes:
+        listed = ", ".join(f"{pipe} {share:.0f}%" for share, pipe in pipes)
+        print(f"  {'busiest pipes, % of peak':36s} {listed}")
 
 for p in sys.argv[1:]:
     summarise(p)

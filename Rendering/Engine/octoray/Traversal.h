@@ -156,59 +156,89 @@ OCTORAY_HD_INLINE float FarFace(unsigned signs, int a, float lo, float size)
   return (signs >> a) & 1u ? lo : lo + size;
 }
 
-// The crossings of the root cube [0, 1)^3.
-OCTORAY_HD_INLINE NodeCrossings RootCrossings(const Ray& ray, unsigned signs)
+// The crossings of the node whose corner is `lo` and side `size`. Its
+// planes are exact dyadic fractions, so the values are the same however the
+// corner was reached.
+OCTORAY_HD_INLINE NodeCrossings CrossingsOf(const Ray& ray, unsigned signs, const Vec3f& lo, float size)
 {
   NodeCrossings c;
   for (int a = 0; a < 3; ++a)
   {
-    c.nearT[a] = Crossing(ray, a, NearFace(signs, a, 0.0f, 1.0f));
-    c.midT[a] = Crossing(ray, a, 0.5f);
-    c.farT[a] = Crossing(ray, a, FarFace(signs, a, 0.0f, 1.0f));
+    c.nearT[a] = Crossing(ray, a, NearFace(signs, a, lo[a], size));
+    c.midT[a] = Crossing(ray, a, lo[a] + 0.5f * size);
+    c.farT[a] = Crossing(ray, a, FarFace(signs, a, lo[a], size));
   }
   return c;
 }
 
-// The entry, exit and entry axis of the child in mirrored octant m: the
-// latest near face and the earliest far face, the lowest axis on ties.
+// The entry and exit of the child in mirrored octant m: the latest near
+// face and the earliest far face.
 struct ChildSpan
 {
   float tEnter, tExit;
-  int axis;
 };
+
+OCTORAY_HD_INLINE float ChildNear(const NodeCrossings& c, unsigned m, int a)
+{
+  return (m >> a) & 1u ? c.midT[a] : c.nearT[a];
+}
 
 OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
 {
-  ChildSpan s{ -INFINITY, INFINITY, -1 };
+  ChildSpan s{ -INFINITY, INFINITY };
   for (int a = 0; a < 3; ++a)
   {
-    const bool upper = (m >> a) & 1u;
-    const float tNear = upper ? c.midT[a] : c.nearT[a];
-    const float tFar = upper ? c.farT[a] : c.midT[a];
-    if (tNear > s.tEnter)
-    {
-      s.tEnter = tNear;
-      s.axis = a;
-    }
+    const float tNear = ChildNear(c, m, a);
+    const float tFar = (m >> a) & 1u ? c.farT[a] : c.midT[a];
+    s.tEnter = tNear > s.tEnter ? tNear : s.tEnter;
     s.tExit = tFar < s.tExit ? tFar : s.tExit;
   }
   return s;
 }
 
-// Mirrored octants whose every axis the ray can reach inside a node it
-// spans over [tEnter, tExit]: the near half where the mid plane comes no
-// earlier than the entry, the far half where it comes no later than the
-// exit. A superset of the children the ray meets, so only those get their
-// span computed.
-OCTORAY_HD_INLINE unsigned ReachableOctants(const NodeCrossings& c, float tEnter, float tExit)
+// The axis of the face by which the ray enters the child in mirrored octant
+// m at tEnter (SpanOf's): the lowest axis on ties, -1 when the ray starts
+// inside on every axis. Only the voxels drawn need it.
+OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter)
 {
-  unsigned reachable = 0xFFu;
+  for (int a = 0; a < 3; ++a)
+  {
+    const float tNear = ChildNear(c, m, a);
+    if (tNear == tEnter && tNear > -INFINITY)
+    {
+      return a;
+    }
+  }
+  return -1;
+}
+
+// The mirrored octants the ray meets inside a node it spans over [tEnter,
+// tExit]: exactly the children whose slab test passes, zero-length touches
+// of edges and corners included. A child's span is empty only where one of
+// its near planes comes after one of its far planes. On one axis the near
+// face, mid plane and far face come in that order, and a near face never
+// comes after a far face of a node the ray is in, so three kinds of
+// comparison decide it: the near half of axis a needs its mid plane no
+// earlier than the entry, the far half no later than the exit, and an
+// octant past a's mid plane but not b's needs a's mid plane no later than
+// b's.
+OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, float tExit)
+{
+  unsigned met = 0xFFu;
   for (int a = 0; a < 3; ++a)
   {
     const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
-    reachable &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
+    met &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
   }
-  return reachable & 0xFFu;
+  // Octants with bit a set and bit b clear, for the pairs (x,y), (y,x),
+  // (x,z), (z,x), (y,z), (z,y).
+  met &= c.midT.x > c.midT.y ? ~0x22u : ~0u;
+  met &= c.midT.y > c.midT.x ? ~0x44u : ~0u;
+  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0u;
+  met &= c.midT.z > c.midT.x ? ~0x50u : ~0u;
+  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0u;
+  met &= c.midT.z > c.midT.y ? ~0x30u : ~0u;
+  return met & 0xFFu;
 }
 
 // The octants that hold every bit of m: those the ray can still meet after
@@ -246,22 +276,37 @@ OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
 #endif
 }
 
-// What the traversal keeps of a node while it is inside one of its
-// children, packed in 64 bits: how to find the children, which of them are
-// still to be looked at, and the one it is in.
+OCTORAY_HD_INLINE int HighestBit(unsigned bits)
+{
+#if defined(__CUDA_ARCH__)
+  return 31 - __clz(static_cast<int>(bits));
+#else
+  return 31 - __builtin_clz(bits);
+#endif
+}
+
+// The corner, on one axis, of the node of `level` that holds the point x of
+// the unit cube: x cut down to a multiple of the node's side (exact in
+// float, the scalings being powers of two).
+OCTORAY_HD_INLINE float NodeCorner(float x, int level)
+{
+  return static_cast<float>(static_cast<int>(x * PowerOfTwo(level))) * PowerOfTwo(-level);
+}
+
+// What the traversal keeps of a node that has children left to visit while
+// it is inside one of their siblings, packed in 64 bits: how to find the
+// children and which of them are left.
 struct PausedNode
 {
   std::uint64_t bits;
 
-  OCTORAY_HD_INLINE static PausedNode Of(std::uint32_t firstChild, unsigned childMask, unsigned todo, unsigned m)
+  OCTORAY_HD_INLINE static PausedNode Of(std::uint32_t firstChild, unsigned childMask, unsigned todo)
   {
-    return PausedNode{ std::uint64_t{ firstChild } | std::uint64_t{ childMask } << 32 |
-      std::uint64_t{ todo } << 40 | std::uint64_t{ m } << 48 };
+    return PausedNode{ std::uint64_t{ firstChild } | std::uint64_t{ childMask } << 32 | std::uint64_t{ todo } << 40 };
   }
   OCTORAY_HD_INLINE std::uint32_t FirstChild() const { return static_cast<std::uint32_t>(bits); }
   OCTORAY_HD_INLINE unsigned ChildMask() const { return static_cast<unsigned>(bits >> 32) & 0xFFu; }
   OCTORAY_HD_INLINE unsigned Todo() const { return static_cast<unsigned>(bits >> 40) & 0xFFu; }
-  OCTORAY_HD_INLINE unsigned Visiting() const { return static_cast<unsigned>(bits >> 48) & 7u; }
 };
 
 // Visits the drawn voxels (leaves, or nodes where the level of detail
@@ -274,15 +319,16 @@ struct PausedNode
 // Visiting the children by increasing mirrored octant is thus the order the
 // ray meets them, and depth-first in that order is front to back overall.
 //
-// Cost, one candidate child per step of a single loop (threads of a warp
-// stay in step): a child's span is picked from its parent's crossings, a
-// node's crossings are its parent's with three new mid planes, and only
-// the children the mid planes let the ray reach are looked at. Going back
-// up, the parent's crossings come back from the child's (its near face and
-// mid plane, or mid plane and far face, per axis) with at most three far
-// faces computed again; the parent itself is one 64-bit word per level
-// (PausedNode). Every value equals what a slab test of each child's box
-// gives, bit for bit: the planes are exact dyadic fractions.
+// Cost, one child per step of a single loop (threads of a warp stay in
+// step): a node's crossings are its parent's with three new mid planes, a
+// child's span is picked from them, and only the children the ray meets
+// are stepped to (MetOctants). Going back up takes one step however many
+// levels it climbs: the stack holds only nodes with children left (one
+// 64-bit word each, PausedNode), a bit per level says which, and the
+// traversal resumes at the deepest of them, its corner cut from the
+// current one and its crossings computed again (CrossingsOf). Every value
+// equals what a slab test of each child's box gives, bit for bit: the
+// planes are exact dyadic fractions.
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
@@ -302,47 +348,41 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     return;
   }
   const unsigned signs = DirectionSigns(ray);
-  PausedNode parents[kMaxLevel];
-  NodeCrossings c = RootCrossings(ray, signs);
+  PausedNode paused[kMaxLevel]; // by level, where `pausedLevels` has its bit
+  unsigned pausedLevels = 0;
   Vec3f lo{ 0.0f, 0.0f, 0.0f }; // the current node's corner and side
   float size = 1.0f;
   int level = 0;
+  NodeCrossings c = CrossingsOf(ray, signs, lo, size);
   unsigned childMask = tree.childMask[0];
   std::uint32_t firstChild = tree.firstChild[0];
-  unsigned todo = MirrorOctants(childMask, signs) & ReachableOctants(c, hit.tEnter, hit.tExit);
+  unsigned todo = MirrorOctants(childMask, signs) & MetOctants(c, hit.tEnter, hit.tExit);
   for (;;)
   {
     if (!todo)
     {
-      if (level == 0)
+      if (!pausedLevels)
       {
         return;
       }
-      const PausedNode parent = parents[--level];
-      const unsigned m = parent.Visiting();
-      firstChild = parent.FirstChild();
-      childMask = parent.ChildMask();
-      todo = parent.Todo() & OctantsAfter(m);
+      level = HighestBit(pausedLevels);
+      pausedLevels &= ~(1u << level);
+      const PausedNode node = paused[level];
+      firstChild = node.FirstChild();
+      childMask = node.ChildMask();
+      todo = node.Todo();
       for (int a = 0; a < 3; ++a)
       {
-        lo[a] -= ((m ^ signs) >> a) & 1u ? size : 0.0f;
-        if ((m >> a) & 1u)
-        {
-          c.midT[a] = c.nearT[a]; // the parent's near face is not needed again
-        }
-        else
-        {
-          c.midT[a] = c.farT[a];
-          c.farT[a] = Crossing(ray, a, FarFace(signs, a, lo[a], 2.0f * size));
-        }
+        lo[a] = NodeCorner(lo[a], level);
       }
-      size *= 2.0f;
+      size = PowerOfTwo(-level);
+      c = CrossingsOf(ray, signs, lo, size);
       continue;
     }
     const unsigned m = LowestBit(todo);
     todo &= todo - 1u;
     const ChildSpan span = SpanOf(c, m);
-    if (!(span.tEnter <= span.tExit) || span.tExit < ray.tMin)
+    if (span.tExit < ray.tMin)
     {
       continue;
     }
@@ -360,14 +400,20 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
     if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
     {
-      hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, span.axis, childLo, half };
+      hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, EntryAxis(c, m, span.tEnter), childLo, half };
       if (visitor.Visit(hit))
       {
         return;
       }
       continue;
     }
-    parents[level++] = PausedNode::Of(firstChild, childMask, todo, m);
+    const unsigned after = todo & OctantsAfter(m);
+    if (after)
+    {
+      paused[level] = PausedNode::Of(firstChild, childMask, after);
+      pausedLevels |= 1u << level;
+    }
+    ++level;
     for (int a = 0; a < 3; ++a)
     {
       const bool upper = (m >> a) & 1u;
@@ -379,7 +425,7 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     size = half;
     childMask = tree.childMask[child];
     firstChild = tree.firstChild[child];
-    todo = MirrorOctants(childMask, signs) & ReachableOctants(c, span.tEnter, span.tExit);
+    todo = MirrorOctants(childMask, signs) & MetOctants(c, span.tEnter, span.tExit);
   }
 }
 
