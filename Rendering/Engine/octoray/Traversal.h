@@ -116,10 +116,13 @@ struct NodeHit
 
 // Where the ray crosses the plane x[a] = p. A ray parallel to the plane
 // never crosses it: -inf where it runs on the plane or beyond it (boxes are
-// half-open, so the plane belongs to the upper side), +inf below it.
+// half-open, so the plane belongs to the upper side), +inf below it. A ray
+// known to have no parallel axis (MayBeParallel false: almost every ray)
+// skips that test, a third of the work of the traversal's crossings.
+template <bool MayBeParallel = true>
 OCTORAY_HD_INLINE float Crossing(const Ray& ray, int a, float p)
 {
-  if (ray.inverse[a] == INFINITY) // parallel (SetDirection)
+  if (MayBeParallel && ray.inverse[a] == INFINITY) // parallel (SetDirection)
   {
     return p <= ray.origin[a] ? -INFINITY : INFINITY;
   }
@@ -159,16 +162,38 @@ OCTORAY_HD_INLINE float FarFace(unsigned signs, int a, float lo, float size)
 // The crossings of the node whose corner is `lo` and side `size`. Its
 // planes are exact dyadic fractions, so the values are the same however the
 // corner was reached.
+template <bool MayBeParallel>
 OCTORAY_HD_INLINE NodeCrossings CrossingsOf(const Ray& ray, unsigned signs, const Vec3f& lo, float size)
 {
   NodeCrossings c;
   for (int a = 0; a < 3; ++a)
   {
-    c.nearT[a] = Crossing(ray, a, NearFace(signs, a, lo[a], size));
-    c.midT[a] = Crossing(ray, a, lo[a] + 0.5f * size);
-    c.farT[a] = Crossing(ray, a, FarFace(signs, a, lo[a], size));
+    c.nearT[a] = Crossing<MayBeParallel>(ray, a, NearFace(signs, a, lo[a], size));
+    c.midT[a] = Crossing<MayBeParallel>(ray, a, lo[a] + 0.5f * size);
+    c.farT[a] = Crossing<MayBeParallel>(ray, a, FarFace(signs, a, lo[a], size));
   }
   return c;
+}
+
+// The larger and the smaller of two crossings, which are never NaN: one
+// instruction on the device, where fmaxf is one; a compare on the host,
+// where it is a library call.
+OCTORAY_HD_INLINE float Later(float a, float b)
+{
+#if defined(__CUDA_ARCH__)
+  return fmaxf(a, b);
+#else
+  return a > b ? a : b;
+#endif
+}
+
+OCTORAY_HD_INLINE float Earlier(float a, float b)
+{
+#if defined(__CUDA_ARCH__)
+  return fminf(a, b);
+#else
+  return a < b ? a : b;
+#endif
 }
 
 // The entry and exit of the child in mirrored octant m: the latest near
@@ -190,8 +215,8 @@ OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
   {
     const float tNear = ChildNear(c, m, a);
     const float tFar = (m >> a) & 1u ? c.farT[a] : c.midT[a];
-    s.tEnter = tNear > s.tEnter ? tNear : s.tEnter;
-    s.tExit = tFar < s.tExit ? tFar : s.tExit;
+    s.tEnter = Later(tNear, s.tEnter);
+    s.tExit = Earlier(tFar, s.tExit);
   }
   return s;
 }
@@ -309,54 +334,21 @@ struct PausedNode
   OCTORAY_HD_INLINE unsigned Todo() const { return static_cast<unsigned>(bits >> 40) & 0xFFu; }
 };
 
-// Visits the drawn voxels (leaves, or nodes where the level of detail
-// stops) that the ray meets within [tMin, tMax], nearest first, until the
-// visitor's Visit(const NodeHit&) returns true.
-//
-// Order: a ray crosses each mid plane of a node at most once, from the near
-// half to the far one, so the children it meets form a chain in which each
-// next one sets one more bit of the mirrored octant (NodeCrossings).
-// Visiting the children by increasing mirrored octant is thus the order the
-// ray meets them, and depth-first in that order is front to back overall.
-//
-// Cost, one child per step of a single loop (threads of a warp stay in
-// step): a node's crossings are its parent's with three new mid planes, a
-// child's span is picked from them, and only the children the ray meets
-// are stepped to (MetOctants). Going back up takes one step however many
-// levels it climbs: the stack holds only nodes with children left (one
-// 64-bit word each, PausedNode), a bit per level says which, and the
-// traversal resumes at the deepest of them, its corner cut from the
-// current one and its crossings computed again (CrossingsOf). Every value
-// equals what a slab test of each child's box gives, bit for bit: the
-// planes are exact dyadic fractions.
-template <typename Visitor>
-OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
+// The loop of Traverse (below) from the root, whose span the ray's is.
+template <bool MayBeParallel, typename Visitor>
+OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor,
+  float tEnter, float tExit)
 {
-  NodeHit hit;
-  if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) ||
-    hit.tExit < ray.tMin || hit.tEnter > ray.tMax)
-  {
-    return;
-  }
-  if (tree.depth == 0 || lod.StopAt(1.0f, hit.tEnter))
-  {
-    hit.node = 0;
-    hit.level = 0;
-    hit.lo = Vec3f{ 0.0f, 0.0f, 0.0f };
-    hit.size = 1.0f;
-    visitor.Visit(hit);
-    return;
-  }
   const unsigned signs = DirectionSigns(ray);
   PausedNode paused[kMaxLevel]; // by level, where `pausedLevels` has its bit
   unsigned pausedLevels = 0;
   Vec3f lo{ 0.0f, 0.0f, 0.0f }; // the current node's corner and side
   float size = 1.0f;
   int level = 0;
-  NodeCrossings c = CrossingsOf(ray, signs, lo, size);
+  NodeCrossings c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
   unsigned childMask = tree.childMask[0];
   std::uint32_t firstChild = tree.firstChild[0];
-  unsigned todo = MirrorOctants(childMask, signs) & MetOctants(c, hit.tEnter, hit.tExit);
+  unsigned todo = MirrorOctants(childMask, signs) & MetOctants(c, tEnter, tExit);
   for (;;)
   {
     if (!todo)
@@ -376,7 +368,7 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
         lo[a] = NodeCorner(lo[a], level);
       }
       size = PowerOfTwo(-level);
-      c = CrossingsOf(ray, signs, lo, size);
+      c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
       continue;
     }
     const unsigned m = LowestBit(todo);
@@ -400,32 +392,90 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
     if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
     {
-      hit = NodeHit{ child, level + 1, span.tEnter, span.tExit, EntryAxis(c, m, span.tEnter), childLo, half };
+      const NodeHit hit{ child, level + 1, span.tEnter, span.tExit, EntryAxis(c, m, span.tEnter), childLo, half };
       if (visitor.Visit(hit))
       {
         return;
       }
       continue;
     }
+    NodeCrossings inner;
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool upper = (m >> a) & 1u;
+      inner.nearT[a] = upper ? c.midT[a] : c.nearT[a];
+      inner.farT[a] = upper ? c.farT[a] : c.midT[a];
+      inner.midT[a] = Crossing<MayBeParallel>(ray, a, childLo[a] + 0.5f * half);
+    }
+    const unsigned grandchildMask = tree.childMask[child];
+    const unsigned met = MirrorOctants(grandchildMask, signs) & MetOctants(inner, span.tEnter, span.tExit);
     const unsigned after = todo & OctantsAfter(m);
+    if (!met)
+    {
+      todo = after; // as if it had gone down and come back
+      continue;
+    }
     if (after)
     {
       paused[level] = PausedNode::Of(firstChild, childMask, after);
       pausedLevels |= 1u << level;
     }
     ++level;
-    for (int a = 0; a < 3; ++a)
-    {
-      const bool upper = (m >> a) & 1u;
-      c.nearT[a] = upper ? c.midT[a] : c.nearT[a];
-      c.farT[a] = upper ? c.farT[a] : c.midT[a];
-      c.midT[a] = Crossing(ray, a, childLo[a] + 0.5f * half);
-    }
+    c = inner;
     lo = childLo;
     size = half;
-    childMask = tree.childMask[child];
+    childMask = grandchildMask;
     firstChild = tree.firstChild[child];
-    todo = MirrorOctants(childMask, signs) & MetOctants(c, span.tEnter, span.tExit);
+    todo = met;
+  }
+}
+
+// Visits the drawn voxels (leaves, or nodes where the level of detail
+// stops) that the ray meets within [tMin, tMax], nearest first, until the
+// visitor's Visit(const NodeHit&) returns true.
+//
+// Order: a ray crosses each mid plane of a node at most once, from the near
+// half to the far one, so the children it meets form a chain in which each
+// next one sets one more bit of the mirrored octant (NodeCrossings).
+// Visiting the children by increasing mirrored octant is thus the order the
+// ray meets them, and depth-first in that order is front to back overall.
+//
+// Cost, one child per step of a single loop (threads of a warp stay in
+// step): a node's crossings are its parent's with three new mid planes, a
+// child's span is picked from them, and only the children the ray meets
+// are stepped to (MetOctants). A child whose own children the ray misses is
+// passed over in the step that looks at it, without going down. Going back
+// up takes one step however many levels it climbs: the stack holds only
+// nodes with children left (one 64-bit word each, PausedNode), a bit per
+// level says which, and the traversal resumes at the deepest of them, its
+// corner cut from the current one and its crossings computed again
+// (CrossingsOf). Every value equals what a slab test of each child's box
+// gives, bit for bit: the planes are exact dyadic fractions.
+template <typename Visitor>
+OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
+{
+  NodeHit hit;
+  if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) ||
+    hit.tExit < ray.tMin || hit.tEnter > ray.tMax)
+  {
+    return;
+  }
+  if (tree.depth == 0 || lod.StopAt(1.0f, hit.tEnter))
+  {
+    hit.node = 0;
+    hit.level = 0;
+    hit.lo = Vec3f{ 0.0f, 0.0f, 0.0f };
+    hit.size = 1.0f;
+    visitor.Visit(hit);
+    return;
+  }
+  if (ray.inverse.x == INFINITY || ray.inverse.y == INFINITY || ray.inverse.z == INFINITY)
+  {
+    TraverseFromRoot<true>(tree, ray, lod, visitor, hit.tEnter, hit.tExit);
+  }
+  else
+  {
+    TraverseFromRoot<false>(tree, ray, lod, visitor, hit.tEnter, hit.tExit);
   }
 }
 
