@@ -170,8 +170,10 @@ def _one_core(ctx):
                 " / ".join("%.2f×" % (s[1] / s[2]) for s in scenes))]
     text = ("Command:\n\n    %s\n\nEach pixel's primary ray to its first voxel in a plain loop on one core (no "
             "shading, no picture), 1920×1080, best of 3 after a warm-up: through `Traverse` (Traversal.h: each "
-            "child's span picked from its parent's near, mid and far plane crossings, only the children the mid "
-            "planes let the ray reach looked at, one 64-bit word per level on the stack) and through "
+            "child's span picked from its parent's near, mid and far plane crossings; only the children the ray "
+            "meets stepped to, and of those only the ones whose own children it meets gone down into; the way "
+            "back up one step to the deepest node with children left, whose crossings are computed again; one "
+            "64-bit word on the stack per such node) and through "
             "`ReferenceTraverse` (ReferenceTraversal.h: a slab test of every child's box, each node's box decoded "
             "from its Morton key, a stack entry per child met), which is what the engine traced with before. "
             "\"Same first hits\" compares the sums of the hit voxels' indices over the frame; the engine tests "
