@@ -47,9 +47,11 @@ def render(ctx):
         return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
     # A run may come in calls (racecheck, the slowest, in a call of its
-    # own): every summary*.txt of the run, read as one.
+    # own): every summary*.txt of the run, read as one, summary.txt (the
+    # final engine's call) first, so that its lines are the ones found.
     summary = ""
-    for name in sorted(os.listdir(os.path.dirname(summary_path))):
+    names = sorted(os.listdir(os.path.dirname(summary_path)), key=lambda n: (n != "summary.txt", n))
+    for name in names:
         if name.startswith("summary") and name.endswith(".txt"):
             with open(os.path.join(os.path.dirname(summary_path), name)) as f:
                 summary += f.read()
