@@ -88,22 +88,39 @@ StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const d
     d.Stage(xyzDouble, xyzDouble ? 3 * n : 0, what) };
 }
 
+// The first index at which a device loop failed, in the scratch counter
+// kCounterFirst: armed (filled with ones, kNoIndex) before the loop, each
+// failure reported inside it, and read after it, alone (FirstFailedStep) or
+// with the other counters in one copy.
+struct FirstFailure
+{
+  std::uint64_t* slot;
+  OCTORAY_HD void Report(std::size_t i) const { AtomicMin(slot, i); }
+};
+
+template <class Device>
+FirstFailure ArmFirstFailure(Device& d, DriverScratch<Device>& scratch)
+{
+  std::uint64_t* slot = scratch.counters.Get() + kCounterFirst;
+  d.FillBytes(slot, 1, 0xFF);
+  return FirstFailure{ slot };
+}
+
 // Runs step(i) for every i in [0, n) as the loop `name` and returns the
 // first i whose step failed (returned false), or kNoIndex. One copy to the
 // host.
 template <class Device, class Step>
 std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const char* name, std::size_t n, Step step)
 {
-  std::uint64_t* first = scratch.counters.Get() + kCounterFirst;
-  d.FillBytes(first, 1, 0xFF);
+  const FirstFailure failure = ArmFirstFailure(d, scratch);
   d.ForEach(name, n, OCTORAY_LAMBDA(std::size_t i) {
     if (!step(i))
     {
-      AtomicMin(first, i);
+      failure.Report(i);
     }
   });
   std::uint64_t result = kNoIndex;
-  d.ToHost(first, 1, &result, name);
+  d.ToHost(failure.slot, 1, &result, name);
   return result;
 }
 
@@ -182,6 +199,19 @@ struct StagedAttributes
   typename Device::template Staged<float> values[kAttributeCount];
 };
 
+// Calls fn(staged array, caller's array, its length, label) for the 8-bit
+// colours and for each attribute's float array.
+template <class Device, class Fn>
+void ForEachStagedInput(const PointCloudView& points, StagedAttributes<Device>& staged, Fn&& fn)
+{
+  fn(staged.color8, points.color8, points.colorComponents * points.count, std::string("point colours"));
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
+    fn(staged.values[A::kIndex], in.data, in.count, std::string("point ") + A::kLabel);
+  });
+}
+
 // The attributes' staged arrays in two steps (Device::Prepare, Fill): a
 // build takes their memory before it queues the sort and copies them while
 // the device sorts, which needs only the positions.
@@ -189,11 +219,8 @@ template <class Device>
 StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points)
 {
   StagedAttributes<Device> staged;
-  staged.color8 = d.Prepare(points.color8, points.colorComponents * points.count, "point colours");
-  ForEachAttribute([&](auto a) {
-    using A = decltype(a);
-    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
-    staged.values[A::kIndex] = d.Prepare(in.data, in.count, (std::string("point ") + A::kLabel).c_str());
+  ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
+    array = d.Prepare(data, count, label.c_str());
   });
   return staged;
 }
@@ -201,11 +228,8 @@ StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& poin
 template <class Device>
 void FillAttributes(Device& d, const PointCloudView& points, StagedAttributes<Device>& staged)
 {
-  d.Fill(staged.color8, points.color8, points.colorComponents * points.count, "point colours");
-  ForEachAttribute([&](auto a) {
-    using A = decltype(a);
-    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
-    d.Fill(staged.values[A::kIndex], in.data, in.count, (std::string("point ") + A::kLabel).c_str());
+  ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
+    d.Fill(array, data, count, label.c_str());
   });
 }
 
@@ -367,16 +391,16 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   // Only the leaf level's bits need sorting when the depth is known.
   const int leafShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
   phases[0] = clock.Mark();
-  d.FillBytes(counters + kCounterFirst, 1, 0xFF);
+  // The cube holds every point (fitted or checked): a point outside is a
+  // bug, read after the sort with the histogram.
+  const FirstFailure outside = ArmFirstFailure(d, scratch);
   if (computeKeys)
   {
-    // The cube holds every point (fitted or checked): a point outside is a bug.
-    std::uint64_t* first = counters + kCounterFirst;
     d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
       std::uint64_t key = 0;
       if (!ComputePointKey(pts, cube, i, key))
       {
-        AtomicMin(first, i);
+        outside.Report(i);
       }
       if (pointKey)
       {
@@ -705,8 +729,7 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   std::uint64_t* pointKey = s.points.key.Get();
   std::uint64_t* from = fromLeaf.Get();
   std::uint64_t* into = toLeaf.Get();
-  std::uint64_t* first = scratch.counters.Get() + kCounterFirst;
-  d.FillBytes(first, 1, 0xFF);
+  const FirstFailure outside = ArmFirstFailure(d, scratch);
   d.ForEach("MovedKeysKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
     std::uint64_t key = 0;
@@ -716,13 +739,13 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
     pointKey[i] = inside ? key : pointKey[i];
     if (!inside)
     {
-      AtomicMin(first, i);
+      outside.Report(i);
     }
   });
   d.Select(moved, OCTORAY_LAMBDA(std::size_t k) { return from[k] != into[k]; }, changedMoves.Get(),
     scratch.counters.Get() + kCounterSelected);
   std::uint64_t report[2]; // kCounterFirst, kCounterSelected
-  d.ToHost(first, 2, report, "MovedKeysKernel");
+  d.ToHost(outside.slot, 2, report, "MovedKeysKernel");
   const std::size_t changed = report[1];
 
   if (report[0] != kNoIndex)
