@@ -369,7 +369,8 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       }
       size = PowerOfTwo(-level);
       c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
-      continue;
+      // A paused node has children left: on to the next of them in the same
+      // step, where the threads of a warp that did not climb are.
     }
     const unsigned m = LowestBit(todo);
     todo &= todo - 1u;
