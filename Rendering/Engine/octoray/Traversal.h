@@ -238,15 +238,17 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
 }
 
 // The mirrored octants the ray meets inside a node it spans over [tEnter,
-// tExit]: exactly the children whose slab test passes, zero-length touches
-// of edges and corners included. A child's span is empty only where one of
-// its near planes comes after one of its far planes. On one axis the near
-// face, mid plane and far face come in that order, and a near face never
-// comes after a far face of a node the ray is in, so three kinds of
-// comparison decide it: the near half of axis a needs its mid plane no
-// earlier than the entry, the far half no later than the exit, and an
-// octant past a's mid plane but not b's needs a's mid plane no later than
-// b's.
+// tExit]: exactly the children whose slab test passes over a length of the
+// ray. A child's span is empty only where one of its near planes comes
+// after one of its far planes. On one axis the near face, mid plane and far
+// face come in that order, and a near face never comes after a far face of
+// a node the ray is in, so three kinds of comparison decide it: the near
+// half of axis a needs its mid plane no earlier than the entry, the far
+// half no later than the exit, and an octant past a's mid plane but not
+// b's needs a's mid plane before b's. Where the ray crosses both at once it
+// touches the two octants between at a point only; one of them is kept
+// (one comparison per pair of axes, where two would drop both), and the
+// traversal may pass such touches by.
 OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, float tExit)
 {
   unsigned met = 0xFFu;
@@ -255,23 +257,23 @@ OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, floa
     const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
     met &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
   }
-  // Octants with bit a set and bit b clear, for the pairs (x,y), (y,x),
-  // (x,z), (z,x), (y,z), (z,y).
-  met &= c.midT.x > c.midT.y ? ~0x22u : ~0u;
-  met &= c.midT.y > c.midT.x ? ~0x44u : ~0u;
-  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0u;
-  met &= c.midT.z > c.midT.x ? ~0x50u : ~0u;
-  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0u;
-  met &= c.midT.z > c.midT.y ? ~0x30u : ~0u;
+  // Past x's mid plane but not y's (octants 1 and 5) or past y's but not
+  // x's (2 and 6); the same for x and z, then y and z.
+  met &= c.midT.x > c.midT.y ? ~0x22u : ~0x44u;
+  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0x50u;
+  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0x30u;
   return met & 0xFFu;
 }
 
 // The octants that hold every bit of m: those the ray can still meet after
 // the child m, which it met (a ray's children form a chain of growing bit
-// sets).
+// sets). Byte m of the constant, one shift where selects per bit of m
+// would take the device's integer pipe, the traversal's narrowest.
 OCTORAY_HD_INLINE unsigned OctantsAfter(unsigned m)
 {
-  return (m & 1u ? 0xAAu : 0xFFu) & (m & 2u ? 0xCCu : 0xFFu) & (m & 4u ? 0xF0u : 0xFFu);
+  // m:  7     6     5     4     3     2     1     0
+  //     0x80  0xC0  0xA0  0xF0  0x88  0xCC  0xAA  0xFF
+  return static_cast<unsigned>(0x80C0A0F088CCAAFFull >> (8u * m)) & 0xFFu;
 }
 
 // A child mask with octant bits flipped as in NodeCrossings.
