@@ -19,7 +19,8 @@
 # the engine's CUDA tests, memcheck on the mapper's), racecheck (on the
 # engine's CUDA tests: the slowest, about 3 minutes), bench (engine
 # benchmarks; BILLION points, default 1e9, generated on the device, 0: none),
-# profile (Nsight Compute on the render kernel: primary rays, and Phong with
+# profile (Nsight Compute on the render kernel, with its instruction count
+# and busiest pipes: primary rays, and Phong with
 # shadows and a bounce, 10 M points at depth 10, 1920x1080), variants (the
 # render benchmark built with other register caps, OCTORAY_RENDER_MIN_BLOCKS
 # from VARIANT_BLOCKS, default 0 and 8, beside the main build's 6, and with
