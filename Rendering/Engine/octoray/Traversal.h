@@ -238,17 +238,17 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
 }
 
 // The mirrored octants the ray meets inside a node it spans over [tEnter,
-// tExit]: exactly the children whose slab test passes over a length of the
-// ray. A child's span is empty only where one of its near planes comes
-// after one of its far planes. On one axis the near face, mid plane and far
-// face come in that order, and a near face never comes after a far face of
-// a node the ray is in, so three kinds of comparison decide it: the near
-// half of axis a needs its mid plane no earlier than the entry, the far
-// half no later than the exit, and an octant past a's mid plane but not
-// b's needs a's mid plane before b's. Where the ray crosses both at once it
-// touches the two octants between at a point only; one of them is kept
-// (one comparison per pair of axes, where two would drop both), and the
-// traversal may pass such touches by.
+// tExit]: exactly the children whose slab test passes, zero-length touches
+// of edges and corners included. A child's span is empty only where one of
+// its near planes comes after one of its far planes. On one axis the near
+// face, mid plane and far face come in that order, and a near face never
+// comes after a far face of a node the ray is in, so three kinds of
+// comparison decide it: the near half of axis a needs its mid plane no
+// earlier than the entry, the far half no later than the exit, and an
+// octant past a's mid plane but not b's needs a's mid plane no later than
+// b's. Touches are kept, both where the ray crosses two mid planes at once:
+// keeping one of the two (one comparison per pair of axes) lets a ray
+// through a lattice of voxels' edges miss them all, a dotted line of holes.
 OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, float tExit)
 {
   unsigned met = 0xFFu;
@@ -257,11 +257,14 @@ OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, floa
     const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
     met &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
   }
-  // Past x's mid plane but not y's (octants 1 and 5) or past y's but not
-  // x's (2 and 6); the same for x and z, then y and z.
-  met &= c.midT.x > c.midT.y ? ~0x22u : ~0x44u;
-  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0x50u;
-  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0x30u;
+  // Octants with bit a set and bit b clear, for the pairs (x,y), (y,x),
+  // (x,z), (z,x), (y,z), (z,y).
+  met &= c.midT.x > c.midT.y ? ~0x22u : ~0u;
+  met &= c.midT.y > c.midT.x ? ~0x44u : ~0u;
+  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0u;
+  met &= c.midT.z > c.midT.x ? ~0x50u : ~0u;
+  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0u;
+  met &= c.midT.z > c.midT.y ? ~0x30u : ~0u;
   return met & 0xFFu;
 }
 
