@@ -451,12 +451,13 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
 // child's span is picked from them, and only the children the ray meets
 // are stepped to (MetOctants). A child whose own children the ray misses is
 // passed over in the step that looks at it, without going down. Going back
-// up takes one step however many levels it climbs: the stack holds only
-// nodes with children left (one 64-bit word each, PausedNode), a bit per
-// level says which, and the traversal resumes at the deepest of them, its
-// corner cut from the current one and its crossings computed again
-// (CrossingsOf). Every value equals what a slab test of each child's box
-// gives, bit for bit: the planes are exact dyadic fractions.
+// up is part of the step that looks at the next child, however many levels
+// it climbs: the stack holds only nodes with children left (one 64-bit word
+// each, PausedNode), a bit per level says which, and the traversal resumes
+// at the deepest of them, its corner cut from the current one and its
+// crossings computed again (CrossingsOf). Every value equals what a slab
+// test of each child's box gives, bit for bit: the planes are exact dyadic
+// fractions.
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
