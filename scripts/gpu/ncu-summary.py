@@ -67,5 +67,6 @@ def summarise(path):
         listed = ", ".join(f"{pipe} {share:.0f}%" for share, pipe in pipes)
         print(f"  {'busiest pipes, % of peak':36s} {listed}")
 
+
 for p in sys.argv[1:]:
     summarise(p)
