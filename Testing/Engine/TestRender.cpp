@@ -142,6 +142,52 @@ TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
   EXPECT_GT(visits, 30000u); // the rays meet the clusters, not only empty space
 }
 
+// A ray along the diagonal of a layer of voxels, through its empty squares
+// (i, i), beside a line of full ones, (i, i + 1) or (i + 1, i): it crosses
+// the x and y mid planes of every node on its way at once, and touches the
+// full squares only at their corners. Such a touch has no length, but a ray
+// that drops it sees through a solid-looking lattice (a dotted line of
+// holes in a picture), so the first hit must be the slab tests'. Keeping
+// only one of the two octants between two mid planes the ray crosses at
+// once (one comparison per pair of axes in MetOctants) fails it.
+TEST_P(RenderTest, RaysThroughLatticeCornersTouchTheVoxels)
+{
+  for (int side : { 1, -1 })
+  {
+    std::mt19937_64 rng(5);
+    Cloud c;
+    for (int i = 0; i < 31; ++i)
+      c.Add(i + (side < 0) + 0.5, i + (side > 0) + 0.5, 0.5, rng);
+    BuildOptions options; // cells of side 1, so that the diagonal runs through their corners exactly
+    options.depth = 5;
+    options.fixedCube = true;
+    options.cube.size = 32.0;
+    engine->Build(c.View(), options);
+    HostOctree t;
+    engine->CopyToHost(t);
+    const OctreeView view = t.View();
+    for (float direction : { 1.0f, -1.0f })
+    {
+      SCOPED_TRACE("full squares on the " + std::string(side > 0 ? "+y" : "+x") + " side, direction " +
+        std::to_string(direction));
+      const float start = (direction > 0 ? 0.5f : 31.5f) / 32;
+      Ray ray;
+      ray.origin = Vec3f{ start, start, 0.5f / 32 };
+      SetDirection(ray, Normalize(Vec3f{ direction, direction, 0.0f }));
+      ray.tMin = 0.0f;
+      ray.tMax = INFINITY;
+      LevelOfDetail lod;
+      FirstHitVisitor fast, reference;
+      Traverse(view, ray, lod, fast);
+      ReferenceTraverse(view, ray, lod, reference);
+      ASSERT_TRUE(reference.found);
+      EXPECT_EQ(reference.hit.tEnter, reference.hit.tExit); // a touch
+      ASSERT_TRUE(fast.found);
+      EXPECT_EQ(fast.hit.tEnter, reference.hit.tEnter);
+    }
+  }
+}
+
 TEST_P(RenderTest, FullPlaneHasNoCracksAtAnyAngle)
 {
   // Every cell of a 32x32 plane at depth 5 occupied.
