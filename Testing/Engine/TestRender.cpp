@@ -162,9 +162,7 @@ TEST_P(RenderTest, RaysThroughLatticeCornersTouchTheVoxels)
     options.depth = 5;
     options.fixedCube = true;
     options.cube.size = 32.0;
-    engine->Build(c.View(), options);
-    HostOctree t;
-    engine->CopyToHost(t);
+    HostOctree t = BuildOnHost(*engine, c.View(), options);
     const OctreeView view = t.View();
     for (float direction : { 1.0f, -1.0f })
     {

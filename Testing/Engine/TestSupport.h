@@ -76,14 +76,19 @@ inline Cloud UniformCloud(std::size_t n, std::uint64_t seed, double lo = -1.0, d
 
 // The octree `engine` builds from `points` at `depth` (0: chosen from the
 // data), copied to the host for a test to inspect or trace.
-inline HostOctree BuildOnHost(Engine& engine, const PointCloudView& points, int depth)
+inline HostOctree BuildOnHost(Engine& engine, const PointCloudView& points, const BuildOptions& options)
 {
-  BuildOptions options;
-  options.depth = depth;
   engine.Build(points, options);
   HostOctree t;
   engine.CopyToHost(t);
   return t;
+}
+
+inline HostOctree BuildOnHost(Engine& engine, const PointCloudView& points, int depth)
+{
+  BuildOptions options;
+  options.depth = depth;
+  return BuildOnHost(engine, points, options);
 }
 
 inline Cloud GaussianClusters(std::size_t n, std::uint64_t seed)
