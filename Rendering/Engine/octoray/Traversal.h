@@ -90,15 +90,13 @@ struct LevelOfDetail
 {
   float footprint0 = 0.0f;
   float footprintSlope = 0.0f;
-  float pixels = 0.0f; // 0: always down to the leaves
+  float pixels = 0.0f; // 0 (or less): always down to the leaves
 
-  // `voxel`: the node's side in the unit cube.
+  // `voxel`: the node's side in the unit cube. Without a branch for
+  // pixels <= 0, which needs none (no side is below 0, nor below NaN where
+  // 0 meets an infinite footprint): the traversal asks at every step.
   OCTORAY_HD bool StopAt(float voxel, float t) const
   {
-    if (pixels <= 0.0f)
-    {
-      return false;
-    }
     return voxel < pixels * (footprint0 + footprintSlope * (t > 0.0f ? t : 0.0f));
   }
 };
@@ -208,15 +206,18 @@ OCTORAY_HD_INLINE float ChildNear(const NodeCrossings& c, unsigned m, int a)
   return (m >> a) & 1u ? c.midT[a] : c.nearT[a];
 }
 
+OCTORAY_HD_INLINE float ChildFar(const NodeCrossings& c, unsigned m, int a)
+{
+  return (m >> a) & 1u ? c.farT[a] : c.midT[a];
+}
+
 OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
 {
   ChildSpan s{ -INFINITY, INFINITY };
   for (int a = 0; a < 3; ++a)
   {
-    const float tNear = ChildNear(c, m, a);
-    const float tFar = (m >> a) & 1u ? c.farT[a] : c.midT[a];
-    s.tEnter = Later(tNear, s.tEnter);
-    s.tExit = Earlier(tFar, s.tExit);
+    s.tEnter = Later(ChildNear(c, m, a), s.tEnter);
+    s.tExit = Earlier(ChildFar(c, m, a), s.tExit);
   }
   return s;
 }
@@ -237,8 +238,9 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
   return -1;
 }
 
-// The mirrored octants the ray meets inside a node it spans over [tEnter,
-// tExit]: exactly the children whose slab test passes, zero-length touches
+// The mirrored octants the ray meets over [tEnter, tExit] inside a node
+// whose mid planes it crosses at midT and whose box it is in over all of
+// that interval (a part of its span will do): exactly the children whose slab test passes, zero-length touches
 // of edges and corners included. A child's span is empty only where one of
 // its near planes comes after one of its far planes. On one axis the near
 // face, mid plane and far face come in that order, and a near face never
@@ -249,22 +251,22 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
 // b's. Touches are kept, both where the ray crosses two mid planes at once:
 // keeping one of the two (one comparison per pair of axes) lets a ray
 // through a lattice of voxels' edges miss them all, a dotted line of holes.
-OCTORAY_HD_INLINE unsigned MetOctants(const NodeCrossings& c, float tEnter, float tExit)
+OCTORAY_HD_INLINE unsigned MetOctants(const Vec3f& midT, float tEnter, float tExit)
 {
   unsigned met = 0xFFu;
   for (int a = 0; a < 3; ++a)
   {
     const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
-    met &= (c.midT[a] >= tEnter ? nearHalf : 0u) | (c.midT[a] <= tExit ? ~nearHalf : 0u);
+    met &= (midT[a] >= tEnter ? nearHalf : 0u) | (midT[a] <= tExit ? ~nearHalf : 0u);
   }
   // Octants with bit a set and bit b clear, for the pairs (x,y), (y,x),
   // (x,z), (z,x), (y,z), (z,y).
-  met &= c.midT.x > c.midT.y ? ~0x22u : ~0u;
-  met &= c.midT.y > c.midT.x ? ~0x44u : ~0u;
-  met &= c.midT.x > c.midT.z ? ~0x0Au : ~0u;
-  met &= c.midT.z > c.midT.x ? ~0x50u : ~0u;
-  met &= c.midT.y > c.midT.z ? ~0x0Cu : ~0u;
-  met &= c.midT.z > c.midT.y ? ~0x30u : ~0u;
+  met &= midT.x > midT.y ? ~0x22u : ~0u;
+  met &= midT.y > midT.x ? ~0x44u : ~0u;
+  met &= midT.x > midT.z ? ~0x0Au : ~0u;
+  met &= midT.z > midT.x ? ~0x50u : ~0u;
+  met &= midT.y > midT.z ? ~0x0Cu : ~0u;
+  met &= midT.z > midT.y ? ~0x30u : ~0u;
   return met & 0xFFu;
 }
 
@@ -353,7 +355,11 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   NodeCrossings c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
   unsigned childMask = tree.childMask[0];
   std::uint32_t firstChild = tree.firstChild[0];
-  unsigned todo = MirrorOctants(childMask, signs) & MetOctants(c, tEnter, tExit);
+  // Children are tested against the part of each span within [tMin, tMax]
+  // (never empty: a child is stepped to only where it meets that part), so
+  // the loop needs no test of its own for voxels before tMin or past tMax.
+  unsigned todo =
+    MirrorOctants(childMask, signs) & MetOctants(c.midT, Later(tEnter, ray.tMin), Earlier(tExit, ray.tMax));
   for (;;)
   {
     if (!todo)
@@ -380,14 +386,6 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     const unsigned m = LowestBit(todo);
     todo &= todo - 1u;
     const ChildSpan span = SpanOf(c, m);
-    if (span.tExit < ray.tMin)
-    {
-      continue;
-    }
-    if (span.tEnter > ray.tMax)
-    {
-      return; // everything after it is farther
-    }
     const unsigned octant = m ^ signs;
     const float half = 0.5f * size;
     Vec3f childLo = lo;
@@ -405,16 +403,14 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       }
       continue;
     }
-    NodeCrossings inner;
+    Vec3f innerMidT;
     for (int a = 0; a < 3; ++a)
     {
-      const bool upper = (m >> a) & 1u;
-      inner.nearT[a] = upper ? c.midT[a] : c.nearT[a];
-      inner.farT[a] = upper ? c.farT[a] : c.midT[a];
-      inner.midT[a] = Crossing<MayBeParallel>(ray, a, childLo[a] + 0.5f * half);
+      innerMidT[a] = Crossing<MayBeParallel>(ray, a, childLo[a] + 0.5f * half);
     }
     const unsigned grandchildMask = tree.childMask[child];
-    const unsigned met = MirrorOctants(grandchildMask, signs) & MetOctants(inner, span.tEnter, span.tExit);
+    const unsigned met = MirrorOctants(grandchildMask, signs) &
+      MetOctants(innerMidT, Later(span.tEnter, ray.tMin), Earlier(span.tExit, ray.tMax));
     const unsigned after = todo & OctantsAfter(m);
     if (!met)
     {
@@ -427,7 +423,13 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       pausedLevels |= 1u << level;
     }
     ++level;
-    c = inner;
+    for (int a = 0; a < 3; ++a)
+    {
+      const float tNear = ChildNear(c, m, a);
+      c.farT[a] = ChildFar(c, m, a);
+      c.nearT[a] = tNear;
+      c.midT[a] = innerMidT[a];
+    }
     lo = childLo;
     size = half;
     childMask = grandchildMask;
@@ -449,15 +451,15 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
 // Cost, one child per step of a single loop (threads of a warp stay in
 // step): a node's crossings are its parent's with three new mid planes, a
 // child's span is picked from them, and only the children the ray meets
-// are stepped to (MetOctants). A child whose own children the ray misses is
-// passed over in the step that looks at it, without going down. Going back
-// up is part of the step that looks at the next child, however many levels
-// it climbs: the stack holds only nodes with children left (one 64-bit word
-// each, PausedNode), a bit per level says which, and the traversal resumes
-// at the deepest of them, its corner cut from the current one and its
-// crossings computed again (CrossingsOf). Every value equals what a slab
-// test of each child's box gives, bit for bit: the planes are exact dyadic
-// fractions.
+// within [tMin, tMax] are stepped to (MetOctants). A child whose own
+// children the ray misses is passed over in the step that looks at it,
+// without going down. Going back up is part of the step that looks at the
+// next child, however many levels it climbs: the stack holds only nodes
+// with children left (one 64-bit word each, PausedNode), a bit per level
+// says which, and the traversal resumes at the deepest of them, its corner
+// cut from the current one and its crossings computed again (CrossingsOf).
+// Every value equals what a slab test of each child's box gives, bit for
+// bit: the planes are exact dyadic fractions.
 template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
