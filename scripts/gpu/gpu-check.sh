@@ -107,8 +107,9 @@ fi
 if want profile; then
   # RenderKernel launches of `--only render`: 10 with the copy to the host,
   # then 10 primary and 10 full frames at depth 10 (one of each profiled),
-  # then depth 16. The card's clocks are left as they are.
-  for run in primary:12 full:22; do
+  # then the same at depth 16 (its primary frame profiled too, the goal
+  # furthest off). The card's clocks are left as they are.
+  for run in primary:12 full:22 primary16:42; do
     step "profile-${run%%:*}" ncu --clock-control none -k regex:RenderKernel --launch-skip "${run##*:}" \
       --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
       --section MemoryWorkloadAnalysis --section WarpStateStats --section ComputeWorkloadAnalysis \
@@ -117,7 +118,8 @@ if want profile; then
       --csv --page details \
       --log-file "$out/profile-${run%%:*}.csv" $build/bin/octoray_bench_cuda --only render
   done
-  python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv > "$out/profile.txt" 2>&1
+  python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv "$out"/profile-primary16.csv \
+    > "$out/profile.txt" 2>&1
 fi
 if want profile-build; then
   # Every kernel of two 100 M-point builds at depth 10, timed by ncu with
@@ -185,7 +187,7 @@ printf '%s\n' "${status[@]}"
 files=()
 for f in summary.txt gpu.txt engine-tests.xml mapper-tests.xml bench-results-cuda.json quality-cuda.json \
   bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json orbit.json profile.txt \
-  profile-primary.csv profile-full.csv profile-build.txt; do
+  profile-primary.csv profile-full.csv profile-primary16.csv profile-build.txt; do
   [ -e "$out/$f" ] && files+=("$f")
 done
 (cd "$out" && tar czf report-files.tgz "${files[@]}")

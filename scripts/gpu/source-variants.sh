@@ -1,30 +1,67 @@
 #!/usr/bin/env bash
-# The render benchmark of source variants of the traversal, on the GPU
-# machine after gpu-check.sh (whose VTK in /tmp/vtk-egl it reuses): for each
-# NAME in SOURCE_VARIANTS, .gpu-vtk/variants/Traversal.NAME.h replaces
-# Rendering/Engine/octoray/Traversal.h in a build folder of its own, where
-# `octoray_bench_cuda --only render` runs; the tree's own Traversal.h is put
-# back after each. A variant file is made here from the commit Benchmarks/gpu/COMMAND.md
+# A benchmark section of source variants of engine headers, on the GPU
+# machine: for each NAME in SOURCE_VARIANTS, every .gpu-vtk/variants/FILE.NAME.h
+# replaces Rendering/Engine/octoray/FILE.h (Traversal.h, CudaUpload.h, ...)
+# in a copy of the tree with a build folder of its own; "main" names the
+# tree itself. All are built first (in parallel), then `octoray_bench_cuda
+# --only SECTION` (default render) runs ROUNDS times (default 1) over all of
+# them in turn, so that a drift of the card's clocks reaches every variant
+# alike. A variant file is made here from the commit Benchmarks/gpu/COMMAND.md
 # names and the patch in Benchmarks/gpu/variants/:
-#   git show COMMIT:Rendering/Engine/octoray/Traversal.h > .gpu-vtk/variants/Traversal.NAME.h
-#   patch .gpu-vtk/variants/Traversal.NAME.h Benchmarks/gpu/variants/NAME.patch
+#   git show COMMIT:Rendering/Engine/octoray/FILE.h > .gpu-vtk/variants/FILE.NAME.h
+#   patch .gpu-vtk/variants/FILE.NAME.h Benchmarks/gpu/variants/NAME.patch
 # and travels in the device call's carry (.gpu-vtk/variants).
 #
-#   SOURCE_VARIANTS="NAME..." scripts/gpu/source-variants.sh OUTDIR
+# Run after gpu-check.sh, it builds against that call's VTK (/tmp/vtk-egl);
+# without it, the engine alone (OCTORAY_ENABLE_VTK=OFF), which is all the
+# benchmark needs. With TESTS=1 the "main" folder also builds and runs the
+# engine's tests (both backends).
+#
+#   SOURCE_VARIANTS="main NAME..." [SECTION=render|build] [ROUNDS=N] [TESTS=1] \
+#     scripts/gpu/source-variants.sh OUTDIR
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-out=$1
+out=$(realpath -m "$1")
+mkdir -p "$out"
 vtk=/tmp/vtk-egl
-traversal=Rendering/Engine/octoray/Traversal.h
+section=${SECTION:-render}
+if [ -f "$vtk/lib/cmake/vtk-9.2/vtk-config.cmake" ]; then
+  with_vtk=(-DVTK_DIR="$vtk/lib/cmake/vtk-9.2")
+else
+  with_vtk=(-DOCTORAY_ENABLE_VTK=OFF)
+fi
+targets=(octoray_bench_cuda)
+[ "${TESTS:-0}" = 1 ] && targets+=(octoray_engine_tests)
+
+# Each variant gets a copy of the source tree, so that the builds can run
+# side by side.
 for v in ${SOURCE_VARIANTS:?name the variants}; do
-  cp $traversal /tmp/Traversal.main.h
-  cp .gpu-vtk/variants/Traversal.$v.h $traversal
-  vb=build-gpu-src-$v
-  { cmake -S . -B $vb -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 \
-      -DVTK_DIR="$vtk/lib/cmake/vtk-9.2" -DCMAKE_CXX_FLAGS='-include cstdint' \
-      -DOCTORAY_GTEST_SOURCE_DIR="$PWD/.gpu-vtk/googletest" >/dev/null &&
-    cmake --build $vb --target octoray_bench_cuda >/dev/null && $vb/bin/octoray_bench_cuda --only render; } > "$out/source-$v.log" 2>&1
-  cp /tmp/Traversal.main.h $traversal
+  src=/tmp/src-$v
+  rm -rf "$src" && mkdir -p "$src"
+  git ls-files -z | xargs -0 cp --parents -t "$src"
+  cp -r .gpu-vtk "$src/"
+  for f in .gpu-vtk/variants/*."$v".h; do
+    [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".h).h"
+  done
+  { cmake -S "$src" -B "$src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
+      -DCMAKE_CUDA_ARCHITECTURES=90 "${with_vtk[@]}" -DCMAKE_CXX_FLAGS='-include cstdint' \
+      -DOCTORAY_GTEST_SOURCE_DIR="$src/.gpu-vtk/googletest" &&
+    cmake --build "$src/build" --target "${targets[@]}" -j 8; } > "$out/build-$v.log" 2>&1 &
+done
+wait
+for v in $SOURCE_VARIANTS; do
+  [ -x /tmp/src-$v/build/bin/octoray_bench_cuda ] || { echo "== $v: build failed"; tail -5 "$out/build-$v.log"; }
+done
+if [ "${TESTS:-0}" = 1 ]; then
+  /tmp/src-main/build/bin/octoray_engine_tests > "$out/variant-main-tests.log" 2>&1
+  echo "== main: engine tests, exit $?"; grep -E "tests ran|PASSED|FAILED" "$out/variant-main-tests.log" | head -5
+fi
+for r in $(seq "${ROUNDS:-1}"); do
+  for v in $SOURCE_VARIANTS; do
+    /tmp/src-$v/build/bin/octoray_bench_cuda --only "$section" >> "$out/source-$v.log" 2>&1
+  done
+done
+for v in $SOURCE_VARIANTS; do
   echo "== source variant $v"
-  grep "render depth" "$out/source-$v.log"
+  grep -E "^(render depth|upload of|build n=.*depth=10)" "$out/source-$v.log"
 done
