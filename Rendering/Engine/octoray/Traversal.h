@@ -92,9 +92,9 @@ struct LevelOfDetail
   float footprintSlope = 0.0f;
   float pixels = 0.0f; // 0 (or less): always down to the leaves
 
-  // `voxel`: the node's side in the unit cube. Without a branch for
-  // pixels <= 0, which needs none (no side is below 0, nor below NaN where
-  // 0 meets an infinite footprint): the traversal asks at every step.
+  // `voxel`: the node's side in the unit cube. False for pixels <= 0 with
+  // no test of its own: no side is below 0, nor below NaN where 0 meets an
+  // infinite footprint.
   OCTORAY_HD bool StopAt(float voxel, float t) const
   {
     return voxel < pixels * (footprint0 + footprintSlope * (t > 0.0f ? t : 0.0f));
@@ -347,6 +347,9 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   float tEnter, float tExit)
 {
   const unsigned signs = DirectionSigns(ray);
+  // One test for the whole picture, mostly drawn down to the leaves, in
+  // place of StopAt's arithmetic at every step.
+  const bool lodOn = lod.pixels > 0.0f;
   PausedNode paused[kMaxLevel]; // by level, where `pausedLevels` has its bit
   unsigned pausedLevels = 0;
   Vec3f lo{ 0.0f, 0.0f, 0.0f }; // the current node's corner and side
@@ -394,7 +397,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       childLo[a] += (octant >> a) & 1u ? half : 0.0f;
     }
     const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
-    if (level + 1 == tree.depth || lod.StopAt(half, span.tEnter))
+    if (level + 1 == tree.depth || (lodOn && lod.StopAt(half, span.tEnter)))
     {
       const NodeHit hit{ child, level + 1, span.tEnter, span.tExit, EntryAxis(c, m, span.tEnter), childLo, half };
       if (visitor.Visit(hit))
