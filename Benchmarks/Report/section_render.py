@@ -238,7 +238,8 @@ def _cuda_cloud(ctx):
             "sparse and most rays cross the whole cube without a hit." % csv)
     profile = ctx.gpu_file("profile.txt")
     if profile:
-        text += ("\n\nNsight Compute on the render kernel, one depth-10 frame of each kind above (gpu-check.sh's "
+        text += ("\n\nNsight Compute on the render kernel, one depth-10 frame of each kind above and one "
+                 "depth-16 primary frame (gpu-check.sh's "
                  "`profile` part, `ncu --clock-control none`, [gpu/profile.txt](gpu/profile.txt); the kernel is "
                  "built with the register cap OCTORAY_RENDER_MIN_BLOCKS, Rendering/Engine/CMakeLists.txt):\n\n"
                  "```\n%s```\n" % open(profile).read())
