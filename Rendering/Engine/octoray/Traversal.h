@@ -240,17 +240,18 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
 
 // The mirrored octants the ray meets over [tEnter, tExit] inside a node
 // whose mid planes it crosses at midT and whose box it is in over all of
-// that interval (a part of its span will do): exactly the children whose slab test passes, zero-length touches
-// of edges and corners included. A child's span is empty only where one of
-// its near planes comes after one of its far planes. On one axis the near
-// face, mid plane and far face come in that order, and a near face never
-// comes after a far face of a node the ray is in, so three kinds of
-// comparison decide it: the near half of axis a needs its mid plane no
-// earlier than the entry, the far half no later than the exit, and an
-// octant past a's mid plane but not b's needs a's mid plane no later than
-// b's. Touches are kept, both where the ray crosses two mid planes at once:
-// keeping one of the two (one comparison per pair of axes) lets a ray
-// through a lattice of voxels' edges miss them all, a dotted line of holes.
+// that interval (a part of its span will do): exactly the children whose
+// slab test passes, zero-length touches of edges and corners included. A
+// child's span is empty only where one of its near planes comes after one of
+// its far planes. On one axis the near face, mid plane and far face come in
+// that order, and a near face never comes after a far face of a node the ray
+// is in, so three kinds of comparison decide it: the near half of axis a
+// needs its mid plane no earlier than the entry, the far half no later than
+// the exit, and an octant past a's mid plane but not b's needs a's mid plane
+// no later than b's. Touches are kept, both where the ray crosses two mid
+// planes at once: keeping one of the two (one comparison per pair of axes)
+// lets a ray through a lattice of voxels' edges miss them all, a dotted line
+// of holes.
 OCTORAY_HD_INLINE unsigned MetOctants(const Vec3f& midT, float tEnter, float tExit)
 {
   unsigned met = 0xFFu;
