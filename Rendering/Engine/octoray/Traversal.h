@@ -348,8 +348,9 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   float tEnter, float tExit)
 {
   const unsigned signs = DirectionSigns(ray);
-  // One test for the whole picture, mostly drawn down to the leaves, in
-  // place of StopAt's arithmetic at every step.
+  // Whether the picture has a level of detail at all (most are drawn down
+  // to the leaves): asked once here, so that those pictures skip StopAt's
+  // arithmetic at every step.
   const bool lodOn = lod.pixels > 0.0f;
   PausedNode paused[kMaxLevel]; // by level, where `pausedLevels` has its bit
   unsigned pausedLevels = 0;
