@@ -9,7 +9,9 @@
 //   spheres the synthetic sphere field of the render benchmark.
 // The distances are measured on the engine's own octree (Quantisation.h)
 // and checked against the analytic bound, half the leaf voxel's diagonal;
-// a distance past it fails the run.
+// a distance past it fails the run. Where the scene has 8-bit colours, the
+// rounding of the nodes' colours to bytes is measured too, against the
+// exact means, and checked against its bound (Attributes.h).
 //
 //   octoray_bench_quantisation [--backend cpu|cuda] [--depths 1-21]
 //                              [--ct PATH] [--lidar PATH] [--sphere-points N]
@@ -94,8 +96,9 @@ int main(int argc, char** argv)
     for (const Scene& scene : scenes)
     {
       std::printf("\nscene %s, %zu points\n", scene.name.c_str(), scene.points.count);
-      std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB |\n");
-      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+      std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB | "
+                  "colour steps leaf / inner / bound |\n");
+      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
       for (int depth = first; depth <= last; ++depth)
       {
         // A fresh engine per depth: one reused across depths keeps the
@@ -110,11 +113,21 @@ int main(int argc, char** argv)
         engine->CopyToHost(tree);
         const QuantisationError q = MeasureQuantisation(tree, scene.points);
         const double bytes = double(engine->Memory().Total());
+        const bool colours = !tree.color8.empty();
+        const ColourQuantisationError colour =
+          colours ? MeasureColourQuantisation(tree, scene.points) : ColourQuantisationError{};
         // The bound, less a relative 1e-12 for the rounding of the centre.
-        const bool ok = q.max <= q.bound * (1 + 1e-12);
+        const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound;
         withinBound = withinBound && ok;
-        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f |%s\n", depth, q.leafSide, q.max, q.mean,
-          q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, ok ? "" : " PAST THE BOUND");
+        char colourText[64] = "-";
+        if (colours)
+        {
+          std::snprintf(colourText, sizeof colourText, "%.3f / %.3f / %.1f", colour.leafMax, colour.innerMax,
+            colour.rootBound);
+        }
+        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s |%s\n", depth, q.leafSide, q.max,
+          q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText,
+          ok ? "" : " PAST THE BOUND");
         std::fflush(stdout);
         Record r{ "quantisation/" + scene.name, backend, scene.points.count, depth, t.median, "", 0.0 };
         r.With("max_distance", q.max)
@@ -125,13 +138,20 @@ int main(int argc, char** argv)
           .With("nodes", double(stats.nodes))
           .With("bytes", bytes)
           .With("min_seconds", t.min);
+        if (colours)
+        {
+          r.With("colour_leaf_steps", colour.leafMax)
+            .With("colour_inner_steps", colour.innerMax)
+            .With("colour_root_bound_steps", colour.rootBound);
+        }
         records.push_back(r);
       }
     }
     SaveRecords(json, records);
     if (!withinBound)
     {
-      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal\n");
+      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour its "
+                           "bound\n");
       return 1;
     }
   }

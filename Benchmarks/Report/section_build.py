@@ -479,11 +479,16 @@ def _quantisation(ctx):
     }
     parts, csv_rows = [], []
     worst = 0.0
+    worst_colour = [0.0, 0.0]  # steps of 1/255: leaves, inner nodes
     gpu_same = True
     for s in scenes_in:
         rows = []
         for r in (x for x in records if x["name"].endswith("/" + s)):
             worst = max(worst, r["max_distance"] / r["bound"])
+            colour = "colour_leaf_steps" in r
+            if colour:
+                worst_colour = [max(worst_colour[0], r["colour_leaf_steps"]),
+                                max(worst_colour[1], r["colour_inner_steps"])]
             g = gpu_by.get((r["name"], r["depth"]))
             if g is not None:
                 gpu_same = gpu_same and abs(g["max_distance"] - r["max_distance"]) <= 1e-12 * r["cube_size"] \
@@ -492,18 +497,21 @@ def _quantisation(ctx):
                 rows.append([r["depth"], "%.4g" % r["leaf_side"], "%.4g" % r["max_distance"], "%.4g" % r["mean_distance"],
                              "%.3f" % (r["max_distance"] / r["bound"]), count(r["nodes"]),
                              "%.2f" % (r["seconds"] * 1e3), "%.2f" % (r["bytes"] / 1e6),
-                             ("%.2f" % (g["seconds"] * 1e3)) if g else "–"])
+                             ("%.2f" % (g["seconds"] * 1e3)) if g else "–",
+                             ("%.2f / %.2f / %.1f" % (r["colour_leaf_steps"], r["colour_inner_steps"],
+                                                      r["colour_root_bound_steps"])) if colour else "–"])
             csv_rows.append([s, r["n"], r["depth"], r["cube_size"], r["leaf_side"], r["max_distance"],
                              r["mean_distance"], r["bound"], r["nodes"], r["seconds"], r["bytes"],
-                             g["seconds"] if g else ""])
+                             g["seconds"] if g else "", r.get("colour_leaf_steps", ""),
+                             r.get("colour_inner_steps", "")])
         n = next(x["n"] for x in records if x["name"].endswith("/" + s))
         parts.append("**%s**, %s points, root cube side %.6g:\n\n" % (describe.get(s, s), count(n), next(
             x["cube_size"] for x in records if x["name"].endswith("/" + s))) + ctx.table(
             ["depth", "leaf side", "max distance", "mean distance", "max / bound", "nodes", "build ms (CPU)",
-             "engine MB", "build ms (CUDA)"], rows, "rrrrrrrrr"))
+             "engine MB", "build ms (CUDA)", "colour error, steps: leaves / inner / bound"], rows, "rrrrrrrrrr"))
     csv = ctx.write_csv("build-quantisation", ["scene", "points", "depth", "cube_size", "leaf_side", "max_distance",
                                                "mean_distance", "bound", "nodes", "build_s_cpu", "engine_bytes",
-                                               "build_s_cuda"], csv_rows)
+                                               "build_s_cuda", "colour_leaf_steps", "colour_inner_steps"], csv_rows)
     png, link = ctx.figure_path("build-quantisation")
     _plot_quantisation(png, records, scenes_in, describe)
     gpu_line = ("The CUDA column is from %s; its distances %s the CPU's (the same tree)." % (
@@ -513,7 +521,15 @@ def _quantisation(ctx):
             "Odd depths and 21 shown; every depth is in the CSV. Build times of the small scenes are a fraction "
             "of a millisecond and swing with the machine's load; the error columns do not depend on it. "
             "Largest max / bound over every scene and depth: %.3f (≤ 1 by construction; the run fails if a distance "
-            "passes the bound). %s\n" % (worst, gpu_line))
+            "passes the bound). %s\n\n"
+            "8-bit colours are stored as bytes (Rendering/Engine/octoray/Attributes.h: 4 bytes a node where four "
+            "floats took 16; float colours, HDR included, stay floats). The last column measures that rounding on "
+            "the scenes with 8-bit colours: each node's stored channels against the exact mean of the 8-bit "
+            "channels of the points beneath it (Quantisation.h, the same walk), in steps of 1/255, the largest at "
+            "the leaves and above them, beside the bound at the root. A leaf's mean is rounded once (bound half a "
+            "step); an inner node's is the count-weighted mean of its children's rounded means, rounded again "
+            "(bound half a step more per level); the run fails past a node's bound. Largest over every scene and "
+            "depth: %.2f steps at the leaves, %.2f above them.\n" % (worst, gpu_line, worst_colour[0], worst_colour[1]))
 
 
 def _plot_quantisation(png, records, scene_names, describe):

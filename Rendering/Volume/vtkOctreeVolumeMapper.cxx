@@ -213,10 +213,14 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
     const vtkIdType id = node - begin;
     points->SetPoint(id, p);
     const octoray::Rgba c = tree.color.empty() ? octoray::Rgba{ 1, 1, 1, 1 } : tree.color[node];
-    const float rgba[4] = { c.r, c.g, c.b, c.a };
+    const octoray::Rgba8 c8 = tree.color8.empty()
+      ? octoray::Rgba8{ octoray::ChannelToByte(c.r), octoray::ChannelToByte(c.g), octoray::ChannelToByte(c.b),
+          octoray::ChannelToByte(c.a) }
+      : tree.color8[node];
+    const unsigned char rgba[4] = { c8.r, c8.g, c8.b, c8.a };
     for (int k = 0; k < 4; ++k)
     {
-      colors->SetTypedComponent(id, k, octoray::ChannelToByte(rgba[k]));
+      colors->SetTypedComponent(id, k, rgba[k]);
     }
     if (!tree.scalar.empty())
     {

@@ -204,6 +204,19 @@ TEST(Attributes, SlotsAndBitsFollowTheList)
   const Rgba mean = AttributeValue<Rgba>::Mean(sum, 0.5);
   EXPECT_EQ(mean.r, 0.5f);
   EXPECT_EQ(mean.a, 2.0f);
+  // Colours are stored as bytes, rounded to nearest and clamped to [0,1].
+  const double bytes[4] = { 0.0, 255.0 / 255.0, 128.0 / 255.0, 4.0 };
+  const Rgba8 mean8 = AttributeValue<Rgba8>::Mean(bytes, 0.5);
+  EXPECT_EQ(mean8.r, 0);
+  EXPECT_EQ(mean8.g, 128) << "127.5 rounds up";
+  EXPECT_EQ(mean8.b, 64);
+  EXPECT_EQ(mean8.a, 255);
+  AttributeValue<Rgba8>::ToSlots(Rgba8{ 0, 51, 255, 128 }, v);
+  EXPECT_FLOAT_EQ(v[1], 0.2f);
+  EXPECT_FLOAT_EQ(v[2], 1.0f);
+  EXPECT_FALSE(AttributeValue<Rgba>::kRounded);
+  EXPECT_TRUE(AttributeValue<Rgba8>::kRounded);
+  EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8));
 }
 
 // The vector operators round like the per-component expressions they stand

@@ -43,7 +43,7 @@ TEST_P(RenderTest, SurfaceMatchesBruteForceVoxelHits)
           continue;
         }
         ++hits;
-        const Rgba col = t.color[b.node];
+        const Rgba col = NodeColour(t, b.node);
         const bool same = std::fabs(image.rgba[4 * i] - col.r) < 1e-6 && std::fabs(image.rgba[4 * i + 1] - col.g) < 1e-6 &&
           std::fabs(image.rgba[4 * i + 2] - col.b) < 1e-6;
         agree += same;

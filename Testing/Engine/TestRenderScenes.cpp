@@ -629,7 +629,7 @@ TEST_P(SceneTest, NearPlaneInsideAVoxel)
       ASSERT_EQ(image.rgba[4 * i + 3] > 0, b.hit) << "pixel " << x << "," << y;
       if (!b.hit)
         continue;
-      EXPECT_TRUE(SameRgb(&image.rgba[4 * i], &t.color[b.node].r));
+      EXPECT_TRUE(SameRgb(&image.rgba[4 * i], NodeColour(t, b.node)));
       EXPECT_NEAR(image.depth[i], b.depth, 1e-6);
       if (b.t == 0)
       {

@@ -327,4 +327,15 @@ inline bool SameRgb(const float* pixel, const float c[3], float tol = 1e-6f)
 {
   return std::fabs(pixel[0] - c[0]) <= tol && std::fabs(pixel[1] - c[1]) <= tol && std::fabs(pixel[2] - c[2]) <= tol;
 }
+
+inline bool SameRgb(const float* pixel, const Rgba& c, float tol = 1e-6f)
+{
+  return SameRgb(pixel, &c.r, tol);
+}
+
+// A node's averaged colour as the engine draws it: float or 8-bit.
+inline Rgba NodeColour(const HostOctree& t, std::uint32_t node)
+{
+  return t.color.empty() ? ToRgba(t.color8.at(node)) : t.color[node];
+}
 }

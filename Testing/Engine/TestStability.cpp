@@ -41,9 +41,9 @@ void Record(const std::string& check, const std::string& outcome)
 
 // A leaf's colour as the picture should show it: its own, or from a
 // per-node table (a transfer function's lookup).
-const float* NodeRgb(const HostOctree& t, std::uint32_t node, const std::vector<Rgba>* colours = nullptr)
+Rgba NodeRgb(const HostOctree& t, std::uint32_t node, const std::vector<Rgba>* colours = nullptr)
 {
-  return colours ? &(*colours)[node].r : &t.color[node].r;
+  return colours ? (*colours)[node] : NodeColour(t, node);
 }
 
 // Whether the ray meets any leaf box grown by `margin` on every side (a
@@ -668,7 +668,10 @@ TEST_P(Stability, CoincidentPoints)
   for (std::size_t i = 0; i < c.Size(); ++i)
     for (int k = 0; k < 3; ++k)
       mean[k] += c.rgb[3 * i + k] / 255.0 / c.Size();
-  const float colour[3] = { float(mean[0]), float(mean[1]), float(mean[2]) };
+  // 8-bit colours: their mean is stored rounded to a byte (Attributes.h).
+  float colour[3];
+  for (int k = 0; k < 3; ++k)
+    colour[k] = float(std::lround(mean[k] * 255.0) / 255.0);
   BuildAndCompare(*engine, c, 5);
   const LeafPicture five = OneLeafPicture(*engine, colour, 1e-3);
   BuildAndCompare(*engine, c, 21);
@@ -681,7 +684,8 @@ TEST_P(Stability, CoincidentPoints)
   EXPECT_EQ(t.pointCount.back(), 1000u);
   Record("1000 points at one place: octree against the brute-force reference at depths 5, 21 and automatic "
          "(which must stop at 1); the picture of the one leaf against its box in double: outside a band of 1e-3 "
-         "voxel (1/4 at depth 21, 2 float ulps) coverage exact, colour = the mean of the 1000 colours to 2e-6, "
+         "voxel (1/4 at depth 21, 2 float ulps) coverage exact, colour = the mean of the 1000 8-bit colours rounded "
+         "to a byte, to 2e-6, "
          "hit distance within the band",
     Format("automatic depth %d; depth 5: ", t.depth) + Describe(five) + "; depth 21: " + Describe(deepest));
 }
@@ -1279,10 +1283,9 @@ TEST_P(Stability, OpacityOneEverywhere)
     const Image image = RenderChecked(*engine, settings);
     // What the first voxel should show: the transfer function's entry for
     // its scalar (in double), or its own colour.
-    std::vector<Rgba> colours(t.color);
-    if (transfer)
-      for (std::size_t n = 0; n < colours.size(); ++n)
-        colours[n] = TableEntry(settings.transfer, t.scalar[n]);
+    std::vector<Rgba> colours;
+    for (std::size_t n = 0; n < t.color.size(); ++n)
+      colours.push_back(transfer ? TableEntry(settings.transfer, t.scalar[n]) : t.color[n]);
     const HitComparison c = CompareWithFirstHits(image, t, vp, 1e-6, &colours);
     int notOpaque = 0;
     for (std::size_t i = 0; i < image.depth.size(); ++i)

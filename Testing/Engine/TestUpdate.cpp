@@ -93,14 +93,14 @@ TEST_P(OctreeUpdate, SmallMovesInsideLeavesChangeNothing)
   EXPECT_EQ(s.changedLeaf, 0u);
 }
 
-TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
+// Builds c (20 000 points, dense at depth 3: every leaf holds ~40 of them)
+// and moves 20 points onto other points' positions, which empties no leaf
+// and creates none.
+UpdateStats MoveOntoOtherPoints(Backend backend, Engine& engine, Cloud& c)
 {
-  // Dense at depth 3 (every leaf holds ~40 points), so moving 20 points onto
-  // other points' positions empties no leaf and creates none.
-  Cloud c = UniformCloud(20000, 32);
   BuildOptions options;
   options.depth = 3;
-  engine->Build(c.View(), options);
+  engine.Build(c.View(), options);
   std::vector<std::uint32_t> idx;
   std::vector<double> to;
   for (std::uint32_t k = 0; k < 20; ++k)
@@ -109,8 +109,25 @@ TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
     const std::uint32_t target = 19999 - k * 53;
     to.insert(to.end(), { c.xyz[3 * target], c.xyz[3 * target + 1], c.xyz[3 * target + 2] });
   }
-  const UpdateStats s = MoveAndCheck(GetParam(), *engine, c, idx, to);
+  return MoveAndCheck(backend, engine, c, idx, to);
+}
+
+TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
+{
+  Cloud c = UniformCloud(20000, 32).WithoutColours();
+  const UpdateStats s = MoveOntoOtherPoints(GetParam(), *engine, c);
   EXPECT_EQ(s.path, UpdateStats::Path::InPlace);
+  EXPECT_GT(s.changedLeaf, 10u);
+}
+
+// The same moves with colours: adjusting their byte-rounded means would
+// carry the rounding, so the update re-sorts, and every colour is again
+// within half a step of its mean (MoveAndCheck).
+TEST_P(OctreeUpdate, ColouredOctreesReSortInsteadOfAdjustingRoundedMeans)
+{
+  Cloud c = UniformCloud(20000, 32);
+  const UpdateStats s = MoveOntoOtherPoints(GetParam(), *engine, c);
+  EXPECT_EQ(s.path, UpdateStats::Path::Relevel);
   EXPECT_GT(s.changedLeaf, 10u);
 }
 

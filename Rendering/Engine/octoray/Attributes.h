@@ -31,20 +31,24 @@ namespace octoray
 // Optional per-point attributes, each stored per node as the plain mean over
 // the points beneath it, and only where the input had it:
 // X(member, Name, Type, Input, label). Input says how the caller's arrays
-// (PointCloudView) become the engine's: CopiedInput as given, ColorInput
-// widened to RGBA, UnitNormalInput scaled to unit length (OctreeDriver.h).
+// (PointCloudView) become the engine's: CopiedInput as given, the colour
+// inputs as RGBA in the caller's precision (floats, HDR allowed, or bytes: a
+// quarter of the memory, the means rounded to bytes), UnitNormalInput scaled
+// to unit length (OctreeDriver.h).
 // The mean of unit normals is shorter than 1 where they disagree and zero
 // where they cancel. Labels name the arrays in memory reports ("node
 // colours", "point colours") and out-of-memory errors.
 #define OCTORAY_ATTRIBUTES(X)                                                                                         \
-  X(color, Color, Rgba, ColorInput, "colours")                                                                       \
+  X(color, Color, Rgba, FloatColorInput, "colours")                                                                  \
+  X(color8, Color8, Rgba8, ByteColorInput, "8-bit colours")                                                          \
   X(scalar, Scalar, float, CopiedInput, "scalars")                                                                   \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
   X(normal, Normal, Vec3f, UnitNormalInput, "normals")
 
 struct CopiedInput;
-struct ColorInput;
+struct FloatColorInput;
+struct ByteColorInput;
 struct UnitNormalInput;
 
 enum AttributeIndex : int
@@ -72,6 +76,7 @@ struct AttributeValue
 {
   static_assert(sizeof(T) % sizeof(float) == 0 && std::is_trivially_copyable<T>::value, "a value made of floats");
   static constexpr int kSlots = static_cast<int>(sizeof(T) / sizeof(float));
+  static constexpr bool kRounded = false; // the mean is stored as computed
 
   OCTORAY_HD static void ToSlots(const T& value, float* v) { memcpy(v, &value, sizeof(T)); }
   OCTORAY_HD static T Mean(const double* sum, double inv)
@@ -87,6 +92,31 @@ struct AttributeValue
   }
 };
 
+// 8-bit colours are summed as four floats in [0,1] and stored as bytes. A
+// leaf's mean is rounded once; an inner node's is
+// the count-weighted mean of its children's rounded ones, rounded again
+// (ColourErrorBound). Being rounded, such a mean cannot be adjusted by the
+// points that leave and join a node (an update's in-place path): the
+// rounding would be carried into the new mean, multiplied where a node loses
+// most of its points.
+template <>
+struct AttributeValue<Rgba8>
+{
+  static constexpr int kSlots = 4;
+  static constexpr bool kRounded = true;
+
+  OCTORAY_HD static void ToSlots(const Rgba8& value, float* v)
+  {
+    const Rgba c = ToRgba(value);
+    v[0] = c.r, v[1] = c.g, v[2] = c.b, v[3] = c.a;
+  }
+  OCTORAY_HD static Rgba8 Mean(const double* sum, double inv)
+  {
+    auto channel = [&](int k) { return ChannelToByte(static_cast<float>(sum[k] * inv)); };
+    return Rgba8{ channel(0), channel(1), channel(2), channel(3) };
+  }
+};
+
 // The first slot of each attribute, and kSlotCount in all.
 enum AttributeSlot : int
 {
@@ -96,6 +126,19 @@ enum AttributeSlot : int
 #undef OCTORAY_SLOTS
     kSlotCount
 };
+
+// The largest difference between a node's stored 8-bit colour channel at
+// `level` and the exact mean of its points' channels: half a step (of 1/255)
+// at the leaves, half a step more for each level up.
+OCTORAY_HD constexpr double ColourErrorBound(int depth, int level)
+{
+  return 0.5 * (depth - level + 1) / 255.0;
+}
+
+// The attributes (AttributeBits) whose node means are stored rounded.
+#define OCTORAY_ROUNDED_BIT(member, Name, Type, ...) (AttributeValue<Type>::kRounded ? kHas##Name : 0u) |
+constexpr unsigned kRoundedAttributes = OCTORAY_ATTRIBUTES(OCTORAY_ROUNDED_BIT) 0u;
+#undef OCTORAY_ROUNDED_BIT
 
 // Descriptors that loops receive: the array's value type, index in its
 // list (attributes), presence bit (0: always present), first slot, label,

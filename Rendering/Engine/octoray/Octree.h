@@ -213,7 +213,7 @@ struct UpdateStats
   enum class Path
   {
     Unchanged,     // no point left its leaf: nothing to do
-    InPlace,       // same nodes: counts and averages adjusted along the moved points' paths
+    InPlace,       // same nodes: counts and averages adjusted along the moved points' paths (no colours)
     Relevel,       // nodes appeared or vanished: points re-sorted, levels rebuilt in the same buffers
     NewCube        // a point left the root cube: full rebuild around the new bounds
   } path = Path::Unchanged;

@@ -186,9 +186,15 @@ InputFloats InputFloatsOf(UnitNormalInput, A, const PointCloudView& points)
 }
 
 template <class A>
-InputFloats InputFloatsOf(ColorInput, A, const PointCloudView& points)
+InputFloats InputFloatsOf(FloatColorInput, A, const PointCloudView& points)
 {
   return InputFloats{ points.colorFloat, points.colorComponents * points.count };
+}
+
+template <class A>
+InputFloats InputFloatsOf(ByteColorInput, A, const PointCloudView&)
+{
+  return InputFloats{ nullptr, 0 }; // staged as color8
 }
 
 // A caller's attribute arrays, as given, where the device's loops read them.
@@ -234,11 +240,10 @@ void FillAttributes(Device& d, const PointCloudView& points, StagedAttributes<De
 }
 
 // The record layout of a cloud's attributes: those it has, in the list's
-// order, colours given as 8-bit in one word.
+// order, each a value of the type its nodes store.
 inline PointRecordLayout RecordLayoutOf(const PointCloudView& points)
 {
   PointRecordLayout layout;
-  layout.color8 = points.color8 != nullptr;
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
     if (!A::Input::template Present<A>(points))
@@ -246,9 +251,7 @@ inline PointRecordLayout RecordLayoutOf(const PointCloudView& points)
       return;
     }
     layout.offset[A::kIndex] = layout.stride;
-    layout.words[A::kIndex] =
-      A::kIndex == kAttributeColor && layout.color8 ? 1 : AttributeValue<typename A::Type>::kSlots;
-    layout.stride += layout.words[A::kIndex];
+    layout.stride += RecordWords(a);
   });
   return layout;
 }
@@ -278,23 +281,23 @@ OCTORAY_HD void StoreInput(UnitNormalInput, A, const AttributeInputs& in, std::s
   StoreInRecord(records, layout, i, A::kIndex, UnitNormal(n[0], n[1], n[2]));
 }
 
-// Colours become RGBA: 8-bit ones one word, float ones four; a missing
-// alpha is opaque.
+// Colours become RGBA in their own precision; a missing alpha is opaque.
 template <class A>
-OCTORAY_HD void StoreInput(ColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+OCTORAY_HD void StoreInput(FloatColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
   const PointRecordLayout& layout)
 {
   const int cc = in.colorComponents;
-  if (in.color8)
-  {
-    const std::uint8_t* c = in.color8 + cc * i;
-    StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
-  }
-  else
-  {
-    const float* c = in.values[A::kIndex] + cc * i;
-    StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
-  }
+  const float* c = in.values[A::kIndex] + cc * i;
+  StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
+}
+
+template <class A>
+OCTORAY_HD void StoreInput(ByteColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
+{
+  const int cc = in.colorComponents;
+  const std::uint8_t* c = in.color8 + cc * i;
+  StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
 }
 
 // The state's point records from the staged arrays: one loop writes each
@@ -760,7 +763,7 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   {
     stats.path = UpdateStats::Path::Unchanged;
   }
-  else if (changed <= s.count / kInPlaceUpdateShare &&
+  else if (changed <= s.count / kInPlaceUpdateShare && !(s.attributes & kRoundedAttributes) &&
     UpdateInPlace(d, scratch, s, changedMoves.Get(), changed, indices, from, into))
   {
     stats.changedLeaf = changed;
@@ -768,8 +771,9 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   }
   else
   {
-    // Nodes appear or empty, or too many points moved for the in-place
-    // path: the stored keys sorted again, the levels rebuilt in place.
+    // Nodes appear or empty, too many points moved for the in-place path,
+    // or the nodes hold rounded means (Attributes.h) that it cannot adjust:
+    // the stored keys sorted again, the levels rebuilt in place.
     BuildLevels(d, scratch, s, s.cube, s.depth, false);
     stats.changedLeaf = changed;
     stats.path = UpdateStats::Path::Relevel;

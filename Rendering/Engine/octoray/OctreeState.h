@@ -72,7 +72,9 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
   // Each attribute's words of the records.
   const PointRecordLayout& layout = s.points.layout;
   const std::size_t perWord = layout.stride ? s.points.records.Bytes() / layout.stride : 0;
-  ForEachAttribute([&](auto a) { m.Add(std::string("point ") + a.kLabel, layout.words[a.kIndex] * perWord); });
+  ForEachAttribute([&](auto a) {
+    m.Add(std::string("point ") + a.kLabel, layout.offset[a.kIndex] >= 0 ? RecordWords(a) * perWord : 0);
+  });
   m.Add("point keys", s.points.key.Bytes());
   m.Add("sort buffers", sortBytes);
   m.Add(MemoryReport::kAllocatorCache, cachedBytes);

@@ -21,19 +21,24 @@ namespace octoray
 struct PointRecordLayout
 {
   int offset[kAttributeCount]; // first word of each attribute; -1: absent
-  int words[kAttributeCount];  // words of each attribute; 0: absent
   int stride = 0;              // words per point
-  bool color8 = false;         // colour as one RGBA8 word (given as 8-bit), else 4 floats
 
   OCTORAY_HD PointRecordLayout()
   {
     for (int a = 0; a < kAttributeCount; ++a)
     {
       offset[a] = -1;
-      words[a] = 0;
     }
   }
 };
+
+// The words of attribute A in a record: a value of the type its nodes store.
+template <class A>
+constexpr int RecordWords(A)
+{
+  static_assert(sizeof(typename A::Type) % sizeof(std::uint32_t) == 0, "whole words");
+  return static_cast<int>(sizeof(typename A::Type) / sizeof(std::uint32_t));
+}
 
 // A value of type T into a point's record.
 template <typename T>
@@ -80,16 +85,6 @@ struct PointArraysView
       const int offset = layout.offset[A::kIndex];
       if (offset < 0)
       {
-        return;
-      }
-      if (A::kIndex == kAttributeColor && layout.color8)
-      {
-        Rgba8 c;
-        memcpy(&c, record + offset, sizeof c);
-        v[A::kSlot + 0] = c.r * (1.0f / 255.0f);
-        v[A::kSlot + 1] = c.g * (1.0f / 255.0f);
-        v[A::kSlot + 2] = c.b * (1.0f / 255.0f);
-        v[A::kSlot + 3] = c.a * (1.0f / 255.0f);
         return;
       }
       typename A::Type value;

@@ -24,7 +24,12 @@ struct CopiedInput // one value per point, in the member of the attribute's name
 struct UnitNormalInput : CopiedInput // 3 floats per point, of any length
 {
 };
-struct ColorInput // color8 or colorFloat, of colorComponents each
+struct FloatColorInput // colorFloat, of colorComponents each
+{
+  template <typename A>
+  static bool Present(const PointCloudView& points);
+};
+struct ByteColorInput // color8, of colorComponents each
 {
   template <typename A>
   static bool Present(const PointCloudView& points);
@@ -58,9 +63,15 @@ struct PointCloudView
 };
 
 template <typename A>
-bool ColorInput::Present(const PointCloudView& points)
+bool FloatColorInput::Present(const PointCloudView& points)
 {
-  return points.color8 != nullptr || points.colorFloat != nullptr;
+  return points.colorFloat != nullptr;
+}
+
+template <typename A>
+bool ByteColorInput::Present(const PointCloudView& points)
+{
+  return points.color8 != nullptr;
 }
 
 inline unsigned PointCloudView::Attributes() const

@@ -12,6 +12,9 @@
 // Header-only. The report's quantisation section measures it against leaf
 // depth (Benchmarks/Engine/BenchQuantisation.cpp); TestQuantisation checks it
 // against a brute-force recomputation.
+//
+// The same walk measures the rounding of 8-bit colours (Attributes.h): each
+// node's stored bytes against the exact mean of the points beneath it.
 #pragma once
 
 #include "Octree.h"
@@ -22,6 +25,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace octoray
 {
@@ -45,9 +49,22 @@ inline Vec3d VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey
   return origin + Vec3d{ cell[0] + 0.5, cell[1] + 0.5, cell[2] + 0.5 } * side;
 }
 
+// The largest difference, in steps of 1/255, between a stored 8-bit colour
+// channel and the exact mean of its points', at the leaves and above them,
+// and the bound at the root (ColourErrorBound).
+struct ColourQuantisationError
+{
+  double leafMax = 0.0;
+  double innerMax = 0.0;
+  double rootBound = 0.0;
+  bool withinBound = true; // every node within its level's bound
+};
+
 // The leaf of point i, found by walking the tree from the root; its node
-// index. Throws when the walk leaves the tree (the engine lost the point).
-inline std::uint32_t LeafOf(const HostOctree& tree, const PointCloudView& points, std::size_t i)
+// index. visit(node) is called for each node on the way, the root first.
+// Throws when the walk leaves the tree (the engine lost the point).
+template <class Visit>
+std::uint32_t WalkToLeaf(const HostOctree& tree, const PointCloudView& points, std::size_t i, Visit&& visit)
 {
   std::uint64_t full = 0;
   const Vec3d p = points.Position(i);
@@ -56,6 +73,7 @@ inline std::uint32_t LeafOf(const HostOctree& tree, const PointCloudView& points
     throw std::runtime_error("point " + std::to_string(i) + " lies outside the engine's root cube");
   }
   std::uint32_t node = 0;
+  visit(node);
   for (int level = 1; level <= tree.depth; ++level)
   {
     const unsigned octant = static_cast<unsigned>(AncestorKey(full, level) & 7u);
@@ -64,6 +82,7 @@ inline std::uint32_t LeafOf(const HostOctree& tree, const PointCloudView& points
       throw std::runtime_error("point " + std::to_string(i) + " has no node at level " + std::to_string(level));
     }
     node = ChildIndex(tree.childMask[node], tree.firstChild[node], octant);
+    visit(node);
   }
   if (tree.key[node] != AncestorKey(full, tree.depth))
   {
@@ -81,12 +100,49 @@ inline QuantisationError MeasureQuantisation(const HostOctree& tree, const Point
   double sum = 0.0;
   for (std::size_t i = 0; i < points.count; ++i)
   {
-    const std::uint32_t leaf = LeafOf(tree, points, i);
+    const std::uint32_t leaf = WalkToLeaf(tree, points, i, [](std::uint32_t) {});
     const double d = Length(points.Position(i) - VoxelCentre(tree.cube, tree.depth, tree.key[leaf]));
     q.max = std::max(q.max, d);
     sum += d;
   }
   q.mean = points.count ? sum / double(points.count) : 0.0;
   return q;
+}
+
+// Needs an octree of 8-bit colours (tree.color8) built from `points`.
+inline ColourQuantisationError MeasureColourQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  const int cc = points.colorComponents;
+  std::vector<double> sum(4 * tree.NodeCount(), 0.0);
+  for (std::size_t i = 0; i < points.count; ++i)
+  {
+    const std::uint8_t* c = points.color8 + cc * i;
+    const double rgba[4] = { double(c[0]), double(c[1]), double(c[2]), cc == 4 ? double(c[3]) : 255.0 };
+    WalkToLeaf(tree, points, i, [&](std::uint32_t node) {
+      for (int k = 0; k < 4; ++k)
+      {
+        sum[4 * node + k] += rgba[k];
+      }
+    });
+  }
+  ColourQuantisationError e;
+  e.rootBound = 255.0 * ColourErrorBound(tree.depth, 0);
+  for (int level = 0; level <= tree.depth; ++level)
+  {
+    const double bound = 255.0 * ColourErrorBound(tree.depth, level);
+    double& worst = level == tree.depth ? e.leafMax : e.innerMax;
+    for (std::uint32_t n = tree.levelBegin[level]; n < tree.levelBegin[level + 1]; ++n)
+    {
+      const Rgba8 stored = tree.color8[n];
+      const double bytes[4] = { double(stored.r), double(stored.g), double(stored.b), double(stored.a) };
+      for (int k = 0; k < 4; ++k)
+      {
+        const double steps = std::fabs(bytes[k] - sum[4 * n + k] / tree.pointCount[n]);
+        worst = std::max(worst, steps);
+        e.withinBound = e.withinBound && steps <= bound * (1 + 1e-9);
+      }
+    }
+  }
+  return e;
 }
 }

@@ -96,19 +96,6 @@ struct DeviceImage
   const float* depth = nullptr;
 };
 
-// A premultiplied channel in [0,1] as a byte, rounded to nearest; the same
-// byte on host and device (the device's multiply and add are spelled out
-// so that no build can fuse them).
-OCTORAY_HD std::uint8_t ChannelToByte(float v)
-{
-  v = Clamp01(v);
-#if defined(__CUDA_ARCH__)
-  return static_cast<std::uint8_t>(__fadd_rn(__fmul_rn(v, 255.0f), 0.5f));
-#else
-  return static_cast<std::uint8_t>(v * 255.0f + 0.5f);
-#endif
-}
-
 struct RenderStats
 {
   double seconds = 0.0;     // the frame, up to the picture in the backend's memory

@@ -207,19 +207,29 @@ OCTORAY_HD Vec3f RgbOf(const Rgba& c)
   return Vec3f{ c.r, c.g, c.b };
 }
 
+// A node's averaged colour, float or 8-bit, else white.
+OCTORAY_HD Rgba StoredColor(const OctreeView& tree, std::uint32_t node)
+{
+  if (tree.color)
+  {
+    return tree.color[node];
+  }
+  if (tree.color8)
+  {
+    return ToRgba(tree.color8[node]);
+  }
+  return Rgba{ 1.0f, 1.0f, 1.0f, 1.0f };
+}
+
 // Colour and opacity of a node: through the transfer function when the
-// frame has one and the node a scalar, else its averaged colour, else white.
+// frame has one and the node a scalar, else its averaged colour.
 OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::uint32_t node)
 {
   if (f.transfer && tree.scalar)
   {
     return TransferLookup(f, tree.scalar[node]);
   }
-  if (tree.color)
-  {
-    return tree.color[node];
-  }
-  return Rgba{ 1.0f, 1.0f, 1.0f, 1.0f };
+  return StoredColor(tree, node);
 }
 
 // Surface normal at a hit, facing the viewer. Averaged point normals where
@@ -390,7 +400,7 @@ struct BlendVisitor
 
   OCTORAY_HD float NodeLuminance(std::uint32_t node) const
   {
-    const Rgba c = tree->color ? tree->color[node] : Rgba{ 1, 1, 1, 1 };
+    const Rgba c = StoredColor(*tree, node);
     return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
   }
 };
