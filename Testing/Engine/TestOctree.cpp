@@ -424,6 +424,11 @@ TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
     gpu->CopyToHost(b);
     ExpectSameOctree(b, a, true);
   };
+  // 8-bit colours: their means rounded to the same bytes.
+  const Cloud coloured = GaussianClusters(30000, 25);
+  cpu->Build(coloured.View(), BuildOptions{});
+  gpu->Build(coloured.View(), BuildOptions{});
+  expectSame("build with 8-bit colours");
   // Every point twice (with other attributes), so that moving a copy onto
   // another point's place empties no leaf and creates none: the in-place
   // path, which octrees with colours do not take (Attributes.h).

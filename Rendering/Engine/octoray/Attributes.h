@@ -93,12 +93,11 @@ struct AttributeValue
 };
 
 // 8-bit colours are summed as four floats in [0,1] and stored as bytes. A
-// leaf's mean is rounded once; an inner node's is
-// the count-weighted mean of its children's rounded ones, rounded again
-// (ColourErrorBound). Being rounded, such a mean cannot be adjusted by the
-// points that leave and join a node (an update's in-place path): the
-// rounding would be carried into the new mean, multiplied where a node loses
-// most of its points.
+// leaf's mean is rounded once; an inner node's is the count-weighted mean of
+// its children's rounded ones, rounded again (ColourErrorBound). Being
+// rounded, such a mean cannot be adjusted by the points that leave and join
+// a node (an update's in-place path): the rounding would be carried into the
+// new mean, multiplied where a node loses most of its points.
 template <>
 struct AttributeValue<Rgba8>
 {

@@ -16,8 +16,8 @@ struct alignas(16) Rgba
 };
 
 // A colour of 8-bit channels, read and written as one 4-byte word: how the
-// octree stores node colours and the engine's copy of the points stores
-// theirs (a quarter of four floats, and within half a step of them).
+// octree and the engine's copy of the points keep colours given as 8-bit (a
+// quarter of the memory of four floats).
 struct alignas(4) Rgba8
 {
   std::uint8_t r, g, b, a;
