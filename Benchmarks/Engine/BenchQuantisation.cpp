@@ -9,9 +9,10 @@
 //   spheres the synthetic sphere field of the render benchmark.
 // The distances are measured on the engine's own octree (Quantisation.h)
 // and checked against the analytic bound, half the leaf voxel's diagonal;
-// a distance past it fails the run. Where the scene has 8-bit colours, the
-// rounding of the nodes' colours to bytes is measured too, against the
-// exact means, and checked against its bound (Attributes.h).
+// a distance past it fails the run. Where the scene has 8-bit colours or
+// normals, their rounding in the nodes (to bytes; to the octahedron's
+// 4-byte code) is measured too, against the exact means, and checked
+// against its bound (Attributes.h).
 //
 //   octoray_bench_quantisation [--backend cpu|cuda] [--depths 1-21]
 //                              [--ct PATH] [--lidar PATH] [--sphere-points N]
@@ -97,8 +98,8 @@ int main(int argc, char** argv)
     {
       std::printf("\nscene %s, %zu points\n", scene.name.c_str(), scene.points.count);
       std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB | "
-                  "colour steps leaf / inner / bound |\n");
-      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+                  "colour steps leaf / inner / bound | normal distance x1e-3 leaf / inner / bound |\n");
+      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
       for (int depth = first; depth <= last; ++depth)
       {
         // A fresh engine per depth: one reused across depths keeps the
@@ -113,20 +114,25 @@ int main(int argc, char** argv)
         engine->CopyToHost(tree);
         const QuantisationError q = MeasureQuantisation(tree, scene.points);
         const double bytes = double(engine->Memory().Total());
-        const bool colours = !tree.color8.empty();
-        const ColourQuantisationError colour =
-          colours ? MeasureColourQuantisation(tree, scene.points) : ColourQuantisationError{};
+        const bool colours = !tree.color8.empty(), normals = !tree.normal.empty();
+        const RoundingError colour = colours ? MeasureColourQuantisation(tree, scene.points) : RoundingError{};
+        const RoundingError normal = normals ? MeasureNormalQuantisation(tree, scene.points) : RoundingError{};
         // The bound, less a relative 1e-12 for the rounding of the centre.
-        const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound;
+        const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound && normal.withinBound;
         withinBound = withinBound && ok;
-        char colourText[64] = "-";
+        char colourText[64] = "-", normalText[64] = "-";
         if (colours)
         {
           std::snprintf(colourText, sizeof colourText, "%.3f / %.3f / %.1f", colour.leafMax, colour.innerMax,
             colour.rootBound);
         }
-        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s |%s\n", depth, q.leafSide, q.max,
-          q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText,
+        if (normals)
+        {
+          std::snprintf(normalText, sizeof normalText, "%.2f / %.2f / %.1f", 1e3 * normal.leafMax,
+            1e3 * normal.innerMax, 1e3 * normal.rootBound);
+        }
+        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s | %s |%s\n", depth, q.leafSide,
+          q.max, q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText, normalText,
           ok ? "" : " PAST THE BOUND");
         std::fflush(stdout);
         Record r{ "quantisation/" + scene.name, backend, scene.points.count, depth, t.median, "", 0.0 };
@@ -144,14 +150,20 @@ int main(int argc, char** argv)
             .With("colour_inner_steps", colour.innerMax)
             .With("colour_root_bound_steps", colour.rootBound);
         }
+        if (normals)
+        {
+          r.With("normal_leaf_distance", normal.leafMax)
+            .With("normal_inner_distance", normal.innerMax)
+            .With("normal_root_bound", normal.rootBound);
+        }
         records.push_back(r);
       }
     }
     SaveRecords(json, records);
     if (!withinBound)
     {
-      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour its "
-                           "bound\n");
+      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour "
+                           "or a normal its bound\n");
       return 1;
     }
   }

@@ -480,6 +480,7 @@ def _quantisation(ctx):
     parts, csv_rows = [], []
     worst = 0.0
     worst_colour = [0.0, 0.0]  # steps of 1/255: leaves, inner nodes
+    worst_normal = [0.0, 0.0]  # distance between vectors: leaves, inner nodes
     gpu_same = True
     for s in scenes_in:
         rows = []
@@ -489,6 +490,10 @@ def _quantisation(ctx):
             if colour:
                 worst_colour = [max(worst_colour[0], r["colour_leaf_steps"]),
                                 max(worst_colour[1], r["colour_inner_steps"])]
+            normal = "normal_leaf_distance" in r
+            if normal:
+                worst_normal = [max(worst_normal[0], r["normal_leaf_distance"]),
+                                max(worst_normal[1], r["normal_inner_distance"])]
             g = gpu_by.get((r["name"], r["depth"]))
             if g is not None:
                 gpu_same = gpu_same and abs(g["max_distance"] - r["max_distance"]) <= 1e-12 * r["cube_size"] \
@@ -499,19 +504,24 @@ def _quantisation(ctx):
                              "%.2f" % (r["seconds"] * 1e3), "%.2f" % (r["bytes"] / 1e6),
                              ("%.2f" % (g["seconds"] * 1e3)) if g else "–",
                              ("%.2f / %.2f / %.1f" % (r["colour_leaf_steps"], r["colour_inner_steps"],
-                                                      r["colour_root_bound_steps"])) if colour else "–"])
+                                                      r["colour_root_bound_steps"])) if colour else "–",
+                             ("%.2f / %.2f / %.1f" % (1e3 * r["normal_leaf_distance"], 1e3 * r["normal_inner_distance"],
+                                                      1e3 * r["normal_root_bound"])) if normal else "–"])
             csv_rows.append([s, r["n"], r["depth"], r["cube_size"], r["leaf_side"], r["max_distance"],
                              r["mean_distance"], r["bound"], r["nodes"], r["seconds"], r["bytes"],
                              g["seconds"] if g else "", r.get("colour_leaf_steps", ""),
-                             r.get("colour_inner_steps", "")])
+                             r.get("colour_inner_steps", ""), r.get("normal_leaf_distance", ""),
+                             r.get("normal_inner_distance", "")])
         n = next(x["n"] for x in records if x["name"].endswith("/" + s))
         parts.append("**%s**, %s points, root cube side %.6g:\n\n" % (describe.get(s, s), count(n), next(
             x["cube_size"] for x in records if x["name"].endswith("/" + s))) + ctx.table(
             ["depth", "leaf side", "max distance", "mean distance", "max / bound", "nodes", "build ms (CPU)",
-             "engine MB", "build ms (CUDA)", "colour error, steps: leaves / inner / bound"], rows, "rrrrrrrrrr"))
+             "engine MB", "build ms (CUDA)", "colour error, steps: leaves / inner / bound",
+             "normal error ×10⁻³: leaves / inner / bound"], rows, "rrrrrrrrrrr"))
     csv = ctx.write_csv("build-quantisation", ["scene", "points", "depth", "cube_size", "leaf_side", "max_distance",
                                                "mean_distance", "bound", "nodes", "build_s_cpu", "engine_bytes",
-                                               "build_s_cuda", "colour_leaf_steps", "colour_inner_steps"], csv_rows)
+                                               "build_s_cuda", "colour_leaf_steps", "colour_inner_steps",
+                                               "normal_leaf_distance", "normal_inner_distance"], csv_rows)
     png, link = ctx.figure_path("build-quantisation")
     _plot_quantisation(png, records, scenes_in, describe)
     gpu_line = ("The CUDA column is from %s; its distances %s the CPU's (the same tree)." % (
@@ -529,7 +539,17 @@ def _quantisation(ctx):
             "the leaves and above them, beside the bound at the root. A leaf's mean is rounded once (bound half a "
             "step); an inner node's is the count-weighted mean of its children's rounded means, rounded again "
             "(bound half a step more per level); the run fails past a node's bound. Largest over every scene and "
-            "depth: %.2f steps at the leaves, %.2f above them.\n" % (worst, gpu_line, worst_colour[0], worst_colour[1]))
+            "depth: %.2f steps at the leaves, %.2f above them.\n\n"
+            "Normals are stored in one 4-byte word where three floats took 12 (Rendering/Engine/octoray/"
+            "OctahedralNormal.h): the direction on the octahedron, 12 bits a coordinate, the length (the mean of "
+            "unit normals is shorter where they disagree) in 8 bits. The last column measures that rounding on the "
+            "scenes with normals: the distance between each node's decoded normal and the exact mean of its points' "
+            "unit normals (computed in double), in thousandths, the largest at the leaves and above them, beside "
+            "the bound at the root: the points' own rounding (at most 2√6/4094 = 1.2×10⁻³ in angle), plus, at the "
+            "leaves and again at each level up, that angle and half a length step (1/510). The run fails past a "
+            "node's bound. Largest over every scene and depth: %.2f×10⁻³ at the leaves, %.2f×10⁻³ above them "
+            "(1×10⁻³ is 0.057° for a unit normal).\n" % (
+                worst, gpu_line, worst_colour[0], worst_colour[1], 1e3 * worst_normal[0], 1e3 * worst_normal[1]))
 
 
 def _plot_quantisation(png, records, scene_names, describe):

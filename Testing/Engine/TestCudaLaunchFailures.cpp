@@ -139,7 +139,7 @@ TEST_F(CudaFaultsLaunch, RenderKeepsTheOctreeAndTheNextFrame)
 
 TEST_F(CudaFaultsLaunch, UpdateSaysWhatBecameOfTheOctree)
 {
-  const Cloud base = UniformCloud(4000, 64).WithoutColours(); // the in-place path: no rounded means
+  const Cloud base = UniformCloud(4000, 64).WithExactMeans(); // the in-place path: no rounded means
   const Cloud cloud = Doubled(base);
   BuildOptions options;
   options.depth = 6;

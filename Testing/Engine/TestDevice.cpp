@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <random>
 
@@ -216,7 +217,61 @@ TEST(Attributes, SlotsAndBitsFollowTheList)
   EXPECT_FLOAT_EQ(v[2], 1.0f);
   EXPECT_FALSE(AttributeValue<Rgba>::kRounded);
   EXPECT_TRUE(AttributeValue<Rgba8>::kRounded);
-  EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8));
+  EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8 | kHasNormal));
+}
+
+// Normals on the octahedron (OctahedralNormal.h): the axes exactly, every
+// direction within the stated angle, every vector no longer than 1 within
+// the stated distance, a stored vector unmoved when stored again.
+TEST(OctahedralNormal, ErrorsStayWithinTheirBounds)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    for (float sign : { -1.0f, 1.0f })
+    {
+      Vec3f axis{ 0.0f, 0.0f, 0.0f };
+      axis[a] = sign;
+      const Vec3f back = DecodeNormal(EncodeNormal(axis));
+      EXPECT_EQ(back.x, axis.x);
+      EXPECT_EQ(back.y, axis.y);
+      EXPECT_EQ(back.z, axis.z);
+    }
+  }
+  EXPECT_EQ(EncodeNormal(Vec3f{ 0.0f, 0.0f, 0.0f }).bits, 0u);
+  EXPECT_EQ(EncodeNormal(Vec3f{ 0.0f, 0.0f, 0.49f / kLengthSteps }).bits, 0u) << "under half a length step";
+  EXPECT_NEAR(Length(DecodeNormal(EncodeNormal(Vec3f{ 0.0f, 0.51f / kLengthSteps, 0.0f }))), 1.0 / kLengthSteps,
+    1e-7);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<float> gauss(0.0f, 1.0f);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  double worstAngle = 0.0, worstDistance = 0.0;
+  int recoded = 0;
+  for (int i = 0; i < 200000; ++i)
+  {
+    Vec3f d = Normalize(Vec3f{ gauss(rng), gauss(rng), gauss(rng) });
+    if (i % 4 == 0)
+    {
+      d[i % 3] = 0.0f; // on a fold line or the equator
+      d = Normalize(d);
+    }
+    const Vec3d back = ToDouble(DecodeNormal(EncodeNormal(d)));
+    worstAngle = std::max(worstAngle, std::acos(std::min(1.0, Dot(back, ToDouble(d)) / Length(back))));
+    const Vec3f v = d * unit(rng);
+    worstDistance = std::max(worstDistance, Length(ToDouble(DecodeNormal(EncodeNormal(v))) - ToDouble(v)));
+    // The square's outer edge holds each direction twice, so a code may
+    // re-encode to its twin, but never to another vector.
+    const Vec3f once = DecodeNormal(EncodeNormal(v));
+    const Vec3f twice = DecodeNormal(EncodeNormal(once));
+    recoded += !(once.x == twice.x && once.y == twice.y && once.z == twice.z);
+  }
+  EXPECT_EQ(recoded, 0) << "vectors that move when stored again";
+  EXPECT_LE(worstAngle, kOctDirectionError);
+  EXPECT_LE(worstDistance, kOctVectorError);
+  // The bounds are not loose by much: measured against stated.
+  EXPECT_GT(worstAngle, 0.25 * kOctDirectionError);
+  EXPECT_GT(worstDistance, 0.25 * kOctVectorError);
+  std::printf("octahedral normals: worst angle %.3g rad (bound %.3g), worst distance %.3g (bound %.3g)\n", worstAngle,
+    kOctDirectionError, worstDistance, kOctVectorError);
 }
 
 // The vector operators round like the per-component expressions they stand

@@ -424,17 +424,17 @@ TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
     gpu->CopyToHost(b);
     ExpectSameOctree(b, a, true);
   };
-  // 8-bit colours: their means rounded to the same bytes.
-  const Cloud coloured = GaussianClusters(30000, 25);
-  cpu->Build(coloured.View(), BuildOptions{});
-  gpu->Build(coloured.View(), BuildOptions{});
-  expectSame("build with 8-bit colours");
+  // 8-bit colours and normals: their means rounded to the same bits.
+  const Cloud rounded = GaussianClusters(30000, 25);
+  cpu->Build(rounded.View(), BuildOptions{});
+  gpu->Build(rounded.View(), BuildOptions{});
+  expectSame("build with 8-bit colours and normals");
   // Every point twice (with other attributes), so that moving a copy onto
   // another point's place empties no leaf and creates none: the in-place
-  // path, which octrees with colours do not take (Attributes.h).
-  Cloud c = GaussianClusters(30000, 25).WithoutColours();
+  // path, which octrees with rounded means do not take (Attributes.h).
+  Cloud c = GaussianClusters(30000, 25).WithExactMeans();
   const std::size_t n = c.Size();
-  Cloud twins = GaussianClusters(n, 26).WithoutColours();
+  Cloud twins = GaussianClusters(n, 26).WithExactMeans();
   twins.xyz = c.xyz;
   c.Append(twins);
   for (int depth : { 0, 9 })

@@ -114,16 +114,16 @@ UpdateStats MoveOntoOtherPoints(Backend backend, Engine& engine, Cloud& c)
 
 TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
 {
-  Cloud c = UniformCloud(20000, 32).WithoutColours();
+  Cloud c = UniformCloud(20000, 32).WithExactMeans();
   const UpdateStats s = MoveOntoOtherPoints(GetParam(), *engine, c);
   EXPECT_EQ(s.path, UpdateStats::Path::InPlace);
   EXPECT_GT(s.changedLeaf, 10u);
 }
 
-// The same moves with colours: adjusting their byte-rounded means would
-// carry the rounding, so the update re-sorts, and every colour is again
-// within half a step of its mean (MoveAndCheck).
-TEST_P(OctreeUpdate, ColouredOctreesReSortInsteadOfAdjustingRoundedMeans)
+// The same moves with 8-bit colours and normals: adjusting their rounded
+// means would carry the rounding, so the update re-sorts, and every colour
+// and normal is again within its bound of its mean (MoveAndCheck).
+TEST_P(OctreeUpdate, RoundedMeansReSortInsteadOfBeingAdjusted)
 {
   Cloud c = UniformCloud(20000, 32);
   const UpdateStats s = MoveOntoOtherPoints(GetParam(), *engine, c);

@@ -7,6 +7,7 @@
 // input array in PointCloudView and whatever reads it.
 #pragma once
 
+#include "OctahedralNormal.h"
 #include "Types.h"
 
 #include <cstdint>
@@ -34,7 +35,7 @@ namespace octoray
 // (PointCloudView) become the engine's: CopiedInput as given, the colour
 // inputs as RGBA in the caller's precision (floats, HDR allowed, or bytes: a
 // quarter of the memory, the means rounded to bytes), UnitNormalInput scaled
-// to unit length (OctreeDriver.h).
+// to unit length (OctreeDriver.h) and stored in one word (OctahedralNormal.h).
 // The mean of unit normals is shorter than 1 where they disagree and zero
 // where they cancel. Labels name the arrays in memory reports ("node
 // colours", "point colours") and out-of-memory errors.
@@ -44,7 +45,7 @@ namespace octoray
   X(scalar, Scalar, float, CopiedInput, "scalars")                                                                   \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
-  X(normal, Normal, Vec3f, UnitNormalInput, "normals")
+  X(normal, Normal, OctNormal, UnitNormalInput, "normals")
 
 struct CopiedInput;
 struct FloatColorInput;
@@ -116,6 +117,27 @@ struct AttributeValue<Rgba8>
   }
 };
 
+// Normals are summed as three floats and stored on the octahedron, rounded
+// as 8-bit colours are: a leaf's mean once, an inner node's again from its
+// children's rounded ones (NormalErrorBound).
+template <>
+struct AttributeValue<OctNormal>
+{
+  static constexpr int kSlots = 3;
+  static constexpr bool kRounded = true;
+
+  OCTORAY_HD static void ToSlots(const OctNormal& value, float* v)
+  {
+    const Vec3f n = DecodeNormal(value);
+    v[0] = n.x, v[1] = n.y, v[2] = n.z;
+  }
+  OCTORAY_HD static OctNormal Mean(const double* sum, double inv)
+  {
+    auto component = [&](int k) { return static_cast<float>(sum[k] * inv); };
+    return EncodeNormal(Vec3f{ component(0), component(1), component(2) });
+  }
+};
+
 // The first slot of each attribute, and kSlotCount in all.
 enum AttributeSlot : int
 {
@@ -132,6 +154,15 @@ enum AttributeSlot : int
 OCTORAY_HD constexpr double ColourErrorBound(int depth, int level)
 {
   return 0.5 * (depth - level + 1) / 255.0;
+}
+
+// The largest distance between a node's stored normal at `level` and the
+// exact mean of its points' unit normals: the points' own rounding (each
+// stored as its code, OctahedralNormal.h), a rounding at the leaves, one
+// more for each level up.
+OCTORAY_HD constexpr double NormalErrorBound(int depth, int level)
+{
+  return kOctDirectionError + (depth - level + 1) * kOctVectorError;
 }
 
 // The attributes (AttributeBits) whose node means are stored rounded.

@@ -278,7 +278,7 @@ OCTORAY_HD void StoreInput(UnitNormalInput, A, const AttributeInputs& in, std::s
   const PointRecordLayout& layout)
 {
   const float* n = in.values[A::kIndex] + 3 * i;
-  StoreInRecord(records, layout, i, A::kIndex, UnitNormal(n[0], n[1], n[2]));
+  StoreInRecord(records, layout, i, A::kIndex, EncodeNormal(UnitNormal(n[0], n[1], n[2])));
 }
 
 // Colours become RGBA in their own precision; a missing alpha is opaque.

@@ -13,8 +13,9 @@
 // depth (Benchmarks/Engine/BenchQuantisation.cpp); TestQuantisation checks it
 // against a brute-force recomputation.
 //
-// The same walk measures the rounding of 8-bit colours (Attributes.h): each
-// node's stored bytes against the exact mean of the points beneath it.
+// The same walk measures the rounding of 8-bit colours and normals
+// (Attributes.h): each node's stored value against the exact mean of the
+// points beneath it.
 #pragma once
 
 #include "Octree.h"
@@ -49,10 +50,12 @@ inline Vec3d VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey
   return origin + Vec3d{ cell[0] + 0.5, cell[1] + 0.5, cell[2] + 0.5 } * side;
 }
 
-// The largest difference, in steps of 1/255, between a stored 8-bit colour
-// channel and the exact mean of its points', at the leaves and above them,
-// and the bound at the root (ColourErrorBound).
-struct ColourQuantisationError
+// The rounding of a node attribute stored rounded (Attributes.h): the
+// largest difference between a node's stored value and the exact mean of
+// its points' values, at the leaves and above them, and the bound at the
+// root. 8-bit colours: the largest channel's, in steps of 1/255; normals:
+// the distance between the vectors.
+struct RoundingError
 {
   double leafMax = 0.0;
   double innerMax = 0.0;
@@ -109,40 +112,84 @@ inline QuantisationError MeasureQuantisation(const HostOctree& tree, const Point
   return q;
 }
 
-// Needs an octree of 8-bit colours (tree.color8) built from `points`.
-inline ColourQuantisationError MeasureColourQuantisation(const HostOctree& tree, const PointCloudView& points)
+// Sums each point's Slots values, pointValue(i, values), into every node on
+// its path, and compares each node's mean with its stored value by
+// difference(node, mean), against bound(level).
+template <int Slots, class PointValue, class Difference, class Bound>
+RoundingError MeasureRounding(const HostOctree& tree, const PointCloudView& points, PointValue&& pointValue,
+  Difference&& difference, Bound&& bound)
 {
-  const int cc = points.colorComponents;
-  std::vector<double> sum(4 * tree.NodeCount(), 0.0);
+  std::vector<double> sum(Slots * tree.NodeCount(), 0.0);
   for (std::size_t i = 0; i < points.count; ++i)
   {
-    const std::uint8_t* c = points.color8 + cc * i;
-    const double rgba[4] = { double(c[0]), double(c[1]), double(c[2]), cc == 4 ? double(c[3]) : 255.0 };
+    double value[Slots];
+    pointValue(i, value);
     WalkToLeaf(tree, points, i, [&](std::uint32_t node) {
-      for (int k = 0; k < 4; ++k)
+      for (int k = 0; k < Slots; ++k)
       {
-        sum[4 * node + k] += rgba[k];
+        sum[Slots * node + k] += value[k];
       }
     });
   }
-  ColourQuantisationError e;
-  e.rootBound = 255.0 * ColourErrorBound(tree.depth, 0);
+  RoundingError e;
+  e.rootBound = bound(0);
   for (int level = 0; level <= tree.depth; ++level)
   {
-    const double bound = 255.0 * ColourErrorBound(tree.depth, level);
     double& worst = level == tree.depth ? e.leafMax : e.innerMax;
     for (std::uint32_t n = tree.levelBegin[level]; n < tree.levelBegin[level + 1]; ++n)
     {
-      const Rgba8 stored = tree.color8[n];
-      const double bytes[4] = { double(stored.r), double(stored.g), double(stored.b), double(stored.a) };
-      for (int k = 0; k < 4; ++k)
+      double mean[Slots];
+      for (int k = 0; k < Slots; ++k)
       {
-        const double steps = std::fabs(bytes[k] - sum[4 * n + k] / tree.pointCount[n]);
-        worst = std::max(worst, steps);
-        e.withinBound = e.withinBound && steps <= bound * (1 + 1e-9);
+        mean[k] = sum[Slots * n + k] / tree.pointCount[n];
       }
+      const double d = difference(n, mean);
+      worst = std::max(worst, d);
+      e.withinBound = e.withinBound && d <= bound(level) * (1 + 1e-9);
     }
   }
   return e;
+}
+
+// Needs an octree of 8-bit colours (tree.color8) built from `points`.
+inline RoundingError MeasureColourQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  const int cc = points.colorComponents;
+  auto bytes = [&](std::size_t i, double rgba[4]) {
+    const std::uint8_t* c = points.color8 + cc * i;
+    for (int k = 0; k < 4; ++k)
+    {
+      rgba[k] = k < cc ? double(c[k]) : 255.0;
+    }
+  };
+  auto steps = [&](std::uint32_t n, const double mean[4]) {
+    const Rgba8 c = tree.color8[n];
+    const double stored[4] = { double(c.r), double(c.g), double(c.b), double(c.a) };
+    double worst = 0.0;
+    for (int k = 0; k < 4; ++k)
+    {
+      worst = std::max(worst, std::fabs(stored[k] - mean[k]));
+    }
+    return worst;
+  };
+  return MeasureRounding<4>(tree, points, bytes, steps,
+    [&](int level) { return 255.0 * ColourErrorBound(tree.depth, level); });
+}
+
+// Needs an octree of normals (tree.normal) built from `points`; the exact
+// means are of the caller's normals scaled to unit length in double.
+inline RoundingError MeasureNormalQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  auto unitNormal = [&](std::size_t i, double n[3]) {
+    const Vec3d v = ToDouble(Vec3f{ points.normal[3 * i], points.normal[3 * i + 1], points.normal[3 * i + 2] });
+    const double length = Length(v);
+    const Vec3d unit = length > 0.0 && std::isfinite(length) ? v / length : Vec3d{ 0.0, 0.0, 0.0 };
+    n[0] = unit.x, n[1] = unit.y, n[2] = unit.z;
+  };
+  auto distance = [&](std::uint32_t n, const double mean[3]) {
+    return Length(ToDouble(DecodeNormal(tree.normal[n])) - Vec3d{ mean[0], mean[1], mean[2] });
+  };
+  return MeasureRounding<3>(tree, points, unitNormal, distance,
+    [&](int level) { return NormalErrorBound(tree.depth, level); });
 }
 }
