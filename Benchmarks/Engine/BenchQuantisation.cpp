@@ -9,9 +9,9 @@
 //   spheres the synthetic sphere field of the render benchmark.
 // The distances are measured on the engine's own octree (Quantisation.h)
 // and checked against the analytic bound, half the leaf voxel's diagonal;
-// a distance past it fails the run. Where the scene has 8-bit colours or
-// normals, their rounding in the nodes (to bytes; to the octahedron's
-// 4-byte code) is measured too, against the exact means, and checked
+// a distance past it fails the run. Where the scene has 8-bit colours,
+// scalars or normals, their rounding in the nodes (to bytes; to 16 bits
+// over the range; to the octahedron's 4-byte code) is measured too, against the exact means, and checked
 // against its bound (Attributes.h).
 //
 //   octoray_bench_quantisation [--backend cpu|cuda] [--depths 1-21]
@@ -98,8 +98,9 @@ int main(int argc, char** argv)
     {
       std::printf("\nscene %s, %zu points\n", scene.name.c_str(), scene.points.count);
       std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB | "
-                  "colour steps leaf / inner / bound | normal distance x1e-3 leaf / inner / bound |\n");
-      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+                  "colour steps leaf / inner / bound | scalar steps leaf / inner / bound | "
+                  "normal distance x1e-3 leaf / inner / bound |\n");
+      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
       for (int depth = first; depth <= last; ++depth)
       {
         // A fresh engine per depth: one reused across depths keeps the
@@ -114,26 +115,33 @@ int main(int argc, char** argv)
         engine->CopyToHost(tree);
         const QuantisationError q = MeasureQuantisation(tree, scene.points);
         const double bytes = double(engine->Memory().Total());
-        const bool colours = !tree.color8.empty(), normals = !tree.normal.empty();
+        const bool colours = !tree.color8.empty(), scalars = !tree.scalar.empty(), normals = !tree.normal.empty();
         const RoundingError colour = colours ? MeasureColourQuantisation(tree, scene.points) : RoundingError{};
+        const RoundingError scalar = scalars ? MeasureScalarQuantisation(tree, scene.points) : RoundingError{};
         const RoundingError normal = normals ? MeasureNormalQuantisation(tree, scene.points) : RoundingError{};
         // The bound, less a relative 1e-12 for the rounding of the centre.
-        const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound && normal.withinBound;
+        const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound && scalar.withinBound &&
+          normal.withinBound;
         withinBound = withinBound && ok;
-        char colourText[64] = "-", normalText[64] = "-";
+        char colourText[64] = "-", scalarText[64] = "-", normalText[64] = "-";
         if (colours)
         {
           std::snprintf(colourText, sizeof colourText, "%.3f / %.3f / %.1f", colour.leafMax, colour.innerMax,
             colour.rootBound);
+        }
+        if (scalars)
+        {
+          std::snprintf(scalarText, sizeof scalarText, "%.3f / %.3f / %.1f", scalar.leafMax, scalar.innerMax,
+            scalar.rootBound);
         }
         if (normals)
         {
           std::snprintf(normalText, sizeof normalText, "%.2f / %.2f / %.1f", 1e3 * normal.leafMax,
             1e3 * normal.innerMax, 1e3 * normal.rootBound);
         }
-        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s | %s |%s\n", depth, q.leafSide,
-          q.max, q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText, normalText,
-          ok ? "" : " PAST THE BOUND");
+        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s | %s | %s |%s\n", depth,
+          q.leafSide, q.max, q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText,
+          scalarText, normalText, ok ? "" : " PAST THE BOUND");
         std::fflush(stdout);
         Record r{ "quantisation/" + scene.name, backend, scene.points.count, depth, t.median, "", 0.0 };
         r.With("max_distance", q.max)
@@ -150,6 +158,13 @@ int main(int argc, char** argv)
             .With("colour_inner_steps", colour.innerMax)
             .With("colour_root_bound_steps", colour.rootBound);
         }
+        if (scalars)
+        {
+          r.With("scalar_leaf_steps", scalar.leafMax)
+            .With("scalar_inner_steps", scalar.innerMax)
+            .With("scalar_root_bound_steps", scalar.rootBound)
+            .With("scalar_range", double(tree.scalarRange.hi) - tree.scalarRange.lo);
+        }
         if (normals)
         {
           r.With("normal_leaf_distance", normal.leafMax)
@@ -162,8 +177,8 @@ int main(int argc, char** argv)
     SaveRecords(json, records);
     if (!withinBound)
     {
-      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour "
-                           "or a normal its bound\n");
+      std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour, "
+                           "a scalar or a normal its bound\n");
       return 1;
     }
   }

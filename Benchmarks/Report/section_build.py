@@ -481,6 +481,7 @@ def _quantisation(ctx):
     worst = 0.0
     worst_colour = [0.0, 0.0]  # steps of 1/255: leaves, inner nodes
     worst_normal = [0.0, 0.0]  # distance between vectors: leaves, inner nodes
+    worst_scalar = [0.0, 0.0]  # steps of the scalar range / 65532: leaves, inner nodes
     gpu_same = True
     for s in scenes_in:
         rows = []
@@ -490,6 +491,10 @@ def _quantisation(ctx):
             if colour:
                 worst_colour = [max(worst_colour[0], r["colour_leaf_steps"]),
                                 max(worst_colour[1], r["colour_inner_steps"])]
+            scalar = "scalar_leaf_steps" in r
+            if scalar:
+                worst_scalar = [max(worst_scalar[0], r["scalar_leaf_steps"]),
+                                max(worst_scalar[1], r["scalar_inner_steps"])]
             normal = "normal_leaf_distance" in r
             if normal:
                 worst_normal = [max(worst_normal[0], r["normal_leaf_distance"]),
@@ -505,22 +510,27 @@ def _quantisation(ctx):
                              ("%.2f" % (g["seconds"] * 1e3)) if g else "–",
                              ("%.2f / %.2f / %.1f" % (r["colour_leaf_steps"], r["colour_inner_steps"],
                                                       r["colour_root_bound_steps"])) if colour else "–",
+                             ("%.2f / %.2f / %.1f" % (r["scalar_leaf_steps"], r["scalar_inner_steps"],
+                                                      r["scalar_root_bound_steps"])) if scalar else "–",
                              ("%.2f / %.2f / %.1f" % (1e3 * r["normal_leaf_distance"], 1e3 * r["normal_inner_distance"],
                                                       1e3 * r["normal_root_bound"])) if normal else "–"])
             csv_rows.append([s, r["n"], r["depth"], r["cube_size"], r["leaf_side"], r["max_distance"],
                              r["mean_distance"], r["bound"], r["nodes"], r["seconds"], r["bytes"],
                              g["seconds"] if g else "", r.get("colour_leaf_steps", ""),
-                             r.get("colour_inner_steps", ""), r.get("normal_leaf_distance", ""),
+                             r.get("colour_inner_steps", ""), r.get("scalar_leaf_steps", ""),
+                             r.get("scalar_inner_steps", ""), r.get("normal_leaf_distance", ""),
                              r.get("normal_inner_distance", "")])
         n = next(x["n"] for x in records if x["name"].endswith("/" + s))
         parts.append("**%s**, %s points, root cube side %.6g:\n\n" % (describe.get(s, s), count(n), next(
             x["cube_size"] for x in records if x["name"].endswith("/" + s))) + ctx.table(
             ["depth", "leaf side", "max distance", "mean distance", "max / bound", "nodes", "build ms (CPU)",
              "engine MB", "build ms (CUDA)", "colour error, steps: leaves / inner / bound",
-             "normal error ×10⁻³: leaves / inner / bound"], rows, "rrrrrrrrrrr"))
+             "scalar error, steps: leaves / inner / bound",
+             "normal error ×10⁻³: leaves / inner / bound"], rows, "rrrrrrrrrrrr"))
     csv = ctx.write_csv("build-quantisation", ["scene", "points", "depth", "cube_size", "leaf_side", "max_distance",
                                                "mean_distance", "bound", "nodes", "build_s_cpu", "engine_bytes",
                                                "build_s_cuda", "colour_leaf_steps", "colour_inner_steps",
+                                               "scalar_leaf_steps", "scalar_inner_steps",
                                                "normal_leaf_distance", "normal_inner_distance"], csv_rows)
     png, link = ctx.figure_path("build-quantisation")
     _plot_quantisation(png, records, scenes_in, describe)
@@ -533,13 +543,22 @@ def _quantisation(ctx):
             "Largest max / bound over every scene and depth: %.3f (≤ 1 by construction; the run fails if a distance "
             "passes the bound). %s\n\n"
             "8-bit colours are stored as bytes (Rendering/Engine/octoray/Attributes.h: 4 bytes a node where four "
-            "floats took 16; float colours, HDR included, stay floats). The last column measures that rounding on "
+            "floats took 16; float colours, HDR included, stay floats). The colour column measures that rounding on "
             "the scenes with 8-bit colours: each node's stored channels against the exact mean of the 8-bit "
             "channels of the points beneath it (Quantisation.h, the same walk), in steps of 1/255, the largest at "
             "the leaves and above them, beside the bound at the root. A leaf's mean is rounded once (bound half a "
             "step); an inner node's is the count-weighted mean of its children's rounded means, rounded again "
             "(bound half a step more per level); the run fails past a node's bound. Largest over every scene and "
             "depth: %.2f steps at the leaves, %.2f above them.\n\n"
+            "Scalars are stored in 16 bits where a float took 32 (Rendering/Engine/octoray/Scalar16.h): 65,532 "
+            "equal steps over the range of the build's finite scalars, kept with the octree; −∞, +∞ and NaN have "
+            "codes of their own. The scalar column measures that rounding on the scenes with scalars: each node's "
+            "decoded scalar against the exact mean of its points' scalars (in double), in steps of the range "
+            "/ 65,532, beside the bound at the root: half a step for the points' codes, the leaf's mean and each "
+            "level up, plus two float roundings of the range's ends in decoding (which is why a leaf of one point "
+            "can show a little over half a step). The run fails past a node's bound. Largest over every scene and "
+            "depth: %.3f steps at the leaves, %.3f above them. A step is 64 times finer than an entry of the "
+            "transfer function's table (1,024 entries) where the table spans the data's range.\n\n"
             "Normals are stored in one 4-byte word where three floats took 12 (Rendering/Engine/octoray/"
             "OctahedralNormal.h): the direction on the octahedron, 12 bits a coordinate, the length (the mean of "
             "unit normals is shorter where they disagree) in 8 bits. The last column measures that rounding on the "
@@ -549,7 +568,8 @@ def _quantisation(ctx):
             "leaves and again at each level up, that angle and half a length step (1/510). The run fails past a "
             "node's bound. Largest over every scene and depth: %.2f×10⁻³ at the leaves, %.2f×10⁻³ above them "
             "(1×10⁻³ is 0.057° for a unit normal).\n" % (
-                worst, gpu_line, worst_colour[0], worst_colour[1], 1e3 * worst_normal[0], 1e3 * worst_normal[1]))
+                worst, gpu_line, worst_colour[0], worst_colour[1], worst_scalar[0], worst_scalar[1],
+                1e3 * worst_normal[0], 1e3 * worst_normal[1]))
 
 
 def _plot_quantisation(png, records, scene_names, describe):

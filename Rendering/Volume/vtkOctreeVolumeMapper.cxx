@@ -224,7 +224,7 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
     }
     if (!tree.scalar.empty())
     {
-      scalars->SetValue(id, tree.scalar[node]);
+      scalars->SetValue(id, tree.Scalar(node));
     }
     verts->InsertNextCell(1, &id);
   }

@@ -217,7 +217,57 @@ TEST(Attributes, SlotsAndBitsFollowTheList)
   EXPECT_FLOAT_EQ(v[2], 1.0f);
   EXPECT_FALSE(AttributeValue<Rgba>::kRounded);
   EXPECT_TRUE(AttributeValue<Rgba8>::kRounded);
-  EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8 | kHasNormal));
+  EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8 | kHasScalar | kHasNormal));
+}
+
+// 16-bit scalars (Scalar16.h): within half a step of the range anywhere in
+// it, also far from zero; the ends exact; one value alone exact; -inf, +inf
+// and NaN kept, and means with them behave as float means do.
+TEST(Scalar16, ErrorsStayWithinHalfAStepOfTheRange)
+{
+  std::mt19937_64 rng(12);
+  for (const ScalarRange range : { ScalarRange{ -1024.0f, 3071.0f }, ScalarRange{ 1000.0f, 1000.5f } })
+  {
+    EXPECT_EQ(DecodeScalar(range, EncodeUnitScalar(range.ToUnit(range.lo))), range.lo);
+    EXPECT_EQ(DecodeScalar(range, EncodeUnitScalar(range.ToUnit(range.hi))), range.hi);
+    std::uniform_real_distribution<float> value(range.lo, range.hi);
+    double worst = 0.0;
+    for (int i = 0; i < 100000; ++i)
+    {
+      const float x = value(rng);
+      worst = std::max(worst, std::fabs(double(DecodeScalar(range, EncodeUnitScalar(range.ToUnit(x)))) - x));
+    }
+    // Half a step, and two roundings of a float the size of the range's
+    // ends in decoding. Where the steps are finer than the floats (1000 to
+    // 1000.5), every float decodes to itself.
+    const float largest = std::max(std::max(std::fabs(range.lo), std::fabs(range.hi)), range.hi - range.lo);
+    const double floatUlp = std::ldexp(1.0, std::ilogb(largest) - 23);
+    EXPECT_LE(worst, range.HalfStep() + 2 * floatUlp) << range.lo << " to " << range.hi;
+    if (range.HalfStep() > floatUlp)
+    {
+      EXPECT_GT(worst, 0.5 * range.HalfStep()) << "the bound is not loose";
+    }
+    else
+    {
+      EXPECT_EQ(worst, 0.0) << "floats coarser than the steps decode to themselves";
+    }
+  }
+  const ScalarRange one{ 7.5f, 7.5f };
+  EXPECT_EQ(DecodeScalar(one, EncodeUnitScalar(one.ToUnit(7.5f))), 7.5f);
+  const ScalarRange r{ 0.0f, 1.0f };
+  for (float special : { -INFINITY, INFINITY })
+  {
+    EXPECT_EQ(DecodeScalar(r, EncodeUnitScalar(r.ToUnit(special))), special);
+  }
+  EXPECT_TRUE(std::isnan(DecodeScalar(r, EncodeUnitScalar(r.ToUnit(NAN)))));
+  // A mean with +inf in it is +inf, with both infinities NaN.
+  float v[2];
+  AttributeValue<Scalar16>::ToSlots(EncodeUnitScalar(INFINITY), v);
+  AttributeValue<Scalar16>::ToSlots(EncodeUnitScalar(0.25f), v + 1);
+  const double withInf[1] = { double(v[0]) + v[1] };
+  EXPECT_EQ(AttributeValue<Scalar16>::Mean(withInf, 0.5).code, kScalarPlusInfinity);
+  const double bothInf[1] = { double(INFINITY) + double(-INFINITY) };
+  EXPECT_EQ(AttributeValue<Scalar16>::Mean(bothInf, 0.5).code, kScalarNaN);
 }
 
 // Normals on the octahedron (OctahedralNormal.h): the axes exactly, every

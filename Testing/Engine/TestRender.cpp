@@ -255,7 +255,7 @@ TEST_P(RenderTest, MaximumIntensityMatchesBruteForce)
         NodeBox(t, n, 4, lo, hi);
         // Skip grazing contacts, where the two methods may differ.
         if (Slab(ray, lo, hi, t0, t1) && t1 - t0 > 1e-6)
-          maxScalar = std::max(maxScalar, t.scalar[n]);
+          maxScalar = std::max(maxScalar, t.Scalar(n));
       }
       const std::size_t i = std::size_t(y) * w + x;
       if (maxScalar == -INFINITY)

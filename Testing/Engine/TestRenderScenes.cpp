@@ -509,7 +509,7 @@ TEST_P(SceneTest, VolumeBlendModesMatchABruteForceRayMarcher)
           double acc[4] = { 0, 0, 0, 0 };
           for (const Segment& sg : seg)
           {
-            const Rgba c = tf.table[TableIndex(t.scalar[sg.node], tf)];
+            const Rgba c = tf.table[TableIndex(t.Scalar(sg.node), tf)];
             const double alpha = 1 - std::pow(1 - c.a, sg.length / settings.opacityUnitDistance);
             const double wgt = (1 - acc[3]) * alpha;
             acc[0] += wgt * c.r, acc[1] += wgt * c.g, acc[2] += wgt * c.b, acc[3] += wgt;
@@ -524,9 +524,9 @@ TEST_P(SceneTest, VolumeBlendModesMatchABruteForceRayMarcher)
         for (const Segment& sg : seg)
         {
           if (mode == BlendMode::Minimum)
-            value = std::min(value, double(t.scalar[sg.node]));
+            value = std::min(value, double(t.Scalar(sg.node)));
           else
-            value += t.scalar[sg.node] * sg.length, length += sg.length;
+            value += t.Scalar(sg.node) * sg.length, length += sg.length;
         }
         if (mode == BlendMode::Average)
           value /= length;

@@ -1285,7 +1285,7 @@ TEST_P(Stability, OpacityOneEverywhere)
     // its scalar (in double), or its own colour.
     std::vector<Rgba> colours;
     for (std::size_t n = 0; n < t.color.size(); ++n)
-      colours.push_back(transfer ? TableEntry(settings.transfer, t.scalar[n]) : t.color[n]);
+      colours.push_back(transfer ? TableEntry(settings.transfer, t.Scalar(n)) : t.color[n]);
     const HitComparison c = CompareWithFirstHits(image, t, vp, 1e-6, &colours);
     int notOpaque = 0;
     for (std::size_t i = 0; i < image.depth.size(); ++i)

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -14,8 +15,8 @@
 
 namespace octoray::test
 {
-// Points with every attribute, so that every average is checked (colours
-// and normals can be dropped: WithExactMeans).
+// Points with every attribute, so that every average is checked (colours,
+// scalars and normals can be dropped: WithExactMeans).
 struct Cloud
 {
   std::vector<double> xyz;
@@ -48,12 +49,14 @@ struct Cloud
     normal.insert(normal.end(), other.normal.begin(), other.normal.end());
   }
 
-  // The cloud without its colours and normals: the nodes then hold no
-  // rounded means, and updates may take the in-place path (Attributes.h).
+  // The cloud without its colours, scalars and normals: the nodes then
+  // hold no rounded means, and updates may take the in-place path
+  // (Attributes.h).
   Cloud WithExactMeans() const
   {
     Cloud c = *this;
     c.rgb.clear();
+    c.scalar.clear();
     c.normal.clear();
     return c;
   }
@@ -65,7 +68,7 @@ struct Cloud
     v.xyzDouble = xyz.data();
     v.color8 = rgb.empty() ? nullptr : rgb.data();
     v.colorComponents = 3;
-    v.scalar = scalar.data();
+    v.scalar = scalar.empty() ? nullptr : scalar.data();
     v.reflectivity = reflectivity.data();
     v.refraction = refraction.data();
     v.normal = normal.empty() ? nullptr : normal.data();
@@ -176,7 +179,7 @@ inline std::vector<std::map<std::uint64_t, ReferenceNode>> ReferenceLevels(const
   for (std::size_t i = 0; i < c.Size(); ++i)
   {
     const std::uint64_t key = ReferenceKey(cube, &c.xyz[3 * i]);
-    double v[10] = { 0, 0, 0, 1.0, c.scalar[i], c.reflectivity[i], c.refraction[i], 0, 0, 0 };
+    double v[10] = { 0, 0, 0, 1.0, c.scalar.empty() ? 0.0 : c.scalar[i], c.reflectivity[i], c.refraction[i], 0, 0, 0 };
     for (int k = 0; k < 3 && !c.rgb.empty(); ++k)
     {
       v[k] = c.rgb[3 * i + k] / 255.0;
@@ -223,6 +226,14 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
     total += levels[l].size();
   }
   ASSERT_EQ(t.NodeCount(), total);
+  ASSERT_EQ(t.scalar.empty(), c.scalar.empty());
+  if (!c.scalar.empty())
+  {
+    // The scalars' codes are relative to their range (Scalar16.h).
+    const auto [lo, hi] = std::minmax_element(c.scalar.begin(), c.scalar.end());
+    EXPECT_EQ(t.scalarRange.lo, *lo);
+    EXPECT_EQ(t.scalarRange.hi, *hi);
+  }
   for (int l = 0; l <= t.depth; ++l)
   {
     std::uint32_t n = t.levelBegin[l];
@@ -271,7 +282,11 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
         EXPECT_NEAR(color.b, ref.sum[2] * inv, bound);
         EXPECT_EQ(color.a, 1.0f);
       }
-      EXPECT_NEAR(t.scalar[n], ref.sum[4] * inv, 5e-5);
+      if (!t.scalar.empty())
+      {
+        // 16 bits over the range, rounded per level.
+        EXPECT_NEAR(t.Scalar(n), ref.sum[4] * inv, ScalarErrorBound(t.scalarRange, t.depth, l) + 5e-5);
+      }
       EXPECT_NEAR(t.reflectivity[n], ref.sum[5] * inv, tol);
       EXPECT_NEAR(t.refraction[n], ref.sum[6] * inv, 4 * tol);
       ASSERT_EQ(t.normal.empty(), c.normal.empty());
@@ -288,13 +303,14 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
 }
 
 // Two octrees with the same topology and the same means: exactly (two
-// backends' builds of the same points), or within float rounding (means an
-// update adjusted by deltas against fresh ones: scalars, which span 100,
-// within 2e-4, every other slot within 1e-5). Every node array of
-// Attributes.h is compared.
+// backends' builds of the same points), or within float rounding, 1e-5
+// (means an update adjusted by deltas against fresh ones; rounded means are
+// never adjusted). Every node array of Attributes.h is compared.
 inline void ExpectSameOctree(const HostOctree& a, const HostOctree& b, bool exact = false)
 {
   ASSERT_EQ(a.depth, b.depth);
+  ASSERT_EQ(a.scalarRange.lo, b.scalarRange.lo);
+  ASSERT_EQ(a.scalarRange.hi, b.scalarRange.hi);
   ASSERT_EQ(a.levelBegin, b.levelBegin);
   ASSERT_EQ(a.attributes, b.attributes);
   ForEachNodeArray([&](auto array) {
@@ -320,7 +336,7 @@ inline void ExpectSameOctree(const HostOctree& a, const HostOctree& b, bool exac
         Value::ToSlots(y[n], v);
         for (int k = 0; k < Value::kSlots; ++k)
         {
-          const float tol = exact ? 0.0f : (A::kSlot + k == kSlotScalar ? 2e-4f : 1e-5f);
+          const float tol = exact ? 0.0f : 1e-5f;
           ASSERT_NEAR(u[k], v[k], tol) << "node " << A::kLabel << " slot " << k << " of node " << n;
         }
       }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "OctahedralNormal.h"
+#include "Scalar16.h"
 #include "Types.h"
 
 #include <cstdint>
@@ -34,20 +35,22 @@ namespace octoray
 // X(member, Name, Type, Input, label). Input says how the caller's arrays
 // (PointCloudView) become the engine's: CopiedInput as given, the colour
 // inputs as RGBA in the caller's precision (floats, HDR allowed, or bytes: a
-// quarter of the memory, the means rounded to bytes), UnitNormalInput scaled
-// to unit length (OctreeDriver.h) and stored in one word (OctahedralNormal.h).
+// quarter of the memory, the means rounded to bytes), ScalarInput in 16 bits
+// over the build's range (Scalar16.h), UnitNormalInput scaled to unit length
+// (OctreeDriver.h) and stored in one word (OctahedralNormal.h).
 // The mean of unit normals is shorter than 1 where they disagree and zero
 // where they cancel. Labels name the arrays in memory reports ("node
 // colours", "point colours") and out-of-memory errors.
 #define OCTORAY_ATTRIBUTES(X)                                                                                         \
   X(color, Color, Rgba, FloatColorInput, "colours")                                                                  \
   X(color8, Color8, Rgba8, ByteColorInput, "8-bit colours")                                                          \
-  X(scalar, Scalar, float, CopiedInput, "scalars")                                                                   \
+  X(scalar, Scalar, Scalar16, ScalarInput, "scalars")                                                                   \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
   X(normal, Normal, OctNormal, UnitNormalInput, "normals")
 
 struct CopiedInput;
+struct ScalarInput;
 struct FloatColorInput;
 struct ByteColorInput;
 struct UnitNormalInput;
@@ -117,6 +120,22 @@ struct AttributeValue<Rgba8>
   }
 };
 
+// Scalars are summed as their unit values and stored as codes (Scalar16.h):
+// a point's value is rounded once, a leaf's mean again, an inner node's
+// again from its children's (ScalarErrorBound).
+template <>
+struct AttributeValue<Scalar16>
+{
+  static constexpr int kSlots = 1;
+  static constexpr bool kRounded = true;
+
+  OCTORAY_HD static void ToSlots(const Scalar16& value, float* v) { v[0] = UnitScalar(value); }
+  OCTORAY_HD static Scalar16 Mean(const double* sum, double inv)
+  {
+    return EncodeUnitScalar(static_cast<float>(sum[0] * inv));
+  }
+};
+
 // Normals are summed as three floats and stored on the octahedron, rounded
 // as 8-bit colours are: a leaf's mean once, an inner node's again from its
 // children's rounded ones (NormalErrorBound).
@@ -163,6 +182,15 @@ OCTORAY_HD constexpr double ColourErrorBound(int depth, int level)
 OCTORAY_HD constexpr double NormalErrorBound(int depth, int level)
 {
   return kOctDirectionError + (depth - level + 1) * kOctVectorError;
+}
+
+// The largest difference between a node's decoded scalar at `level` and the
+// exact mean of its points' scalars (finite ones, in the build's `range`):
+// half a step for the points' codes, the leaf's mean and each level up.
+// Decoding adds a float's rounding of the range's ends, which callers allow.
+OCTORAY_HD double ScalarErrorBound(const ScalarRange& range, int depth, int level)
+{
+  return (depth - level + 2) * range.HalfStep();
 }
 
 // The attributes (AttributeBits) whose node means are stored rounded.

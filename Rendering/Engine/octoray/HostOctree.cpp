@@ -10,7 +10,7 @@ void HostOctree::Allocate(std::size_t nodes, unsigned attributeBits)
 
 OctreeView HostOctree::View()
 {
-  return MakeOctreeView(*this, depth, levelBegin.data(), levelBegin.size(), attributes, cube);
+  return MakeOctreeView(*this, depth, levelBegin.data(), levelBegin.size(), attributes, cube, scalarRange);
 }
 
 const char* ToString(UpdateStats::Path path)

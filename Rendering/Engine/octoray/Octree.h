@@ -43,6 +43,7 @@ struct OctreeView
   std::uint32_t levelBegin[kMaxLevel + 2] = {};  // nodes of level l: [levelBegin[l], levelBegin[l+1])
   unsigned attributes = 0;                       // AttributeBits present
   RootCube cube;
+  ScalarRange scalarRange; // the scalars' codes are relative to it (Scalar16.h)
 #define OCTORAY_POINTER(member, Name, Type, ...) Type* member = nullptr;
   OCTORAY_NODE_TOPOLOGY(OCTORAY_POINTER)
   OCTORAY_ATTRIBUTES(OCTORAY_POINTER)
@@ -96,7 +97,7 @@ auto DataOrNull(const Buffer& b) -> decltype(b.Get())
 // octree of `depth` and those levels.
 template <typename Arrays>
 OctreeView MakeOctreeView(Arrays& arrays, int depth, const std::uint32_t* levelBegin, std::size_t levels,
-  unsigned attributes, const RootCube& cube)
+  unsigned attributes, const RootCube& cube, const ScalarRange& scalarRange)
 {
   OctreeView v;
   v.depth = depth;
@@ -106,6 +107,7 @@ OctreeView MakeOctreeView(Arrays& arrays, int depth, const std::uint32_t* levelB
   }
   v.attributes = attributes;
   v.cube = cube;
+  v.scalarRange = scalarRange;
   ForEachNodeArray([&](auto a) {
     using A = decltype(a);
     A::Of(v) = const_cast<typename A::Type*>(DataOrNull(A::Of(arrays)));
@@ -126,8 +128,11 @@ struct HostOctree : NodeArrays<HostVector>
   std::vector<std::uint32_t> levelBegin;
   unsigned attributes = 0;
   RootCube cube;
+  ScalarRange scalarRange; // the scalars' codes are relative to it (Scalar16.h)
 
   std::size_t NodeCount() const { return key.size(); }
+  // Node n's scalar, decoded.
+  float Scalar(std::size_t n) const { return DecodeScalar(scalarRange, scalar[n]); }
   // Resizes every array for `nodes` nodes (attribute arrays only if present).
   void Allocate(std::size_t nodes, unsigned attributeBits);
   OctreeView View();

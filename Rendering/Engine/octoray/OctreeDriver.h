@@ -180,6 +180,12 @@ InputFloats InputFloatsOf(CopiedInput, A, const PointCloudView& points)
 }
 
 template <class A>
+InputFloats InputFloatsOf(ScalarInput, A, const PointCloudView& points)
+{
+  return InputFloats{ A::Of(points), points.count };
+}
+
+template <class A>
 InputFloats InputFloatsOf(UnitNormalInput, A, const PointCloudView& points)
 {
   return InputFloats{ A::Of(points), 3 * points.count };
@@ -262,6 +268,7 @@ struct AttributeInputs
   const std::uint8_t* color8;
   const float* values[kAttributeCount];
   int colorComponents;
+  ScalarRange scalarRange;
 };
 
 // What each kind of attribute input stores in point i's words of the
@@ -271,6 +278,13 @@ OCTORAY_HD void StoreInput(CopiedInput, A, const AttributeInputs& in, std::size_
   const PointRecordLayout& layout)
 {
   StoreInRecord(records, layout, i, A::kIndex, in.values[A::kIndex][i]);
+}
+
+template <class A>
+OCTORAY_HD void StoreInput(ScalarInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
+{
+  StoreInRecord(records, layout, i, A::kIndex, EncodeUnitScalar(in.scalarRange.ToUnit(in.values[A::kIndex][i])));
 }
 
 template <class A>
@@ -303,7 +317,8 @@ OCTORAY_HD void StoreInput(ByteColorInput, A, const AttributeInputs& in, std::si
 // The state's point records from the staged arrays: one loop writes each
 // point's whole record.
 template <class Device, class Points>
-void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged, Points& s)
+void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
+  const ScalarRange& scalarRange, Points& s)
 {
   const PointRecordLayout layout = s.layout = RecordLayoutOf(points);
   d.Reserve(s.records, points.count * layout.stride, "point attributes");
@@ -311,7 +326,7 @@ void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttri
   {
     return;
   }
-  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents };
+  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents, scalarRange };
   ForEachAttribute([&](auto a) { in.values[a.kIndex] = staged.values[a.kIndex].Get(); });
   std::uint32_t* records = s.records.Get();
   d.ForEach("PointRecordsKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
@@ -322,6 +337,23 @@ void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttri
       }
     });
   });
+}
+
+// The range of the staged scalars' finite values (Scalar16.h); none: 0 to 0.
+template <class Device>
+ScalarRange FiniteScalarRange(Device& d, const float* scalar, std::size_t n)
+{
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  const ScalarRange r = d.Reduce(
+    n, ScalarRange{ inf, -inf },
+    OCTORAY_LAMBDA(std::size_t i) {
+      const float x = scalar[i];
+      return std::isfinite(x) ? ScalarRange{ x, x } : ScalarRange{ inf, -inf };
+    },
+    OCTORAY_LAMBDA(const ScalarRange& a, const ScalarRange& b) {
+      return ScalarRange{ a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi };
+    });
+  return r.lo <= r.hi ? r : ScalarRange{};
 }
 
 // The cube a build uses: fitted to the staged positions, or the caller's
@@ -592,7 +624,9 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
     // copied while the device sorts.
     phase = std::chrono::steady_clock::now();
     FillAttributes(d, points, attributes);
-    IngestAttributes(d, points, attributes, s.points);
+    const float* scalar = attributes.values[kAttributeScalar].Get();
+    s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
+    IngestAttributes(d, points, attributes, s.scalarRange, s.points);
     attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
     uploadSeconds += SecondsSince(phase);
   });

@@ -76,6 +76,7 @@ public:
     const OctreeState<Device>& s = *State;
     out.depth = s.depth;
     out.cube = s.cube;
+    out.scalarRange = s.scalarRange;
     out.attributes = s.attributes;
     out.levelBegin.assign(s.levelBegin, s.levelBegin + kMaxLevel + 2);
     ForEachNodeArray([&](auto a) { Dev.Download(a.Of(s.nodes), a.Of(out)); });

@@ -23,6 +23,7 @@ struct OctreeState
 
   int depth = 0;
   RootCube cube;
+  ScalarRange scalarRange; // what the scalars' codes are relative to (Scalar16.h)
   std::uint32_t levelBegin[kMaxLevel + 2] = {}; // nodes of level l: [levelBegin[l], levelBegin[l+1])
   NodeArrays<Device::template Buffer> nodes;
 
@@ -37,7 +38,10 @@ struct OctreeState
     return v;
   }
 
-  OctreeView View() const { return MakeOctreeView(nodes, depth, levelBegin, kMaxLevel + 2, attributes, cube); }
+  OctreeView View() const
+  {
+    return MakeOctreeView(nodes, depth, levelBegin, kMaxLevel + 2, attributes, cube, scalarRange);
+  }
 };
 
 // Buffers a build keeps for the next, so that rebuilds of similar size

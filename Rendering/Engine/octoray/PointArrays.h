@@ -32,21 +32,26 @@ struct PointRecordLayout
   }
 };
 
+// The words a value of type T takes in a record: whole words, so that every
+// attribute starts on one (a 16-bit scalar is padded to a word).
+template <typename T>
+constexpr int kWordsOf = static_cast<int>((sizeof(T) + sizeof(std::uint32_t) - 1) / sizeof(std::uint32_t));
+
 // The words of attribute A in a record: a value of the type its nodes store.
 template <class A>
 constexpr int RecordWords(A)
 {
-  static_assert(sizeof(typename A::Type) % sizeof(std::uint32_t) == 0, "whole words");
-  return static_cast<int>(sizeof(typename A::Type) / sizeof(std::uint32_t));
+  return kWordsOf<typename A::Type>;
 }
 
-// A value of type T into a point's record.
+// A value of type T into a point's record, its padding zero.
 template <typename T>
 OCTORAY_HD void StoreInRecord(std::uint32_t* records, const PointRecordLayout& layout, std::size_t i, int attribute,
   const T& value)
 {
-  static_assert(sizeof(T) % sizeof(std::uint32_t) == 0, "whole words");
-  memcpy(records + i * layout.stride + layout.offset[attribute], &value, sizeof(T));
+  std::uint32_t words[kWordsOf<T>] = {};
+  memcpy(words, &value, sizeof(T));
+  memcpy(records + i * layout.stride + layout.offset[attribute], words, sizeof words);
 }
 
 // The point arrays a backend holds, each a Buffer<its type>.

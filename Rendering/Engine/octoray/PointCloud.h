@@ -21,6 +21,9 @@ struct CopiedInput // one value per point, in the member of the attribute's name
     return A::Of(points) != nullptr;
   }
 };
+struct ScalarInput : CopiedInput // one float per point, any value
+{
+};
 struct UnitNormalInput : CopiedInput // 3 floats per point, of any length
 {
 };

@@ -13,8 +13,8 @@
 // depth (Benchmarks/Engine/BenchQuantisation.cpp); TestQuantisation checks it
 // against a brute-force recomputation.
 //
-// The same walk measures the rounding of 8-bit colours and normals
-// (Attributes.h): each node's stored value against the exact mean of the
+// The same walk measures the rounding of 8-bit colours, scalars and
+// normals (Attributes.h): each node's stored value against the exact mean of the
 // points beneath it.
 #pragma once
 
@@ -53,8 +53,8 @@ inline Vec3d VoxelCentre(const RootCube& cube, int level, std::uint64_t levelKey
 // The rounding of a node attribute stored rounded (Attributes.h): the
 // largest difference between a node's stored value and the exact mean of
 // its points' values, at the leaves and above them, and the bound at the
-// root. 8-bit colours: the largest channel's, in steps of 1/255; normals:
-// the distance between the vectors.
+// root. 8-bit colours: the largest channel's, in steps of 1/255; scalars:
+// in steps of their range; normals: the distance between the vectors.
 struct RoundingError
 {
   double leafMax = 0.0;
@@ -174,6 +174,26 @@ inline RoundingError MeasureColourQuantisation(const HostOctree& tree, const Poi
   };
   return MeasureRounding<4>(tree, points, bytes, steps,
     [&](int level) { return 255.0 * ColourErrorBound(tree.depth, level); });
+}
+
+// Needs an octree of scalars (tree.scalar) built from `points`, all finite:
+// in steps of the range (Scalar16.h). The bound allows two roundings of a
+// float the size of the range's ends, which decoding adds.
+inline RoundingError MeasureScalarQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  const ScalarRange& range = tree.scalarRange;
+  const double step = 2.0 * range.HalfStep();
+  const double largest =
+    std::max({ std::fabs(double(range.lo)), std::fabs(double(range.hi)), double(range.hi) - range.lo });
+  const double decoding = largest > 0.0 ? std::ldexp(2.0, std::ilogb(largest) - 23) : 0.0;
+  auto value = [&](std::size_t i, double v[1]) { v[0] = points.scalar[i]; };
+  auto steps = [&](std::uint32_t n, const double mean[1]) {
+    const double d = std::fabs(double(tree.Scalar(n)) - mean[0]);
+    return step > 0.0 ? d / step : (d > 0.0 ? HUGE_VAL : 0.0);
+  };
+  return MeasureRounding<1>(tree, points, value, steps, [&](int level) {
+    return step > 0.0 ? (ScalarErrorBound(range, tree.depth, level) + decoding) / step : 0.0;
+  });
 }
 
 // Needs an octree of normals (tree.normal) built from `points`; the exact

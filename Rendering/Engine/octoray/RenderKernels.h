@@ -227,7 +227,7 @@ OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::
 {
   if (f.transfer && tree.scalar)
   {
-    return TransferLookup(f, tree.scalar[node]);
+    return TransferLookup(f, DecodeScalar(tree.scalarRange, tree.scalar[node]));
   }
   return StoredColor(tree, node);
 }
@@ -368,7 +368,7 @@ struct BlendVisitor
     {
       firstT = t0;
     }
-    const float s = tree->scalar ? tree->scalar[hit.node] : NodeLuminance(hit.node);
+    const float s = tree->scalar ? DecodeScalar(tree->scalarRange, tree->scalar[hit.node]) : NodeLuminance(hit.node);
     switch (f->blend)
     {
       case BlendMode::Composite:
