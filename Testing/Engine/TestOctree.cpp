@@ -216,7 +216,7 @@ TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
     EXPECT_EQ(GetParam(), Backend::CUDA);
     labels.pop_back();
   }
-  const std::vector<std::string> expected = { "node keys", "node child masks", "node first children", "node parents",
+  const std::vector<std::string> expected = { "node keys", "node child masks", "node first children",
     "node point counts", "node 8-bit colours", "node scalars", "node reflectivities", "node refraction indices",
     "node normals", "point positions", "point 8-bit colours", "point scalars", "point reflectivities",
     "point refraction indices", "point normals", "point keys", "sort buffers" };

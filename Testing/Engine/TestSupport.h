@@ -243,17 +243,6 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
       ASSERT_EQ(t.key[n], key);
       ASSERT_EQ(t.pointCount[n], ref.count);
       ASSERT_EQ(t.childMask[n], ref.childMask);
-      if (l == 0)
-      {
-        EXPECT_EQ(t.parent[n], kInvalidIndex);
-      }
-      else
-      {
-        const std::uint32_t p = t.parent[n];
-        ASSERT_GE(p, t.levelBegin[l - 1]);
-        ASSERT_LT(p, t.levelBegin[l]);
-        EXPECT_EQ(t.key[p], key >> 3);
-      }
       if (l == t.depth)
       {
         EXPECT_EQ(t.firstChild[n], kInvalidIndex);

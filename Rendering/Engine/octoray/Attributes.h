@@ -21,13 +21,13 @@ namespace octoray
 //   key         the node's level-local Morton key (3 * level bits)
 //   childMask   bit o set: the child in octant o exists
 //   firstChild  global index of the first child; kInvalidIndex for leaves
-//   parent      kInvalidIndex for the root
 //   pointCount  points beneath the node
+// A node's parent is implicit: the node one level up whose key is this
+// node's shifted by one octant (OctreeView::Find).
 #define OCTORAY_NODE_TOPOLOGY(X)                                                                                      \
   X(key, Key, std::uint64_t, "keys")                                                                                 \
   X(childMask, ChildMask, std::uint8_t, "child masks")                                                               \
   X(firstChild, FirstChild, std::uint32_t, "first children")                                                         \
-  X(parent, Parent, std::uint32_t, "parents")                                                                        \
   X(pointCount, PointCount, std::uint32_t, "point counts")
 
 // Optional per-point attributes, each stored per node as the plain mean over

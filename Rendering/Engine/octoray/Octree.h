@@ -121,7 +121,7 @@ using HostVector = std::vector<T>;
 
 // The octree in host memory (what tests and the VTK layer inspect): one
 // vector per node array (Attributes.h), named as there: key, childMask,
-// firstChild, parent, pointCount, color, scalar, ...
+// firstChild, pointCount, color, scalar, ...
 struct HostOctree : NodeArrays<HostVector>
 {
   int depth = 0;

@@ -128,16 +128,12 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
 }
 
 // Inner `node` has the children [c0, c1) (global indices, one level down):
-// child mask, links both ways, count and count-weighted means.
+// child mask, link to the first, count and count-weighted means.
 OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint64_t levelKey, std::uint32_t c0,
   std::uint32_t c1)
 {
   t.key[node] = levelKey;
   t.firstChild[node] = c0;
-  if (node == 0)
-  {
-    t.parent[0] = kInvalidIndex; // the root: no node links it as a child
-  }
   unsigned mask = 0;
   std::uint32_t count = 0;
   double sum[kSlotCount] = {};
@@ -145,7 +141,6 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   for (std::uint32_t c = c0; c < c1; ++c)
   {
     mask |= 1u << OctantOf(t.key[c]);
-    t.parent[c] = node;
     const std::uint32_t n = t.pointCount[c];
     count += n;
     if (t.attributes)
@@ -170,7 +165,10 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
 // (node, 2 * point + joins), depth + 1 per path, the old path first, stored
 // from `first` on; grouped by node (a stable sort) they give each touched
 // node's changes in a fixed order. False, with records that name no node,
-// when the new leaf does not exist: the topology changes.
+// when the new leaf does not exist: the topology changes. A path's nodes
+// are found by their keys, level by level (the octree keeps no links to
+// parents: a key's parent is the key shifted by one octant, and updates in
+// place, which alone would read such links, move few points).
 OCTORAY_HD bool WritePathRecords(const OctreeView& t, std::uint32_t point, std::uint64_t fromLeaf,
   std::uint64_t toLeaf, std::size_t first, std::uint32_t* recordNode, std::uint32_t* recordPoint)
 {
@@ -178,14 +176,15 @@ OCTORAY_HD bool WritePathRecords(const OctreeView& t, std::uint32_t point, std::
   bool found = true;
   for (int joins = 0; joins < 2; ++joins)
   {
-    std::uint32_t node = t.Find(t.depth, joins ? toLeaf : fromLeaf);
-    found = found && node != kInvalidIndex;
+    const std::uint64_t leaf = joins ? toLeaf : fromLeaf;
+    const bool exists = t.Find(t.depth, leaf) != kInvalidIndex;
+    found = found && exists;
     const std::size_t base = first + joins * pathLength;
     for (std::size_t step = 0; step < pathLength; ++step)
     {
-      recordNode[base + step] = node;
+      const int level = t.depth - static_cast<int>(step);
+      recordNode[base + step] = exists ? t.Find(level, leaf >> (3 * step)) : kInvalidIndex;
       recordPoint[base + step] = 2u * point + static_cast<std::uint32_t>(joins);
-      node = node == kInvalidIndex ? kInvalidIndex : t.parent[node];
     }
   }
   return found;
