@@ -5,7 +5,8 @@
 //  - update of 1% and 100% of 10 M points beside a full rebuild;
 //  - primary rays and shadow + one-bounce rays at 1920x1080, depth 10 and 16;
 //  - GPU bytes per point at depth 10 and 21, with the points kept for
-//    updates and without them (the node arrays alone);
+//    updates and without them (the node arrays alone), and per array for
+//    100 M points with every attribute;
 //  - the upload of the caller's pageable arrays beside plain cudaMemcpy and
 //    cudaHostRegister of the same arrays (--only build skips the rest);
 //  - with --billion N: N points generated on the device, built without
@@ -346,6 +347,45 @@ struct Record
   // (the report reads them; see BenchUtil.h's Record::extra).
   std::vector<std::pair<std::string, double>> extra = {};
 };
+
+// GPU bytes per point, and per array, of n clustered points with every
+// attribute (8-bit colours, scalars, reflectivity, normals), depth 10,
+// without the points: a static scene that a transfer function colours and
+// lights use. Each array as the engine's memory report names it.
+void ReportEveryAttribute(Engine& engine, std::size_t n, std::vector<Record>& records)
+{
+  Cloud c = MakeCloud(n, 2);
+  std::vector<float> scalar(n), normal(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    scalar[i] = c.xyz[3 * i] * 100.0f; // a ramp across the clusters, in HU-like units
+    const float* p = &c.xyz[3 * i];
+    for (int a = 0; a < 3; ++a)
+    {
+      normal[3 * i + a] = p[a]; // radial from the origin
+    }
+  }
+  PointCloudView v = c.View();
+  v.scalar = scalar.data();
+  v.normal = normal.data();
+  BuildOptions o;
+  o.depth = 10;
+  o.keepPoints = false;
+  const BuildStats stats = engine.Build(v, o);
+  const MemoryReport memory = engine.Memory();
+  std::printf("every attribute (8-bit colours, scalars, reflectivity, normals), n=%zu depth=10, points not kept: "
+              "%zu nodes, %.2f GPU bytes/point in arrays, %.2f with the allocator's cache; per array:",
+    n, stats.nodes, double(memory.ArrayBytes()) / n, double(memory.Total()) / n);
+  Record r{ "gpu bytes per point, every attribute", n, 10, double(memory.ArrayBytes()) / n, "", 0,
+    { { "total_bytes_per_point", double(memory.Total()) / n }, { "nodes", double(stats.nodes) } } };
+  for (const auto& [name, bytes] : memory.arrays)
+  {
+    std::printf(" %s %.2f;", name.c_str(), double(bytes) / n);
+    r.extra.push_back({ name, double(bytes) / n });
+  }
+  std::printf("\n");
+  records.push_back(r);
+}
 }
 
 // n points generated on the device (ClusteredPointsKernel) and built
@@ -523,6 +563,12 @@ int Run(int argc, char** argv)
     {
       ten = c;
     }
+  }
+
+  // Memory with every attribute a lit scene of scalars and colours uses.
+  if (section("build") && std::find(sizes.begin(), sizes.end(), std::size_t(100000000)) != sizes.end())
+  {
+    ReportEveryAttribute(*engine, 100000000, records);
   }
 
   // Update of 1% and 100% of 10 M points against a rebuild.

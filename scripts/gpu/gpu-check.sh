@@ -172,7 +172,7 @@ echo "== octoray GPU check, $(date -u +%Y-%m-%d): $(cat "$out/gpu.txt") =="
 for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper; do
   [ -f "$out/$f.log" ] && echo "$f: $(grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out/$f.log" | sort | uniq -c | tr -s ' ' | paste -sd';')"
 done
-[ -f "$out/bench.log" ] && grep -E "^(device|upload|build|update|render)" "$out/bench.log"
+[ -f "$out/bench.log" ] && grep -E "^(device|upload|build|every attribute|update|render)" "$out/bench.log"
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
 [ -f "$out/profile-build.txt" ] && head -25 "$out/profile-build.txt"
 [ -f "$out/sass-primary.txt" ] && echo "sass-primary.txt: $(grep -c '/\*[0-9a-f]*\*/' "$out/sass-primary.txt") instructions"
