@@ -38,7 +38,8 @@ targets=(octoray_bench_cuda)
 for v in ${SOURCE_VARIANTS:?name the variants}; do
   src=/tmp/src-$v
   rm -rf "$src" && mkdir -p "$src"
-  git ls-files -z | xargs -0 cp --parents -t "$src"
+  # Tracked files and new ones not yet in the index the copy arrived with.
+  git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$src"
   cp -r .gpu-vtk "$src/"
   for f in .gpu-vtk/variants/*."$v".h; do
     [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".h).h"
