@@ -44,7 +44,7 @@ TEST_P(OctreeBuild, TwoOppositeCorners)
   // The corners fall in octants 0 and 7 of the root.
   HostOctree t;
   engine->CopyToHost(t);
-  EXPECT_EQ(t.childMask[0], 0x81);
+  EXPECT_EQ(ChildMaskOf(t, 0), 0x81u);
   BuildAndCompare(*engine, two, 0);
   engine->CopyToHost(t);
   EXPECT_EQ(t.depth, 1);

@@ -226,6 +226,15 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
     total += levels[l].size();
   }
   ASSERT_EQ(t.NodeCount(), total);
+  // Eight nodes' masks to a word, the last word's spare bytes zero; one
+  // first child per group of eight (Attributes.h).
+  ASSERT_EQ(t.childMasks.size(), (total + 7) / 8);
+  ASSERT_EQ(t.childBase.size(), (total + 7) / 8);
+  const std::size_t used = 1 + (total - 1) % 8;
+  if (used < 8)
+  {
+    EXPECT_EQ(t.childMasks.back() >> (8 * used), 0u) << "spare bytes of the last word";
+  }
   ASSERT_EQ(t.scalar.empty(), c.scalar.empty());
   if (!c.scalar.empty())
   {
@@ -242,14 +251,14 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
       SCOPED_TRACE("level " + std::to_string(l) + " node " + std::to_string(n));
       ASSERT_EQ(t.key[n], key);
       ASSERT_EQ(t.pointCount[n], ref.count);
-      ASSERT_EQ(t.childMask[n], ref.childMask);
+      ASSERT_EQ(ChildMaskOf(t, n), ref.childMask);
       if (l == t.depth)
       {
-        EXPECT_EQ(t.firstChild[n], kInvalidIndex);
+        EXPECT_EQ(FirstChildOf(t, n), t.NodeCount()) << "a leaf's children would follow every node";
       }
       else
       {
-        const std::uint32_t f = t.firstChild[n];
+        const std::uint32_t f = FirstChildOf(t, n);
         ASSERT_GE(f, t.levelBegin[l + 1]);
         ASSERT_LT(f, t.levelBegin[l + 2]);
         EXPECT_EQ(t.key[f] >> 3, key);

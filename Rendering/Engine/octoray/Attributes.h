@@ -17,18 +17,27 @@
 
 namespace octoray
 {
-// Arrays every node has, whatever the input: X(member, Name, Type, label).
+// Arrays every node has, whatever the input: X(member, Name, Type,
+// nodesPerEntry, label).
 //   key         the node's level-local Morton key (3 * level bits)
-//   childMask   bit o set: the child in octant o exists
-//   firstChild  global index of the first child; kInvalidIndex for leaves
+//   childMasks  each node's child mask (bit o set: the child in octant o
+//               exists), eight nodes' to a word: node n's is byte n % 8 of
+//               word n / 8 (the last word's spare bytes zero)
+//   childBase   for each group of eight nodes, the global index of the first
+//               node's first child
 //   pointCount  points beneath the node
-// A node's parent is implicit: the node one level up whose key is this
-// node's shifted by one octant (OctreeView::Find).
+// Child and parent links are implicit. Children are stored level by level
+// in the order of their parents, so node n's first child is 1 plus the
+// children of every node before it: its group's childBase plus the bits of
+// the masks before n in the same word (FirstChildOf, Octree.h). That is
+// half a byte a node where a 32-bit link took 4. A node's parent is the node
+// one level up whose key is this node's shifted by one octant
+// (OctreeView::Find).
 #define OCTORAY_NODE_TOPOLOGY(X)                                                                                      \
-  X(key, Key, std::uint64_t, "keys")                                                                                 \
-  X(childMask, ChildMask, std::uint8_t, "child masks")                                                               \
-  X(firstChild, FirstChild, std::uint32_t, "first children")                                                         \
-  X(pointCount, PointCount, std::uint32_t, "point counts")
+  X(key, Key, std::uint64_t, 1, "keys")                                                                              \
+  X(childMasks, ChildMasks, std::uint64_t, 8, "child masks")                                                         \
+  X(childBase, ChildBase, std::uint32_t, 8, "first children")                                                        \
+  X(pointCount, PointCount, std::uint32_t, 1, "point counts")
 
 // Optional per-point attributes, each stored per node as the plain mean over
 // the points beneath it, and only where the input had it:
@@ -222,12 +231,13 @@ enum TopologyIndex : int
     return arrays.member;                                                                                            \
   }
 
-#define OCTORAY_DESCRIBE_TOPOLOGY(member, Name, Type_, label)                                                        \
+#define OCTORAY_DESCRIBE_TOPOLOGY(member, Name, Type_, nodesPerEntry, label)                                         \
   template <>                                                                                                        \
   struct TopologyArray<kTopology##Name>                                                                              \
   {                                                                                                                  \
     using Type = Type_;                                                                                              \
     static constexpr unsigned kBit = 0;                                                                              \
+    static constexpr std::size_t kNodesPerEntry = nodesPerEntry;                                                     \
     static constexpr const char* kLabel = label;                                                                     \
     OCTORAY_ARRAY_OF(member)                                                                                         \
   };
@@ -243,6 +253,7 @@ OCTORAY_NODE_TOPOLOGY(OCTORAY_DESCRIBE_TOPOLOGY)
     static constexpr int kIndex = kAttribute##Name;                                                                  \
     static constexpr unsigned kBit = kHas##Name;                                                                     \
     static constexpr int kSlot = kSlot##Name;                                                                        \
+    static constexpr std::size_t kNodesPerEntry = 1;                                                                 \
     static constexpr const char* kLabel = label;                                                                     \
     OCTORAY_ARRAY_OF(member)                                                                                         \
   };
@@ -272,6 +283,13 @@ void ForEachNodeArray(Fn&& fn)
   OCTORAY_NODE_TOPOLOGY(OCTORAY_CALL)
 #undef OCTORAY_CALL
   ForEachAttribute(fn);
+}
+
+// Entries of the array in an octree of `nodes` nodes (of those present).
+template <typename Descriptor>
+constexpr std::size_t EntriesFor(Descriptor, std::size_t nodes)
+{
+  return (nodes + Descriptor::kNodesPerEntry - 1) / Descriptor::kNodesPerEntry;
 }
 
 // Whether an octree of `attributes` (AttributeBits) has the array.

@@ -2,12 +2,6 @@
 
 namespace octoray
 {
-void HostOctree::Allocate(std::size_t nodes, unsigned attributeBits)
-{
-  attributes = attributeBits;
-  ForEachNodeArray([&](auto a) { a.Of(*this).resize(Present(a, attributeBits) ? nodes : 0); });
-}
-
 OctreeView HostOctree::View()
 {
   return MakeOctreeView(*this, depth, levelBegin.data(), levelBegin.size(), attributes, cube, scalarRange);

@@ -34,6 +34,47 @@ OCTORAY_HD std::uint32_t ChildIndex(unsigned childMask, std::uint32_t firstChild
 #endif
 }
 
+// The set bits of a 64-bit word.
+OCTORAY_HD unsigned BitCount64(std::uint64_t x)
+{
+#if defined(__CUDA_ARCH__)
+  return static_cast<unsigned>(__popcll(x));
+#else
+  // As ChildIndex: no libgcc call on the baseline x86-64.
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<unsigned>((x * 0x0101010101010101ull) >> 56);
+#endif
+}
+
+// Node n's child mask in its group's word of masks (Attributes.h).
+OCTORAY_HD unsigned MaskInWord(std::uint64_t masks, std::uint32_t n)
+{
+  return static_cast<unsigned>(masks >> (8u * (n & 7u))) & 0xFFu;
+}
+
+// Node n's first child from its group's first child and word of masks: the
+// children of the nodes before n in the group follow the group's first.
+OCTORAY_HD std::uint32_t FirstChildInGroup(std::uint32_t groupBase, std::uint64_t masks, std::uint32_t n)
+{
+  const std::uint64_t before = masks & ((std::uint64_t{ 1 } << (8u * (n & 7u))) - 1u);
+  return groupBase + BitCount64(before);
+}
+
+// The same from any structure of node arrays (OctreeView, HostOctree).
+template <typename Tree>
+OCTORAY_HD unsigned ChildMaskOf(const Tree& t, std::uint32_t n)
+{
+  return MaskInWord(t.childMasks[n >> 3], n);
+}
+
+template <typename Tree>
+OCTORAY_HD std::uint32_t FirstChildOf(const Tree& t, std::uint32_t n)
+{
+  return FirstChildInGroup(t.childBase[n >> 3], t.childMasks[n >> 3], n);
+}
+
 // Plain pointers into the node arrays (host or device memory). Attribute
 // pointers are null when the input lacked that attribute.
 struct OctreeView
@@ -48,6 +89,15 @@ struct OctreeView
   OCTORAY_NODE_TOPOLOGY(OCTORAY_POINTER)
   OCTORAY_ATTRIBUTES(OCTORAY_POINTER)
 #undef OCTORAY_POINTER
+
+  // Node n's child mask, written into its byte of the group's word (a char
+  // type may alias any object; both backends are little-endian, so byte k
+  // of a word is bits 8k to 8k + 7). Nodes of one group are written by
+  // different threads, each its own byte.
+  OCTORAY_HD void SetChildMask(std::uint32_t n, unsigned mask) const
+  {
+    reinterpret_cast<std::uint8_t*>(childMasks)[n] = static_cast<std::uint8_t>(mask);
+  }
 
   OCTORAY_HD std::uint32_t LevelSize(int level) const
   {
@@ -121,7 +171,7 @@ using HostVector = std::vector<T>;
 
 // The octree in host memory (what tests and the VTK layer inspect): one
 // vector per node array (Attributes.h), named as there: key, childMask,
-// firstChild, pointCount, color, scalar, ...
+// childMasks, childBase, pointCount, color, scalar, ...
 struct HostOctree : NodeArrays<HostVector>
 {
   int depth = 0;
@@ -133,8 +183,6 @@ struct HostOctree : NodeArrays<HostVector>
   std::size_t NodeCount() const { return key.size(); }
   // Node n's scalar, decoded.
   float Scalar(std::size_t n) const { return DecodeScalar(scalarRange, scalar[n]); }
-  // Resizes every array for `nodes` nodes (attribute arrays only if present).
-  void Allocate(std::size_t nodes, unsigned attributeBits);
   OctreeView View();
 };
 

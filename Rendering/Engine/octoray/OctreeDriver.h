@@ -512,13 +512,19 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     const std::string what = std::string("node ") + a.kLabel;
     if (Present(a, s.attributes))
     {
-      d.Reserve(a.Of(s.nodes), nodes, what.c_str());
+      d.Reserve(a.Of(s.nodes), EntriesFor(a, nodes), what.c_str());
     }
     else
     {
       d.Release(a.Of(s.nodes));
     }
   });
+  // The last word of masks may have bytes of no node: zero, so that they
+  // count no children.
+  if (nodes)
+  {
+    d.FillBytes(s.nodes.childMasks.Get() + (nodes - 1) / 8, 1, 0);
+  }
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
   std::uint32_t* starts = sorted.spare;

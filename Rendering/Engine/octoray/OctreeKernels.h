@@ -107,8 +107,11 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   std::uint32_t node, std::uint64_t levelKey, std::uint32_t begin, std::uint32_t end)
 {
   t.key[node] = levelKey;
-  t.childMask[node] = 0;
-  t.firstChild[node] = kInvalidIndex;
+  t.SetChildMask(node, 0);
+  if ((node & 7u) == 0)
+  {
+    t.childBase[node >> 3] = t.nodeCount; // the leaves come last: every node before has its children
+  }
   t.pointCount[node] = end - begin;
   if (!t.attributes)
   {
@@ -128,12 +131,16 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
 }
 
 // Inner `node` has the children [c0, c1) (global indices, one level down):
-// child mask, link to the first, count and count-weighted means.
+// child mask, its group's first child where it starts a group, count and
+// count-weighted means.
 OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint64_t levelKey, std::uint32_t c0,
   std::uint32_t c1)
 {
   t.key[node] = levelKey;
-  t.firstChild[node] = c0;
+  if ((node & 7u) == 0)
+  {
+    t.childBase[node >> 3] = c0;
+  }
   unsigned mask = 0;
   std::uint32_t count = 0;
   double sum[kSlotCount] = {};
@@ -152,7 +159,7 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
       }
     }
   }
-  t.childMask[node] = static_cast<std::uint8_t>(mask);
+  t.SetChildMask(node, mask);
   t.pointCount[node] = count;
   if (t.attributes)
   {

@@ -80,11 +80,12 @@ std::uint32_t WalkToLeaf(const HostOctree& tree, const PointCloudView& points, s
   for (int level = 1; level <= tree.depth; ++level)
   {
     const unsigned octant = static_cast<unsigned>(AncestorKey(full, level) & 7u);
-    if (!(tree.childMask[node] & (1u << octant)))
+    const unsigned mask = ChildMaskOf(tree, node);
+    if (!(mask & (1u << octant)))
     {
       throw std::runtime_error("point " + std::to_string(i) + " has no node at level " + std::to_string(level));
     }
-    node = ChildIndex(tree.childMask[node], tree.firstChild[node], octant);
+    node = ChildIndex(mask, FirstChildOf(tree, node), octant);
     visit(node);
   }
   if (tree.key[node] != AncestorKey(full, tree.depth))

@@ -60,7 +60,7 @@ void ReferenceTraverse(const OctreeView& tree, const Ray& ray, const LevelOfDeta
       continue;
     }
     const float half = 0.5f * hit.size;
-    const unsigned mask = tree.childMask[e.node];
+    const unsigned mask = ChildMaskOf(tree, e.node);
     for (int i = 7; i >= 0; --i) // farthest first, so that they pop nearest first
     {
       const unsigned octant = static_cast<unsigned>(i) ^ signs;
@@ -74,7 +74,7 @@ void ReferenceTraverse(const OctreeView& tree, const Ray& ray, const LevelOfDeta
       int axis;
       if (IntersectBox(ray, lo, half, t0, t1, axis) && t1 >= ray.tMin && t0 <= ray.tMax)
       {
-        stack[top++] = Entry{ ChildIndex(mask, tree.firstChild[e.node], octant), e.level + 1, t0 };
+        stack[top++] = Entry{ ChildIndex(mask, FirstChildOf(tree, e.node), octant), e.level + 1, t0 };
       }
     }
   }

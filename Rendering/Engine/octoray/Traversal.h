@@ -358,8 +358,8 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   float size = 1.0f;
   int level = 0;
   NodeCrossings c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
-  unsigned childMask = tree.childMask[0];
-  std::uint32_t firstChild = tree.firstChild[0];
+  unsigned childMask = ChildMaskOf(tree, 0);
+  std::uint32_t firstChild = FirstChildOf(tree, 0);
   // Children are tested against the part of each span within [tMin, tMax]
   // (never empty: a child is stepped to only where it meets that part), so
   // the loop needs no test of its own for voxels before tMin or past tMax.
@@ -413,7 +413,10 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     {
       innerMidT[a] = Crossing<MayBeParallel>(ray, a, childLo[a] + 0.5f * half);
     }
-    const unsigned grandchildMask = tree.childMask[child];
+    // The child's group of eight: its mask now, its first child if it is
+    // entered (Attributes.h).
+    const std::uint64_t groupMasks = tree.childMasks[child >> 3];
+    const unsigned grandchildMask = MaskInWord(groupMasks, child);
     const unsigned met = MirrorOctants(grandchildMask, signs) &
       MetOctants(innerMidT, Later(span.tEnter, ray.tMin), Earlier(span.tExit, ray.tMax));
     const unsigned after = todo & OctantsAfter(m);
@@ -438,7 +441,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     lo = childLo;
     size = half;
     childMask = grandchildMask;
-    firstChild = tree.firstChild[child];
+    firstChild = FirstChildInGroup(tree.childBase[child >> 3], groupMasks, child);
     todo = met;
   }
 }
