@@ -399,6 +399,21 @@ def _cuda(ctx):
                        "B/point, points not kept"], staging_rows),
             "",
         ]
+    every = [r for r in records if r["name"] == "gpu bytes per point, every attribute"]
+    if every:
+        r = every[0]
+        arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")
+                  or k in ("sort buffers", "allocator cache")]
+        text += [
+            "**Every attribute** a scene of colours, a transfer function and lights uses: %s points as above with "
+            "8-bit colours, scalars (a ramp across the clusters), reflectivity and normals (radial), depth %d, "
+            "built without the points: %s nodes, %.2f GPU bytes per point in arrays (%.2f with the allocator's "
+            "cache). Each node array as the engine's memory report names it (`Engine::Memory`), in bytes per "
+            "point:" % (count(r["n"]), r["depth"], count(r["nodes"]), r["seconds"], r["total_bytes_per_point"]),
+            "",
+            ctx.table(["array", "bytes/point"], [[name, "%.2f" % value] for name, value in arrays]),
+            "",
+        ]
     billion = [r for r in records if r["name"].startswith("device points")]
     if billion:
         b = {r["name"]: r for r in billion}
