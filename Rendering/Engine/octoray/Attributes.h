@@ -105,65 +105,77 @@ struct AttributeValue
   }
 };
 
-// 8-bit colours are summed as four floats in [0,1] and stored as bytes. A
-// leaf's mean is rounded once; an inner node's is the count-weighted mean of
-// its children's rounded ones, rounded again (ColourErrorBound). Being
-// rounded, such a mean cannot be adjusted by the points that leave and join
-// a node (an update's in-place path): the rounding would be carried into the
-// new mean, multiplied where a node loses most of its points.
-template <>
-struct AttributeValue<Rgba8>
+// Values stored rounded: summed as the floats ToFloats gives (in double, as
+// every attribute) and stored as FromFloats of their mean. A leaf's mean is
+// rounded once; an inner node's is the count-weighted mean of its children's
+// rounded ones, rounded again (the bounds below). Being rounded, such a mean
+// cannot be adjusted by the points that leave and join a node (an update's
+// in-place path): the rounding would be carried into the new mean,
+// multiplied where a node loses most of its points.
+template <typename T, int Slots>
+struct RoundedAttributeValue
 {
-  static constexpr int kSlots = 4;
+  static constexpr int kSlots = Slots;
   static constexpr bool kRounded = true;
 
-  OCTORAY_HD static void ToSlots(const Rgba8& value, float* v)
+  OCTORAY_HD static void ToSlots(const T& value, float* v) { ToFloats(value, v); }
+  OCTORAY_HD static T Mean(const double* sum, double inv)
   {
-    const Rgba c = ToRgba(value);
-    v[0] = c.r, v[1] = c.g, v[2] = c.b, v[3] = c.a;
-  }
-  OCTORAY_HD static Rgba8 Mean(const double* sum, double inv)
-  {
-    auto channel = [&](int k) { return ChannelToByte(static_cast<float>(sum[k] * inv)); };
-    return Rgba8{ channel(0), channel(1), channel(2), channel(3) };
+    float mean[Slots];
+    for (int k = 0; k < Slots; ++k)
+    {
+      mean[k] = static_cast<float>(sum[k] * inv);
+    }
+    T value;
+    FromFloats(mean, value);
+    return value;
   }
 };
 
-// Scalars are summed as their unit values and stored as codes (Scalar16.h):
-// a point's value is rounded once, a leaf's mean again, an inner node's
-// again from its children's (ScalarErrorBound).
-template <>
-struct AttributeValue<Scalar16>
+// 8-bit colours: four channels in [0,1], stored as bytes.
+OCTORAY_HD void ToFloats(const Rgba8& value, float* v)
 {
-  static constexpr int kSlots = 1;
-  static constexpr bool kRounded = true;
+  const Rgba c = ToRgba(value);
+  v[0] = c.r, v[1] = c.g, v[2] = c.b, v[3] = c.a;
+}
+OCTORAY_HD void FromFloats(const float* v, Rgba8& value)
+{
+  value = Rgba8{ ChannelToByte(v[0]), ChannelToByte(v[1]), ChannelToByte(v[2]), ChannelToByte(v[3]) };
+}
 
-  OCTORAY_HD static void ToSlots(const Scalar16& value, float* v) { v[0] = UnitScalar(value); }
-  OCTORAY_HD static Scalar16 Mean(const double* sum, double inv)
-  {
-    return EncodeUnitScalar(static_cast<float>(sum[0] * inv));
-  }
+// Scalars: their unit values, stored as codes (Scalar16.h); the points'
+// values are rounded too (ScalarErrorBound).
+OCTORAY_HD void ToFloats(const Scalar16& value, float* v)
+{
+  v[0] = UnitScalar(value);
+}
+OCTORAY_HD void FromFloats(const float* v, Scalar16& value)
+{
+  value = EncodeUnitScalar(v[0]);
+}
+
+// Normals: three floats, stored on the octahedron (NormalErrorBound).
+OCTORAY_HD void ToFloats(const OctNormal& value, float* v)
+{
+  const Vec3f n = DecodeNormal(value);
+  v[0] = n.x, v[1] = n.y, v[2] = n.z;
+}
+OCTORAY_HD void FromFloats(const float* v, OctNormal& value)
+{
+  value = EncodeNormal(Vec3f{ v[0], v[1], v[2] });
+}
+
+template <>
+struct AttributeValue<Rgba8> : RoundedAttributeValue<Rgba8, 4>
+{
 };
-
-// Normals are summed as three floats and stored on the octahedron, rounded
-// as 8-bit colours are: a leaf's mean once, an inner node's again from its
-// children's rounded ones (NormalErrorBound).
 template <>
-struct AttributeValue<OctNormal>
+struct AttributeValue<Scalar16> : RoundedAttributeValue<Scalar16, 1>
 {
-  static constexpr int kSlots = 3;
-  static constexpr bool kRounded = true;
-
-  OCTORAY_HD static void ToSlots(const OctNormal& value, float* v)
-  {
-    const Vec3f n = DecodeNormal(value);
-    v[0] = n.x, v[1] = n.y, v[2] = n.z;
-  }
-  OCTORAY_HD static OctNormal Mean(const double* sum, double inv)
-  {
-    auto component = [&](int k) { return static_cast<float>(sum[k] * inv); };
-    return EncodeNormal(Vec3f{ component(0), component(1), component(2) });
-  }
+};
+template <>
+struct AttributeValue<OctNormal> : RoundedAttributeValue<OctNormal, 3>
+{
 };
 
 // The first slot of each attribute, and kSlotCount in all.
