@@ -237,13 +237,10 @@ TEST(Scalar16, ErrorsStayWithinHalfAStepOfTheRange)
       const float x = value(rng);
       worst = std::max(worst, std::fabs(double(DecodeScalar(range, EncodeUnitScalar(range.ToUnit(x)))) - x));
     }
-    // Half a step, and two roundings of a float the size of the range's
-    // ends in decoding. Where the steps are finer than the floats (1000 to
-    // 1000.5), every float decodes to itself.
-    const float largest = std::max(std::max(std::fabs(range.lo), std::fabs(range.hi)), range.hi - range.lo);
-    const double floatUlp = std::ldexp(1.0, std::ilogb(largest) - 23);
-    EXPECT_LE(worst, range.HalfStep() + 2 * floatUlp) << range.lo << " to " << range.hi;
-    if (range.HalfStep() > floatUlp)
+    // Half a step, and decoding's float rounding. Where the steps are finer
+    // than the floats (1000 to 1000.5), every float decodes to itself.
+    EXPECT_LE(worst, range.HalfStep() + range.DecodingError()) << range.lo << " to " << range.hi;
+    if (range.HalfStep() > range.DecodingError())
     {
       EXPECT_GT(worst, 0.5 * range.HalfStep()) << "the bound is not loose";
     }

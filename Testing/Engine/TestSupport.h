@@ -282,7 +282,8 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
       }
       if (!t.scalar.empty())
       {
-        // 16 bits over the range, rounded per level.
+        // 16 bits over the range, rounded per level; 5e-5 for the float
+        // rounding of means of scalars that span 100.
         EXPECT_NEAR(t.Scalar(n), ref.sum[4] * inv, ScalarErrorBound(t.scalarRange, t.depth, l) + 5e-5);
       }
       EXPECT_NEAR(t.reflectivity[n], ref.sum[5] * inv, tol);

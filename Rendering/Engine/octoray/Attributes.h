@@ -53,7 +53,7 @@ namespace octoray
 #define OCTORAY_ATTRIBUTES(X)                                                                                         \
   X(color, Color, Rgba, FloatColorInput, "colours")                                                                  \
   X(color8, Color8, Rgba8, ByteColorInput, "8-bit colours")                                                          \
-  X(scalar, Scalar, Scalar16, ScalarInput, "scalars")                                                                   \
+  X(scalar, Scalar, Scalar16, ScalarInput, "scalars")                                                                \
   X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
   X(normal, Normal, OctNormal, UnitNormalInput, "normals")
@@ -207,11 +207,11 @@ OCTORAY_HD constexpr double NormalErrorBound(int depth, int level)
 
 // The largest difference between a node's decoded scalar at `level` and the
 // exact mean of its points' scalars (finite ones, in the build's `range`):
-// half a step for the points' codes, the leaf's mean and each level up.
-// Decoding adds a float's rounding of the range's ends, which callers allow.
-OCTORAY_HD double ScalarErrorBound(const ScalarRange& range, int depth, int level)
+// half a step for the points' codes, the leaf's mean and each level up, and
+// the float rounding of decoding.
+inline double ScalarErrorBound(const ScalarRange& range, int depth, int level)
 {
-  return (depth - level + 2) * range.HalfStep();
+  return (depth - level + 2) * range.HalfStep() + range.DecodingError();
 }
 
 // The attributes (AttributeBits) whose node means are stored rounded.

@@ -170,8 +170,8 @@ template <typename T>
 using HostVector = std::vector<T>;
 
 // The octree in host memory (what tests and the VTK layer inspect): one
-// vector per node array (Attributes.h), named as there: key, childMask,
-// childMasks, childBase, pointCount, color, scalar, ...
+// vector per node array (Attributes.h), named as there: key, childMasks,
+// childBase, pointCount, color, scalar, ...
 struct HostOctree : NodeArrays<HostVector>
 {
   int depth = 0;

@@ -110,7 +110,9 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   t.SetChildMask(node, 0);
   if ((node & 7u) == 0)
   {
-    t.childBase[node >> 3] = t.nodeCount; // the leaves come last: every node before has its children
+    // A group that starts with a leaf holds leaves alone (they come last),
+    // whose children would follow every node.
+    t.childBase[node >> 3] = t.nodeCount;
   }
   t.pointCount[node] = end - begin;
   if (!t.attributes)
@@ -183,14 +185,15 @@ OCTORAY_HD bool WritePathRecords(const OctreeView& t, std::uint32_t point, std::
   bool found = true;
   for (int joins = 0; joins < 2; ++joins)
   {
-    const std::uint64_t leaf = joins ? toLeaf : fromLeaf;
-    const bool exists = t.Find(t.depth, leaf) != kInvalidIndex;
-    found = found && exists;
+    const std::uint64_t leafKey = joins ? toLeaf : fromLeaf;
+    const std::uint32_t leaf = t.Find(t.depth, leafKey);
+    found = found && leaf != kInvalidIndex;
     const std::size_t base = first + joins * pathLength;
     for (std::size_t step = 0; step < pathLength; ++step)
     {
       const int level = t.depth - static_cast<int>(step);
-      recordNode[base + step] = exists ? t.Find(level, leaf >> (3 * step)) : kInvalidIndex;
+      recordNode[base + step] =
+        leaf == kInvalidIndex ? kInvalidIndex : (step == 0 ? leaf : t.Find(level, leafKey >> (3 * step)));
       recordPoint[base + step] = 2u * point + static_cast<std::uint32_t>(joins);
     }
   }

@@ -14,8 +14,8 @@
 // against a brute-force recomputation.
 //
 // The same walk measures the rounding of 8-bit colours, scalars and
-// normals (Attributes.h): each node's stored value against the exact mean of the
-// points beneath it.
+// normals (Attributes.h): each node's stored value against the exact mean
+// of the points beneath it.
 #pragma once
 
 #include "Octree.h"
@@ -178,22 +178,18 @@ inline RoundingError MeasureColourQuantisation(const HostOctree& tree, const Poi
 }
 
 // Needs an octree of scalars (tree.scalar) built from `points`, all finite:
-// in steps of the range (Scalar16.h). The bound allows two roundings of a
-// float the size of the range's ends, which decoding adds.
+// in steps of the range (Scalar16.h).
 inline RoundingError MeasureScalarQuantisation(const HostOctree& tree, const PointCloudView& points)
 {
   const ScalarRange& range = tree.scalarRange;
   const double step = 2.0 * range.HalfStep();
-  const double largest =
-    std::max({ std::fabs(double(range.lo)), std::fabs(double(range.hi)), double(range.hi) - range.lo });
-  const double decoding = largest > 0.0 ? std::ldexp(2.0, std::ilogb(largest) - 23) : 0.0;
   auto value = [&](std::size_t i, double v[1]) { v[0] = points.scalar[i]; };
   auto steps = [&](std::uint32_t n, const double mean[1]) {
     const double d = std::fabs(double(tree.Scalar(n)) - mean[0]);
     return step > 0.0 ? d / step : (d > 0.0 ? HUGE_VAL : 0.0);
   };
   return MeasureRounding<1>(tree, points, value, steps, [&](int level) {
-    return step > 0.0 ? (ScalarErrorBound(range, tree.depth, level) + decoding) / step : 0.0;
+    return step > 0.0 ? ScalarErrorBound(range, tree.depth, level) / step : 0.0;
   });
 }
 

@@ -234,9 +234,10 @@ OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::
 
 // Surface normal at a hit, facing the viewer. Averaged point normals where
 // the data has them and they do not cancel (a mean shorter than half a
-// length step, 1/510, is stored as zero: OctahedralNormal.h); otherwise the occupancy gradient of the six neighbours
-// at the hit's level (it follows the shape, not the voxel's blocky faces);
-// the entry face where the gradient vanishes (e.g. inside a solid block).
+// length step, 1/510, is stored as zero: OctahedralNormal.h); otherwise the
+// occupancy gradient of the six neighbours at the hit's level (it follows
+// the shape, not the voxel's blocky faces); the entry face where the
+// gradient vanishes (e.g. inside a solid block).
 OCTORAY_HD Vec3f SurfaceNormal(const OctreeView& tree, const Ray& ray, const NodeHit& hit)
 {
   Vec3f n = tree.normal ? DecodeNormal(tree.normal[hit.node]) : Vec3f{ 0.0f, 0.0f, 0.0f };

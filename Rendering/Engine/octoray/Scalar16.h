@@ -84,7 +84,16 @@ struct ScalarRange
   }
 
   // Half a step: the largest error of one rounding.
-  OCTORAY_HD double HalfStep() const { return 0.5 * (static_cast<double>(hi) - lo) / kScalarSteps; }
+  double HalfStep() const { return 0.5 * (static_cast<double>(hi) - lo) / kScalarSteps; }
+
+  // What decoding's float arithmetic adds: two roundings of a float the
+  // size of the range's ends or its width (FromUnit's product and sum).
+  double DecodingError() const
+  {
+    const double largest =
+      std::fmax(std::fmax(std::fabs(double(lo)), std::fabs(double(hi))), static_cast<double>(hi) - lo);
+    return largest > 0.0 ? std::ldexp(2.0, std::ilogb(largest) - 23) : 0.0;
+  }
 };
 
 OCTORAY_HD float DecodeScalar(const ScalarRange& range, Scalar16 s)
