@@ -190,6 +190,7 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
   }
   octoray::HostOctree tree;
   engine->CopyToHost(tree);
+  const octoray::OctreeView view = tree.View();
   const int depth = tree.depth;
   const std::uint32_t begin = tree.levelBegin[depth], end = tree.levelBegin[depth + 1];
   const double leaf = tree.cube.size / static_cast<double>(1u << depth);
@@ -212,11 +213,8 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
       tree.cube.origin[2] + (z + 0.5) * leaf };
     const vtkIdType id = node - begin;
     points->SetPoint(id, p);
-    const octoray::Rgba c = tree.color.empty() ? octoray::Rgba{ 1, 1, 1, 1 } : tree.color[node];
-    const octoray::Rgba8 c8 = tree.color8.empty()
-      ? octoray::Rgba8{ octoray::ChannelToByte(c.r), octoray::ChannelToByte(c.g), octoray::ChannelToByte(c.b),
-          octoray::ChannelToByte(c.a) }
-      : tree.color8[node];
+    // 8-bit colours come back as they are stored (ToRgba8 undoes ToRgba).
+    const octoray::Rgba8 c8 = octoray::ToRgba8(octoray::StoredColor(view, node));
     const unsigned char rgba[4] = { c8.r, c8.g, c8.b, c8.a };
     for (int k = 0; k < 4; ++k)
     {

@@ -361,6 +361,13 @@ TEST(VecMath, ChannelToByteRoundsToNearest)
   EXPECT_EQ(ChannelToByte(0.5f / 255.0f), 1);
   EXPECT_EQ(ChannelToByte(0.49f / 255.0f), 0);
   EXPECT_EQ(ChannelToByte(127.5f / 255.0f), 128);
+  // A byte read as a channel rounds back to itself (the leaf export of
+  // 8-bit colours relies on it).
+  for (int b = 0; b < 256; ++b)
+  {
+    const std::uint8_t byte = static_cast<std::uint8_t>(b);
+    EXPECT_EQ(ToRgba8(ToRgba(Rgba8{ byte, 0, 255, byte })).r, byte);
+  }
 }
 
 // One transfer-function lookup for node colours and projected values: the

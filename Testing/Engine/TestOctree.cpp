@@ -424,11 +424,11 @@ TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
     gpu->CopyToHost(b);
     ExpectSameOctree(b, a, true);
   };
-  // 8-bit colours and normals: their means rounded to the same bits.
+  // 8-bit colours, scalars and normals: their means rounded to the same bits.
   const Cloud rounded = GaussianClusters(30000, 25);
   cpu->Build(rounded.View(), BuildOptions{});
   gpu->Build(rounded.View(), BuildOptions{});
-  expectSame("build with 8-bit colours and normals");
+  expectSame("build with 8-bit colours, scalars and normals");
   // Every point twice (with other attributes), so that moving a copy onto
   // another point's place empties no leaf and creates none: the in-place
   // path, which octrees with rounded means do not take (Attributes.h).

@@ -120,9 +120,9 @@ TEST_P(OctreeUpdate, FewPointsBetweenOccupiedLeavesUpdateInPlace)
   EXPECT_GT(s.changedLeaf, 10u);
 }
 
-// The same moves with 8-bit colours and normals: adjusting their rounded
-// means would carry the rounding, so the update re-sorts, and every colour
-// and normal is again within its bound of its mean (MoveAndCheck).
+// The same moves with 8-bit colours, scalars and normals: adjusting their rounded
+// means would carry the rounding, so the update re-sorts, and every colour,
+// scalar and normal is again within its bound of its mean (MoveAndCheck).
 TEST_P(OctreeUpdate, RoundedMeansReSortInsteadOfBeingAdjusted)
 {
   Cloud c = UniformCloud(20000, 32);

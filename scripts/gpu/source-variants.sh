@@ -30,8 +30,6 @@ if [ -f "$vtk/lib/cmake/vtk-9.2/vtk-config.cmake" ]; then
 else
   with_vtk=(-DOCTORAY_ENABLE_VTK=OFF)
 fi
-targets=(octoray_bench_cuda)
-[ "${TESTS:-0}" = 1 ] && targets+=(octoray_engine_tests)
 
 # Each variant gets a copy of the source tree, so that the builds can run
 # side by side.
@@ -44,6 +42,9 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
   for f in .gpu-vtk/variants/*."$v".h; do
     [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".h).h"
   done
+  # The tests belong to the tree's own headers: built in "main" alone.
+  targets=(octoray_bench_cuda)
+  [ "${TESTS:-0}" = 1 ] && [ "$v" = main ] && targets+=(octoray_engine_tests)
   { cmake -S "$src" -B "$src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
       -DCMAKE_CUDA_ARCHITECTURES=90 "${with_vtk[@]}" -DCMAKE_CXX_FLAGS='-include cstdint' \
       -DOCTORAY_GTEST_SOURCE_DIR="$src/.gpu-vtk/googletest" &&

@@ -140,7 +140,7 @@ OCTORAY_HD void ToFloats(const Rgba8& value, float* v)
 }
 OCTORAY_HD void FromFloats(const float* v, Rgba8& value)
 {
-  value = Rgba8{ ChannelToByte(v[0]), ChannelToByte(v[1]), ChannelToByte(v[2]), ChannelToByte(v[3]) };
+  value = ToRgba8(Rgba{ v[0], v[1], v[2], v[3] });
 }
 
 // Scalars: their unit values, stored as codes (Scalar16.h); the points'

@@ -125,6 +125,20 @@ struct OctreeView
   }
 };
 
+// A node's averaged colour, float or 8-bit, else white.
+OCTORAY_HD Rgba StoredColor(const OctreeView& tree, std::uint32_t node)
+{
+  if (tree.color)
+  {
+    return tree.color[node];
+  }
+  if (tree.color8)
+  {
+    return ToRgba(tree.color8[node]);
+  }
+  return Rgba{ 1.0f, 1.0f, 1.0f, 1.0f };
+}
+
 // The first element of a vector or buffer (HostBuffer, DeviceBuffer), or
 // null where it holds none: what views point at.
 template <typename T>

@@ -172,15 +172,9 @@ struct InputFloats
   std::size_t count;
 };
 
+// One float per point: copied attributes and scalars (ScalarInput is one).
 template <class A>
 InputFloats InputFloatsOf(CopiedInput, A, const PointCloudView& points)
-{
-  static_assert(std::is_same<typename A::Type, float>::value, "a copied attribute is one float per point");
-  return InputFloats{ A::Of(points), points.count };
-}
-
-template <class A>
-InputFloats InputFloatsOf(ScalarInput, A, const PointCloudView& points)
 {
   return InputFloats{ A::Of(points), points.count };
 }
@@ -277,6 +271,7 @@ template <class A>
 OCTORAY_HD void StoreInput(CopiedInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
   const PointRecordLayout& layout)
 {
+  static_assert(std::is_same<typename A::Type, float>::value, "a copied attribute is stored as its float");
   StoreInRecord(records, layout, i, A::kIndex, in.values[A::kIndex][i]);
 }
 

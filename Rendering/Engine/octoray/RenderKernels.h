@@ -207,20 +207,6 @@ OCTORAY_HD Vec3f RgbOf(const Rgba& c)
   return Vec3f{ c.r, c.g, c.b };
 }
 
-// A node's averaged colour, float or 8-bit, else white.
-OCTORAY_HD Rgba StoredColor(const OctreeView& tree, std::uint32_t node)
-{
-  if (tree.color)
-  {
-    return tree.color[node];
-  }
-  if (tree.color8)
-  {
-    return ToRgba(tree.color8[node]);
-  }
-  return Rgba{ 1.0f, 1.0f, 1.0f, 1.0f };
-}
-
 // Colour and opacity of a node: through the transfer function when the
 // frame has one and the node a scalar, else its averaged colour.
 OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::uint32_t node)

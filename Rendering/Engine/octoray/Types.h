@@ -46,6 +46,12 @@ OCTORAY_HD Rgba ToRgba(Rgba8 c)
   return Rgba{ ByteToChannel(c.r), ByteToChannel(c.g), ByteToChannel(c.b), ByteToChannel(c.a) };
 }
 
+// Each channel rounded to a byte; ToRgba8(ToRgba(c)) is c for every byte.
+OCTORAY_HD Rgba8 ToRgba8(const Rgba& c)
+{
+  return Rgba8{ ChannelToByte(c.r), ChannelToByte(c.g), ChannelToByte(c.b), ChannelToByte(c.a) };
+}
+
 // Every error the engine reports: bad input, exhausted memory, a failed
 // device call. The message says what and where (point index, array, bytes).
 class Error : public std::runtime_error
