@@ -3,6 +3,8 @@
 #include "TestRenderSupport.h"
 
 #include <octoray/DepthSignature.h>
+#include <octoray/Frame.h>
+#include <octoray/PacketTraversal.h>
 #include <octoray/ReferenceTraversal.h>
 
 using namespace octoray;
@@ -82,29 +84,30 @@ bool SameHit(const NodeHit& a, const NodeHit& b)
 }
 }
 
-// Traverse against ReferenceTraversal.h's slab test of every child box:
-// the same voxels in the same order with bit-identical spans, entry axes
-// and boxes, for rays from everywhere (inside the cube, outside, clipped by
-// tMin and tMax), parallel to one or two axes and lying on grid planes,
-// diagonal through the mid planes' edges, and with level of detail.
-TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
+namespace
 {
-  const Cloud c = GaussianClusters(3000, 47);
-  HostOctree t = BuildOnHost(*engine, c.View(), 7);
-  const OctreeView view = t.View();
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<float> around(-0.5f, 1.5f), unit(-1.0f, 1.0f), share(0.0f, 1.0f);
-  std::size_t visits = 0;
-  for (int r = 0; r < 20000; ++r)
+// Rays to compare traversals with, from everywhere (inside the cube,
+// outside, clipped by tMin and tMax), parallel to one or two axes and lying
+// on grid planes, diagonal through the mid planes' edges, and with level of
+// detail; each aimed at a corner of a leaf of t (at `depth`), so that most
+// rays meet the clusters. Ray r is of kind r % 8.
+struct TestRays
+{
+  HostOctree& t;
+  int depth;
+  std::mt19937_64 rng{ 11 };
+  std::uniform_real_distribution<float> around{ -0.5f, 1.5f }, unit{ -1.0f, 1.0f }, share{ 0.0f, 1.0f };
+
+  void Make(int r, Ray& ray, LevelOfDetail& lod)
   {
-    // Aimed at a leaf's corner, so that most rays meet the clusters.
-    const std::uint32_t leaf = view.levelBegin[7] + static_cast<std::uint32_t>(rng() % view.LevelSize(7));
+    const OctreeView view = t.View();
+    const float cells = std::ldexp(1.0f, depth);
+    const std::uint32_t leaf = view.levelBegin[depth] + static_cast<std::uint32_t>(rng() % view.LevelSize(depth));
     std::uint32_t cell[3];
     DecodeMorton(t.key[leaf], cell[0], cell[1], cell[2]);
-    const Vec3f corner{ cell[0] / 128.0f, cell[1] / 128.0f, cell[2] / 128.0f };
-    Ray ray;
+    const Vec3f corner{ cell[0] / cells, cell[1] / cells, cell[2] / cells };
     ray.origin = Vec3f{ around(rng), around(rng), around(rng) };
-    Vec3f d = corner + Vec3f{ share(rng), share(rng), share(rng) } * (1.0f / 128.0f) - ray.origin;
+    Vec3f d = corner + Vec3f{ share(rng), share(rng), share(rng) } * (1.0f / cells) - ray.origin;
     const int kind = r % 8;
     if (kind == 1 || kind == 2) // parallel to one or two axes, on the leaf's grid planes
     {
@@ -122,13 +125,32 @@ TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
     SetDirection(ray, Normalize(d));
     ray.tMin = kind == 4 ? share(rng) : 0.0f;
     ray.tMax = kind == 5 ? share(rng) * 2.0f : INFINITY;
-    LevelOfDetail lod;
+    lod = LevelOfDetail{};
     if (kind == 6)
     {
       lod.pixels = 1.0f;
       lod.footprint0 = 0.002f;
       lod.footprintSlope = 0.01f;
     }
+  }
+};
+}
+
+// Traverse against ReferenceTraversal.h's slab test of every child box:
+// the same voxels in the same order with bit-identical spans, entry axes
+// and boxes, for TestRays' rays.
+TEST_P(RenderTest, TraversalVisitsWhatSlabTestsOfEachChildVisit)
+{
+  const Cloud c = GaussianClusters(3000, 47);
+  HostOctree t = BuildOnHost(*engine, c.View(), 7);
+  const OctreeView view = t.View();
+  TestRays rays{ t, 7 };
+  std::size_t visits = 0;
+  for (int r = 0; r < 20000; ++r)
+  {
+    Ray ray;
+    LevelOfDetail lod;
+    rays.Make(r, ray, lod);
     VisitLog fast, reference;
     Traverse(view, ray, lod, fast);
     ReferenceTraverse(view, ray, lod, reference);
@@ -442,6 +464,173 @@ TEST(DepthSignature, ChangesWithAnyPixel)
   moved[12345] = depth[12345];
   EXPECT_NE(base, DepthSignature(moved.data(), moved.size())) << "two pixels swapped";
   EXPECT_NE(base, DepthSignature(depth.data(), depth.size() - 1));
+}
+
+namespace
+{
+// Each lane's first hit from a packet against Traverse's for its ray alone,
+// in every value, through each instruction set this processor has.
+// `valid` has a bit per lane whose ray exists.
+void ExpectPacketHitsAreTraverses(
+  const OctreeView& view, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes], unsigned valid)
+{
+  PacketHits baseline, avx2;
+  FirstHitsBaseline(view, rays, lods, valid, baseline);
+  if (HasAvx2())
+  {
+    FirstHitsAvx2(view, rays, lods, valid, avx2);
+  }
+  for (int lane = 0; lane < kPacketLanes; ++lane)
+  {
+    FirstHitVisitor alone;
+    if ((valid >> lane) & 1u)
+    {
+      Traverse(view, rays[lane], lods[lane], alone);
+    }
+    for (const PacketHits* hits : { &baseline, HasAvx2() ? &avx2 : nullptr })
+    {
+      if (!hits)
+      {
+        continue;
+      }
+      const FirstHitVisitor& packed = hits->lane[lane];
+      ASSERT_EQ(packed.found, alone.found) << "lane " << lane << (hits == &avx2 ? ", AVX2" : ", baseline");
+      if (alone.found)
+      {
+        ASSERT_TRUE(SameHit(packed.hit, alone.hit)) << "lane " << lane << (hits == &avx2 ? ", AVX2" : ", baseline");
+      }
+    }
+  }
+}
+}
+
+// PacketTraversal.h against Traverse, lane by lane: packets of TestRays'
+// rays (lanes of every kind and octant side by side, some lanes empty) and
+// packets of neighbouring pixels as the CPU engine traces them, from
+// cameras outside and inside the cube, in perspective and parallel
+// projection, looking along an axis (lanes parallel to it, and rows whose
+// directions change octant), with level of detail and a depth buffer.
+TEST(PacketTraversal, EveryLaneHitsWhatTraverseHits)
+{
+  const Cloud c = GaussianClusters(3000, 47);
+  auto cpu = CreateEngine(Backend::CPU);
+  HostOctree t = BuildOnHost(*cpu, c.View(), 7);
+  const OctreeView view = t.View();
+  TestRays scattered{ t, 7 };
+  for (int packet = 0; packet < 4000; ++packet)
+  {
+    SCOPED_TRACE("scattered packet " + std::to_string(packet));
+    Ray rays[kPacketLanes];
+    LevelOfDetail lods[kPacketLanes];
+    for (int lane = 0; lane < kPacketLanes; ++lane)
+    {
+      scattered.Make(packet * kPacketLanes + lane, rays[lane], lods[lane]);
+    }
+    ExpectPacketHitsAreTraverses(view, rays, lods, packet % 5 == 0 ? 0xB5u : 0xFFu);
+  }
+  const int w = 61, h = 45; // rows end in a part of a packet
+  const double target[3] = { 2, 1, 1 };
+  const double eyes[][3] = { { 25, -30, 18 }, { 2, 1, 30 }, { 1.5, 0.5, 1.2 } };
+  for (const auto& eye : eyes)
+  {
+    for (bool parallel : { false, true })
+    {
+      const bool down = eye[0] == target[0];
+      const Matrix vp = ViewProjection(eye, target, down ? kYUp : kUp, 40, double(w) / h, 0.5, 120, parallel, 12);
+      RenderSettings s = Settings(vp, w, h);
+      s.lodPixels = parallel ? 0.0f : 1.5f;
+      s.depthBuffer.assign(std::size_t(w) * h, 1.0f);
+      for (std::size_t i = 0; i < s.depthBuffer.size(); i += 7)
+      {
+        s.depthBuffer[i] = 0.995f;
+      }
+      const FrameConstants f = MakeFrame(s, view);
+      int packed = 0;
+      for (int y = 0; y < h; ++y)
+      {
+        for (int x0 = 0; x0 < w; x0 += kPacketLanes)
+        {
+          SCOPED_TRACE("pixels from " + std::to_string(x0) + "," + std::to_string(y));
+          Ray rays[kPacketLanes];
+          LevelOfDetail lods[kPacketLanes];
+          unsigned valid = 0;
+          for (int lane = 0; lane < kPacketLanes && x0 + lane < w; ++lane)
+          {
+            CameraRay pixel;
+            float rgba[4], depth;
+            if (StartPixel(f, x0 + lane, y, pixel, rgba, depth))
+            {
+              valid |= 1u << lane;
+              rays[lane] = pixel.ray;
+              lods[lane] = pixel.lod;
+            }
+          }
+          packed += valid != 0;
+          ExpectPacketHitsAreTraverses(view, rays, lods, valid);
+        }
+      }
+      EXPECT_GT(packed, h); // the camera sees the cube
+    }
+  }
+}
+
+// The CPU engine traces the primary rays of surfaces in packets: its
+// pictures are those of RenderPixel pixel by pixel, in every value, flat,
+// depth-cued and lit with shadows, with and without reflections (the
+// clusters' points reflect) and level of detail.
+TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
+{
+  const Cloud c = GaussianClusters(20000, 46);
+  auto cpu = CreateEngine(Backend::CPU);
+  BuildOptions options;
+  options.depth = 8;
+  HostOctree t = BuildOnHost(*cpu, c.View(), options);
+  const int w = 61, h = 45;
+  const double eye[3] = { 9, -11, 7 }, target[3] = { 1, 1, 0 };
+  const Matrix vp = ViewProjection(eye, target, kUp, 40, double(w) / h, 1, 100);
+  for (ShadeMode shade : { ShadeMode::Flat, ShadeMode::DepthCue, ShadeMode::Phong })
+  {
+    for (int variant = 0; variant < 4; ++variant)
+    {
+      RenderSettings s = Settings(vp, w, h);
+      s.shade = shade;
+      s.maxBounces = variant % 2 == 0 ? 0 : 2;
+      s.lodPixels = variant < 2 ? 0.0f : 2.0f;
+      SCOPED_TRACE("shade " + std::to_string(int(shade)) + ", bounces " + std::to_string(s.maxBounces) +
+        ", level of detail " + std::to_string(s.lodPixels));
+      if (shade == ShadeMode::Phong)
+      {
+        Light sun;
+        sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
+        s.lights.push_back(sun);
+        s.shadows = true;
+      }
+      Image image;
+      cpu->Render(s, image);
+      const OctreeView view = t.View();
+      const FrameConstants f = MakeFrame(s, view);
+      std::size_t rays = 0, hits = 0;
+      DispatchFeatures(f, [&](auto features) {
+        using F = decltype(features);
+        for (int y = 0; y < h; ++y)
+        {
+          for (int x = 0; x < w; ++x)
+          {
+            const std::size_t i = std::size_t(y) * w + x;
+            float rgba[4], depth;
+            RenderPixel<F>(f, view, x, y, rgba, depth, rays);
+            hits += depth < 1.0f;
+            ASSERT_EQ(image.depth[i], depth) << "pixel " << x << "," << y;
+            for (int k = 0; k < 4; ++k)
+            {
+              ASSERT_EQ(image.rgba[4 * i + k], rgba[k]) << "pixel " << x << "," << y << ", channel " << k;
+            }
+          }
+        }
+      });
+      EXPECT_GT(hits, std::size_t(w) * h / 10);
+    }
+  }
 }
 
 // The CUDA picture against the CPU one (the reference), per mode.

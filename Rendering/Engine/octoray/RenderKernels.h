@@ -582,13 +582,11 @@ OCTORAY_HD void BlendPixel(const FrameConstants& f, const OctreeView& tree, cons
   depth = pixel.DepthAt(f, blend.firstT);
 }
 
-// A surface, first hit only.
+// A surface, first hit only, from the voxel its ray hits first (if any).
 template <typename F>
-OCTORAY_HD void FirstHitPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
-  float& depth, std::size_t& secondaryRays)
+OCTORAY_HD void ShadeFirstHit(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel,
+  const FirstHitVisitor& first, float rgba[4], float& depth, std::size_t& secondaryRays)
 {
-  FirstHitVisitor first;
-  Traverse(tree, pixel.ray, pixel.lod, first);
   if (first.found)
   {
     const float tHit = first.hit.tEnter > pixel.ray.tMin ? first.hit.tEnter : pixel.ray.tMin;
@@ -600,10 +598,11 @@ OCTORAY_HD void FirstHitPixel(const FrameConstants& f, const OctreeView& tree, c
 }
 
 // A surface: the first voxel, then the mirror and refracted rays it spawns,
-// each carrying its weight in the pixel, until the bounce limit.
+// each carrying its weight in the pixel, until the bounce limit. The first
+// voxel is primaryHit where the caller traced the pixel's ray already.
 template <typename F>
-OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
-  float& depth, std::size_t& secondaryRays)
+OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel,
+  const FirstHitVisitor* primaryHit, float rgba[4], float& depth, std::size_t& secondaryRays)
 {
   PendingRay pending[kMaxPendingRays];
   int top = 0;
@@ -614,7 +613,14 @@ OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, con
   {
     const PendingRay path = pending[--top];
     FirstHitVisitor first;
-    Traverse(tree, path.ray, pixel.lod, first);
+    if (primary && primaryHit)
+    {
+      first = *primaryHit;
+    }
+    else
+    {
+      Traverse(tree, path.ray, pixel.lod, first);
+    }
     if (!first.found)
     {
       primary = false;
@@ -667,34 +673,48 @@ OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, con
   rgba[0] = color.x, rgba[1] = color.y, rgba[2] = color.z;
 }
 
-// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
-template <typename F>
-OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
-  float& depth, std::size_t& secondaryRays)
+// A pixel's primary ray and level of detail, and its colour and depth where
+// nothing is hit (premultiplied RGBA 0, window depth 1). False where the
+// ray misses the root cube.
+OCTORAY_HD bool StartPixel(const FrameConstants& f, int x, int y, CameraRay& pixel, float rgba[4], float& depth)
 {
   rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
   depth = 1.0f;
-  CameraRay pixel;
   if (!PrimaryRay(f, x, y, pixel.ray, pixel.tBase))
   {
-    return;
+    return false;
   }
   pixel.x = x;
   pixel.y = y;
   pixel.lod.pixels = f.lodPixels;
   pixel.lod.footprint0 = f.footprint0 + f.footprintSlope * static_cast<float>(pixel.tBase);
   pixel.lod.footprintSlope = f.footprintSlope;
+  return true;
+}
+
+// One pixel: premultiplied RGBA and window depth (1 = nothing hit).
+template <typename F>
+OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int x, int y, float rgba[4],
+  float& depth, std::size_t& secondaryRays)
+{
+  CameraRay pixel;
+  if (!StartPixel(f, x, y, pixel, rgba, depth))
+  {
+    return;
+  }
   if constexpr (F::kVolume)
   {
     BlendPixel(f, tree, pixel, rgba, depth);
   }
   else if constexpr (F::kSecondary)
   {
-    TracedPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
+    TracedPixel<F>(f, tree, pixel, nullptr, rgba, depth, secondaryRays);
   }
   else
   {
-    FirstHitPixel<F>(f, tree, pixel, rgba, depth, secondaryRays);
+    FirstHitVisitor first;
+    Traverse(tree, pixel.ray, pixel.lod, first);
+    ShadeFirstHit<F>(f, tree, pixel, first, rgba, depth, secondaryRays);
   }
 }
 

@@ -1,0 +1,395 @@
+// First hits of eight rays at once, for the CPU backend: one walk of the
+// octree for the packet, each step's arithmetic done in SIMD lanes, one ray
+// per lane. Host only (GCC and Clang vector extensions): the GPU's threads
+// are its lanes already.
+//
+// The walk is Traverse's (Traversal.h) for every lane at once. Rays of one
+// octant of directions (DirectionSigns) visit a node's children in the same
+// order, by increasing mirrored octant, so one depth-first walk of the
+// union of the lanes' visits holds each lane's own visits in its own order.
+// Each lane keeps its own set of children left, the very set Traverse keeps
+// for that ray, as one byte of a 64-bit word per node; the walk steps to
+// the lowest child any lane has left, and every value a lane computes is
+// the one Traverse computes for its ray, bit for bit. A lane's first hit is
+// therefore Traverse's, and the pictures are the same.
+//
+// A lane the packet cannot take (a direction in another octant than the
+// first lane's, a zero component, a root that the level of detail stops
+// at) is traced alone by Traverse.
+#pragma once
+
+#include "Traversal.h"
+
+#include <cstring>
+
+namespace octoray
+{
+constexpr int kPacketLanes = 8;
+
+typedef float PacketFloats __attribute__((vector_size(4 * kPacketLanes)));
+typedef std::int32_t PacketInts __attribute__((vector_size(4 * kPacketLanes)));
+typedef std::uint8_t PacketBytes __attribute__((vector_size(kPacketLanes)));
+
+// A byte per lane in a 64-bit word: lane i is byte i.
+constexpr std::uint64_t kEveryLaneByte = 0x0101010101010101ull;
+
+// Lanes where a comparison held, as bytes of 0xFF.
+inline std::uint64_t LaneBytes(PacketInts comparison)
+{
+  const PacketBytes bytes = __builtin_convertvector(comparison, PacketBytes);
+  std::uint64_t word;
+  std::memcpy(&word, &bytes, sizeof word);
+  return word;
+}
+
+// The 8-bit sets of each lane, as bytes.
+inline std::uint64_t LaneSets(PacketInts sets)
+{
+  return LaneBytes(sets & 0xFF);
+}
+
+// The lanes whose set holds bit b, as bytes of 0xFF.
+inline std::uint64_t LanesHolding(std::uint64_t sets, unsigned b)
+{
+  return ((sets >> b) & kEveryLaneByte) * 0xFFu;
+}
+
+// Every lane's set joined.
+inline unsigned UnionOfLanes(std::uint64_t sets)
+{
+  sets |= sets >> 32;
+  sets |= sets >> 16;
+  sets |= sets >> 8;
+  return static_cast<unsigned>(sets) & 0xFFu;
+}
+
+// Later and Earlier (Traversal.h) lane by lane, with the host's comparison.
+inline PacketFloats Later(PacketFloats a, PacketFloats b)
+{
+  return a > b ? a : b;
+}
+
+inline PacketFloats Earlier(PacketFloats a, PacketFloats b)
+{
+  return a < b ? a : b;
+}
+
+// The packet's rays, lane by lane, and the span of each through the root.
+struct RayPacket
+{
+  PacketFloats origin[3], inverse[3];
+  PacketFloats tMin, tMax, tEnter, tExit;
+  PacketFloats lodPixels, footprint0, footprintSlope; // LevelOfDetail's, per lane
+  bool lodOn = false;                                  // in any lane
+  unsigned signs = 0;
+  std::uint64_t lanes = 0; // bytes of 0xFF for the lanes taking part
+};
+
+// NodeCrossings lane by lane.
+struct PacketCrossings
+{
+  PacketFloats nearT[3], midT[3], farT[3];
+
+  NodeCrossings Lane(int lane) const
+  {
+    NodeCrossings c;
+    for (int a = 0; a < 3; ++a)
+    {
+      c.nearT[a] = nearT[a][lane];
+      c.midT[a] = midT[a][lane];
+      c.farT[a] = farT[a][lane];
+    }
+    return c;
+  }
+};
+
+inline PacketFloats Crossing(const RayPacket& p, int a, float plane)
+{
+  return (plane - p.origin[a]) * p.inverse[a];
+}
+
+inline PacketCrossings CrossingsOf(const RayPacket& p, const Vec3f& lo, float size)
+{
+  PacketCrossings c;
+  for (int a = 0; a < 3; ++a)
+  {
+    c.nearT[a] = Crossing(p, a, NearFace(p.signs, a, lo[a], size));
+    c.midT[a] = Crossing(p, a, lo[a] + 0.5f * size);
+    c.farT[a] = Crossing(p, a, FarFace(p.signs, a, lo[a], size));
+  }
+  return c;
+}
+
+inline PacketFloats ChildNear(const PacketCrossings& c, unsigned m, int a)
+{
+  return (m >> a) & 1u ? c.midT[a] : c.nearT[a];
+}
+
+inline PacketFloats ChildFar(const PacketCrossings& c, unsigned m, int a)
+{
+  return (m >> a) & 1u ? c.farT[a] : c.midT[a];
+}
+
+// MetOctants lane by lane.
+inline PacketInts MetOctants(const PacketFloats midT[3], PacketFloats tEnter, PacketFloats tExit)
+{
+  PacketInts met = PacketInts{} + 0xFF;
+  for (int a = 0; a < 3; ++a)
+  {
+    const int nearHalf = a == 0 ? 0x55 : (a == 1 ? 0x33 : 0x0F);
+    met &= ((midT[a] >= tEnter) & nearHalf) | ((midT[a] <= tExit) & (~nearHalf & 0xFF));
+  }
+  met &= ~((midT[0] > midT[1]) & 0x22);
+  met &= ~((midT[1] > midT[0]) & 0x44);
+  met &= ~((midT[0] > midT[2]) & 0x0A);
+  met &= ~((midT[2] > midT[0]) & 0x50);
+  met &= ~((midT[1] > midT[2]) & 0x0C);
+  met &= ~((midT[2] > midT[1]) & 0x30);
+  return met;
+}
+
+// The first voxel of each lane's ray, as FirstHitVisitor has it.
+struct PacketHits
+{
+  FirstHitVisitor lane[kPacketLanes];
+};
+
+// The walk for the lanes of p (Traverse's loop, TraverseFromRoot, for each
+// lane; see the header). `todo` and the paused nodes hold a set per lane.
+inline void TraversePacket(const OctreeView& tree, const RayPacket& p, PacketHits& hits)
+{
+  struct PausedNodes
+  {
+    std::uint32_t firstChild;
+    unsigned childMask;
+    std::uint64_t todo;
+  };
+  PausedNodes paused[kMaxLevel];
+  unsigned pausedLevels = 0;
+  std::uint64_t live = p.lanes; // lanes still without a hit
+  Vec3f lo{ 0.0f, 0.0f, 0.0f };
+  float size = 1.0f;
+  int level = 0;
+  PacketCrossings c = CrossingsOf(p, lo, size);
+  unsigned childMask = ChildMaskOf(tree, 0);
+  std::uint32_t firstChild = FirstChildOf(tree, 0);
+  std::uint64_t todo = live & LaneSets(static_cast<int>(MirrorOctants(childMask, p.signs)) &
+                                 MetOctants(c.midT, Later(p.tEnter, p.tMin), Earlier(p.tExit, p.tMax)));
+  while (live)
+  {
+    const unsigned any = UnionOfLanes(todo);
+    if (!any)
+    {
+      if (!pausedLevels)
+      {
+        return;
+      }
+      level = HighestBit(pausedLevels);
+      pausedLevels &= ~(1u << level);
+      firstChild = paused[level].firstChild;
+      childMask = paused[level].childMask;
+      todo = paused[level].todo & live;
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = NodeCorner(lo[a], level);
+      }
+      size = PowerOfTwo(-level);
+      c = CrossingsOf(p, lo, size);
+      continue;
+    }
+    const unsigned m = LowestBit(any);
+    const std::uint64_t entering = LanesHolding(todo, m); // the lanes that meet child m
+    todo &= ~(kEveryLaneByte << m);
+    PacketFloats tEnter = PacketFloats{} - INFINITY, tExit = PacketFloats{} + INFINITY;
+    for (int a = 0; a < 3; ++a)
+    {
+      tEnter = Later(ChildNear(c, m, a), tEnter);
+      tExit = Earlier(ChildFar(c, m, a), tExit);
+    }
+    const unsigned octant = m ^ p.signs;
+    const float half = 0.5f * size;
+    Vec3f childLo = lo;
+    for (int a = 0; a < 3; ++a)
+    {
+      childLo[a] += (octant >> a) & 1u ? half : 0.0f;
+    }
+    const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
+    std::uint64_t drawn = entering; // lanes that stop at the child: all at the leaves
+    if (level + 1 < tree.depth)
+    {
+      drawn = p.lodOn ? entering &
+          LaneBytes(half < p.lodPixels * (p.footprint0 + p.footprintSlope * Later(tEnter, PacketFloats{})))
+                    : 0;
+    }
+    if (drawn)
+    {
+      for (int lane = 0; lane < kPacketLanes; ++lane)
+      {
+        if ((drawn >> (8 * lane)) & 1u)
+        {
+          FirstHitVisitor& first = hits.lane[lane];
+          first.found = true;
+          const int axis = EntryAxis(c.Lane(lane), m, tEnter[lane]);
+          first.hit = NodeHit{ child, level + 1, tEnter[lane], tExit[lane], axis, childLo, half };
+        }
+      }
+      live &= ~drawn;
+      todo &= live;
+    }
+    const std::uint64_t descending = entering & ~drawn;
+    if (!descending)
+    {
+      continue;
+    }
+    PacketFloats innerMidT[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      innerMidT[a] = Crossing(p, a, childLo[a] + 0.5f * half);
+    }
+    const std::uint64_t groupMasks = tree.childMasks[child >> 3];
+    const unsigned grandchildMask = MaskInWord(groupMasks, child);
+    const std::uint64_t met = descending &
+      LaneSets(static_cast<int>(MirrorOctants(grandchildMask, p.signs)) &
+        MetOctants(innerMidT, Later(tEnter, p.tMin), Earlier(tExit, p.tMax)));
+    // Every lane that met the child goes on, here or after it, with the
+    // children that can still follow it (as Traverse's `after`).
+    todo = (todo & ~descending) | (todo & descending & (OctantsAfter(m) * kEveryLaneByte));
+    if (!met)
+    {
+      continue;
+    }
+    if (todo)
+    {
+      paused[level] = PausedNodes{ firstChild, childMask, todo };
+      pausedLevels |= 1u << level;
+    }
+    ++level;
+    for (int a = 0; a < 3; ++a)
+    {
+      const PacketFloats tNear = ChildNear(c, m, a);
+      c.farT[a] = ChildFar(c, m, a);
+      c.nearT[a] = tNear;
+      c.midT[a] = innerMidT[a];
+    }
+    lo = childLo;
+    size = half;
+    childMask = grandchildMask;
+    firstChild = FirstChildInGroup(tree.childBase[child >> 3], groupMasks, child);
+    todo = met;
+  }
+}
+
+// The first hits of up to kPacketLanes rays: `valid` has a bit per lane
+// whose ray exists. Lanes the packet cannot take are traced one by one.
+// The instruction set is FirstHits's choice (below).
+inline void FirstHitsOfPacket(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
+  unsigned valid, PacketHits& hits)
+{
+  RayPacket p;
+  p.signs = 8; // none yet
+  unsigned alone = 0;
+  for (int lane = 0; lane < kPacketLanes; ++lane)
+  {
+    hits.lane[lane] = FirstHitVisitor{};
+    const Ray& ray = rays[lane];
+    NodeHit root;
+    if (!((valid >> lane) & 1u) ||
+      !IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, root.tEnter, root.tExit, root.axis) ||
+      root.tExit < ray.tMin || root.tEnter > ray.tMax)
+    {
+      continue;
+    }
+    const bool parallel = ray.inverse.x == INFINITY || ray.inverse.y == INFINITY || ray.inverse.z == INFINITY;
+    const unsigned signs = DirectionSigns(ray);
+    if (parallel || tree.depth == 0 || lods[lane].StopAt(1.0f, root.tEnter) || (p.signs != 8 && signs != p.signs))
+    {
+      alone |= 1u << lane;
+      continue;
+    }
+    p.signs = signs;
+    p.lanes |= std::uint64_t{ 0xFF } << (8 * lane);
+    for (int a = 0; a < 3; ++a)
+    {
+      p.origin[a][lane] = ray.origin[a];
+      p.inverse[a][lane] = ray.inverse[a];
+    }
+    p.tMin[lane] = ray.tMin;
+    p.tMax[lane] = ray.tMax;
+    p.tEnter[lane] = root.tEnter;
+    p.tExit[lane] = root.tExit;
+    p.lodPixels[lane] = lods[lane].pixels;
+    p.footprint0[lane] = lods[lane].footprint0;
+    p.footprintSlope[lane] = lods[lane].footprintSlope;
+    p.lodOn = p.lodOn || lods[lane].pixels > 0.0f;
+  }
+  if (p.lanes)
+  {
+    // Lanes left out keep finite values, which no set of theirs reads.
+    for (int lane = 0; lane < kPacketLanes; ++lane)
+    {
+      if (!((p.lanes >> (8 * lane)) & 1u))
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          p.origin[a][lane] = 0.0f;
+          p.inverse[a][lane] = 1.0f;
+        }
+        p.tMin[lane] = p.tMax[lane] = p.tEnter[lane] = p.tExit[lane] = 0.0f;
+        p.lodPixels[lane] = p.footprint0[lane] = p.footprintSlope[lane] = 0.0f;
+      }
+    }
+    TraversePacket(tree, p, hits);
+  }
+  for (int lane = 0; lane < kPacketLanes; ++lane)
+  {
+    if ((alone >> lane) & 1u)
+    {
+      Traverse(tree, rays[lane], lods[lane], hits.lane[lane]);
+    }
+  }
+}
+
+// FirstHitsOfPacket with everything it calls inlined, compiled for the
+// baseline instruction set (on x86-64, two SSE registers per lane vector)
+// or, where the processor has it, for AVX2 (eight lanes in one register).
+// Inlining keeps the AVX2 instructions inside their one function, so a
+// processor without them never meets them, and no 256-bit vector crosses a
+// call between code built for different ABIs. No FMA: products and sums
+// round as the per-ray path's do.
+__attribute__((flatten)) inline void FirstHitsBaseline(const OctreeView& tree, const Ray rays[kPacketLanes],
+  const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+{
+  FirstHitsOfPacket(tree, rays, lods, valid, hits);
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx2"), flatten)) inline void FirstHitsAvx2(const OctreeView& tree,
+  const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+{
+  FirstHitsOfPacket(tree, rays, lods, valid, hits);
+}
+
+inline bool HasAvx2()
+{
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+#else
+inline void FirstHitsAvx2(const OctreeView& tree, const Ray rays[kPacketLanes],
+  const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+{
+  FirstHitsBaseline(tree, rays, lods, valid, hits);
+}
+
+inline bool HasAvx2()
+{
+  return false;
+}
+#endif
+
+inline void FirstHits(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
+  unsigned valid, PacketHits& hits)
+{
+  HasAvx2() ? FirstHitsAvx2(tree, rays, lods, valid, hits) : FirstHitsBaseline(tree, rays, lods, valid, hits);
+}
+}
