@@ -157,9 +157,9 @@ double PacketPrimaryRaySeconds(const FrameConstants& f, const OctreeView& tree, 
           double tBase;
           valid |= PrimaryRay(f, x0 + lane, y, rays[lane], tBase) ? 1u << lane : 0u;
         }
-        PacketHits hits;
-        FirstHits(tree, rays, lods, valid, hits);
-        for (const FirstHitVisitor& first : hits.lane)
+        FirstHitVisitor hits[kPacketLanes];
+        TracePacket(tree, rays, lods, valid, hits);
+        for (const FirstHitVisitor& first : hits)
         {
           hitSum += first.found ? first.hit.node + 1u : 0u;
         }

@@ -108,6 +108,8 @@ Reading these tables:
   on opaque-ish spheres.
 - Shadows and reflections add secondary rays (the last column); Mrays/s counts them, so those rows are not slower
   per ray, only per frame.
+- The CPU backend traces each frame's primary rays eight at a time (the packets of the one-core section below) and
+  its shadow and mirror rays one at a time, so the secondary rays cost more per ray than the primary ones.
 - How level of detail and the bounce limit trade error for time is in the quality section.
 
 ### One core: packets of rays, Traverse and the plain slab-test traversal
@@ -174,11 +176,12 @@ def _one_core(ctx):
     text = ("Command:\n\n    %s\n\nEach pixel's primary ray to its first voxel in a plain loop on one core (no "
             "shading, no picture), 1920×1080, best of 3 after a warm-up, three ways:\n\n"
             "- *packets*: eight neighbouring pixels of a row at once (PacketTraversal.h), as the CPU engine traces "
-            "the primary rays of surfaces. One walk of the octree serves the packet; each step's arithmetic runs "
-            "in SIMD lanes, one ray per lane (AVX2 where the processor has it, chosen at run time; SSE2 "
-            "otherwise). Each lane keeps the set of children that `Traverse` keeps for its ray, so its first hit "
-            "is `Traverse`'s, bit for bit. A lane whose direction lies in another octant than the packet's, or "
-            "runs parallel to an axis, is traced alone by `Traverse`.\n"
+            "every primary ray, of surfaces and of the volume blend modes alike (shadow and mirror rays go one "
+            "by one). One walk of the octree serves the packet; each step's arithmetic runs in SIMD lanes, one "
+            "ray per lane (AVX2 where the processor has it, chosen at run time; SSE2 otherwise). Each lane keeps "
+            "the set of children that `Traverse` keeps for its ray, so its pixel sees the voxels `Traverse` "
+            "shows it, bit for bit and in the same order. A lane whose direction lies in another octant than "
+            "the packet's, or runs parallel to an axis, is traced alone by `Traverse`.\n"
             "- *Traverse* (Traversal.h), one ray at a time: each child's span picked from its parent's near, mid "
             "and far plane crossings; only the children the ray meets stepped to, and of those only the ones "
             "whose own children it meets gone down into; the way back up one step to the deepest node with "

@@ -468,36 +468,54 @@ TEST(DepthSignature, ChangesWithAnyPixel)
 
 namespace
 {
-// Each lane's first hit from a packet against Traverse's for its ray alone,
-// in every value, through each instruction set this processor has.
-// `valid` has a bit per lane whose ray exists.
-void ExpectPacketHitsAreTraverses(
+// The voxels a traversal shows, until `limit` of them.
+struct VisitRecord
+{
+  std::size_t limit = 1;
+  std::vector<NodeHit> hits;
+  bool Visit(const NodeHit& h)
+  {
+    hits.push_back(h);
+    return hits.size() >= limit;
+  }
+};
+
+// What each lane's visitor is shown by a packet against what Traverse shows
+// it for the lane's ray alone, in every value and in order, through each
+// instruction set this processor has: the first voxel, the first three
+// (visitors that stop part of the way, as composite does) and all of them
+// (MIP). `valid` has a bit per lane whose ray exists.
+void ExpectPacketVisitsAreTraverses(
   const OctreeView& view, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes], unsigned valid)
 {
-  PacketHits baseline, avx2;
-  FirstHitsBaseline(view, rays, lods, valid, baseline);
-  if (HasAvx2())
+  for (std::size_t limit : { std::size_t{ 1 }, std::size_t{ 3 }, SIZE_MAX })
   {
-    FirstHitsAvx2(view, rays, lods, valid, avx2);
-  }
-  for (int lane = 0; lane < kPacketLanes; ++lane)
-  {
-    FirstHitVisitor alone;
-    if ((valid >> lane) & 1u)
+    for (bool avx2 : { false, true })
     {
-      Traverse(view, rays[lane], lods[lane], alone);
-    }
-    for (const PacketHits* hits : { &baseline, HasAvx2() ? &avx2 : nullptr })
-    {
-      if (!hits)
+      if (avx2 && !HasAvx2())
       {
         continue;
       }
-      const FirstHitVisitor& packed = hits->lane[lane];
-      ASSERT_EQ(packed.found, alone.found) << "lane " << lane << (hits == &avx2 ? ", AVX2" : ", baseline");
-      if (alone.found)
+      VisitRecord packed[kPacketLanes];
+      for (VisitRecord& v : packed)
       {
-        ASSERT_TRUE(SameHit(packed.hit, alone.hit)) << "lane " << lane << (hits == &avx2 ? ", AVX2" : ", baseline");
+        v.limit = limit;
+      }
+      avx2 ? TracePacketAvx2(view, rays, lods, valid, packed) : TracePacketBaseline(view, rays, lods, valid, packed);
+      for (int lane = 0; lane < kPacketLanes; ++lane)
+      {
+        VisitRecord alone{ limit, {} };
+        if ((valid >> lane) & 1u)
+        {
+          Traverse(view, rays[lane], lods[lane], alone);
+        }
+        const std::string where = "lane " + std::to_string(lane) + ", up to " + std::to_string(limit) +
+          " voxels, " + (avx2 ? "AVX2" : "baseline");
+        ASSERT_EQ(packed[lane].hits.size(), alone.hits.size()) << where;
+        for (std::size_t k = 0; k < alone.hits.size(); ++k)
+        {
+          ASSERT_TRUE(SameHit(packed[lane].hits[k], alone.hits[k])) << where << ", voxel " << k;
+        }
       }
     }
   }
@@ -510,7 +528,7 @@ void ExpectPacketHitsAreTraverses(
 // cameras outside and inside the cube, in perspective and parallel
 // projection, looking along an axis (lanes parallel to it, and rows whose
 // directions change octant), with level of detail and a depth buffer.
-TEST(PacketTraversal, EveryLaneHitsWhatTraverseHits)
+TEST(PacketTraversal, EveryLaneSeesWhatTraverseShows)
 {
   const Cloud c = GaussianClusters(3000, 47);
   auto cpu = CreateEngine(Backend::CPU);
@@ -526,7 +544,7 @@ TEST(PacketTraversal, EveryLaneHitsWhatTraverseHits)
     {
       scattered.Make(packet * kPacketLanes + lane, rays[lane], lods[lane]);
     }
-    ExpectPacketHitsAreTraverses(view, rays, lods, packet % 5 == 0 ? 0xB5u : 0xFFu);
+    ExpectPacketVisitsAreTraverses(view, rays, lods, packet % 5 == 0 ? 0xB5u : 0xFFu);
   }
   const int w = 61, h = 45; // rows end in a part of a packet
   const double target[3] = { 2, 1, 1 };
@@ -566,7 +584,7 @@ TEST(PacketTraversal, EveryLaneHitsWhatTraverseHits)
             }
           }
           packed += valid != 0;
-          ExpectPacketHitsAreTraverses(view, rays, lods, valid);
+          ExpectPacketVisitsAreTraverses(view, rays, lods, valid);
         }
       }
       EXPECT_GT(packed, h); // the camera sees the cube
@@ -574,10 +592,43 @@ TEST(PacketTraversal, EveryLaneHitsWhatTraverseHits)
   }
 }
 
-// The CPU engine traces the primary rays of surfaces in packets: its
-// pictures are those of RenderPixel pixel by pixel, in every value, flat,
-// depth-cued and lit with shadows, with and without reflections (the
-// clusters' points reflect) and level of detail.
+namespace
+{
+// The CPU engine's picture against RenderPixel's, pixel by pixel, in every
+// value. Returns the pixels hit.
+std::size_t ExpectRenderPixelsPicture(Engine& cpu, HostOctree& t, const RenderSettings& s)
+{
+  Image image;
+  cpu.Render(s, image);
+  const OctreeView view = t.View();
+  const FrameConstants f = MakeFrame(s, view);
+  std::size_t rays = 0, hits = 0;
+  DispatchFeatures(f, [&](auto features) {
+    using F = decltype(features);
+    for (int y = 0; y < s.height; ++y)
+    {
+      for (int x = 0; x < s.width; ++x)
+      {
+        const std::size_t i = std::size_t(y) * s.width + x;
+        float rgba[4], depth;
+        RenderPixel<F>(f, view, x, y, rgba, depth, rays);
+        hits += depth < 1.0f;
+        ASSERT_EQ(image.depth[i], depth) << "pixel " << x << "," << y;
+        for (int k = 0; k < 4; ++k)
+        {
+          ASSERT_EQ(image.rgba[4 * i + k], rgba[k]) << "pixel " << x << "," << y << ", channel " << k;
+        }
+      }
+    }
+  });
+  return hits;
+}
+}
+
+// The CPU engine traces primary rays in packets: its pictures are those of
+// RenderPixel pixel by pixel, in every value. Surfaces flat, depth-cued and
+// lit with shadows, with and without reflections (the clusters' points
+// reflect); every volume blend mode; with and without level of detail.
 TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
 {
   const Cloud c = GaussianClusters(20000, 46);
@@ -585,50 +636,43 @@ TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
   BuildOptions options;
   options.depth = 8;
   HostOctree t = BuildOnHost(*cpu, c.View(), options);
-  const int w = 61, h = 45;
+  const int w = 61, h = 45; // rows end in a part of a packet
   const double eye[3] = { 9, -11, 7 }, target[3] = { 1, 1, 0 };
   const Matrix vp = ViewProjection(eye, target, kUp, 40, double(w) / h, 1, 100);
-  for (ShadeMode shade : { ShadeMode::Flat, ShadeMode::DepthCue, ShadeMode::Phong })
+  for (BlendMode blend : { BlendMode::Surface, BlendMode::Composite, BlendMode::Maximum, BlendMode::Minimum,
+         BlendMode::Average, BlendMode::Additive })
   {
-    for (int variant = 0; variant < 4; ++variant)
+    for (ShadeMode shade : { ShadeMode::Flat, ShadeMode::DepthCue, ShadeMode::Phong })
     {
-      RenderSettings s = Settings(vp, w, h);
-      s.shade = shade;
-      s.maxBounces = variant % 2 == 0 ? 0 : 2;
-      s.lodPixels = variant < 2 ? 0.0f : 2.0f;
-      SCOPED_TRACE("shade " + std::to_string(int(shade)) + ", bounces " + std::to_string(s.maxBounces) +
-        ", level of detail " + std::to_string(s.lodPixels));
-      if (shade == ShadeMode::Phong)
+      for (int variant = 0; variant < 4; ++variant)
       {
-        Light sun;
-        sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
-        s.lights.push_back(sun);
-        s.shadows = true;
-      }
-      Image image;
-      cpu->Render(s, image);
-      const OctreeView view = t.View();
-      const FrameConstants f = MakeFrame(s, view);
-      std::size_t rays = 0, hits = 0;
-      DispatchFeatures(f, [&](auto features) {
-        using F = decltype(features);
-        for (int y = 0; y < h; ++y)
+        RenderSettings s = Settings(vp, w, h);
+        s.blend = blend;
+        s.shade = shade;
+        s.maxBounces = variant % 2 == 0 ? 0 : 2;
+        s.lodPixels = variant < 2 ? 0.0f : 2.0f;
+        if (blend != BlendMode::Surface && (shade != ShadeMode::Flat || s.maxBounces > 0))
         {
-          for (int x = 0; x < w; ++x)
-          {
-            const std::size_t i = std::size_t(y) * w + x;
-            float rgba[4], depth;
-            RenderPixel<F>(f, view, x, y, rgba, depth, rays);
-            hits += depth < 1.0f;
-            ASSERT_EQ(image.depth[i], depth) << "pixel " << x << "," << y;
-            for (int k = 0; k < 4; ++k)
-            {
-              ASSERT_EQ(image.rgba[4 * i + k], rgba[k]) << "pixel " << x << "," << y << ", channel " << k;
-            }
-          }
+          continue; // the volume modes neither shade nor bounce
         }
-      });
-      EXPECT_GT(hits, std::size_t(w) * h / 10);
+        SCOPED_TRACE("blend " + std::to_string(int(blend)) + ", shade " + std::to_string(int(shade)) +
+          ", bounces " + std::to_string(s.maxBounces) + ", level of detail " + std::to_string(s.lodPixels));
+        if (shade == ShadeMode::Phong)
+        {
+          Light sun;
+          sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
+          s.lights.push_back(sun);
+          s.shadows = true;
+        }
+        s.transfer.range[0] = -50;
+        s.transfer.range[1] = 50;
+        for (int i = 0; i < 64 && blend != BlendMode::Surface; ++i)
+        {
+          s.transfer.table.push_back(
+            Rgba{ i / 63.0f, 0.5f, 1 - i / 63.0f, blend == BlendMode::Composite ? 0.05f : 1.0f });
+        }
+        EXPECT_GT(ExpectRenderPixelsPicture(*cpu, t, s), std::size_t(w) * h / 10);
+      }
     }
   }
 }

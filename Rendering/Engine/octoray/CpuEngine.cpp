@@ -1,12 +1,16 @@
 // The CPU backend: the shared build and update (OctreeDriver.h) on the
-// CPU device, and rendering that runs the shared per-pixel function
-// (RenderKernels.h) over rows interleaved across threads.
+// CPU device, and rendering over rows interleaved across threads: the
+// primary rays of eight pixels at a time through one walk of the octree
+// (PacketTraversal.h), each pixel then made by the shared per-pixel
+// functions (RenderKernels.h).
 #include "CpuEngine.h"
 
 #include "Frame.h"
 #include "PacketTraversal.h"
 
+#include <algorithm>
 #include <chrono>
+#include <type_traits>
 
 namespace octoray
 {
@@ -27,12 +31,12 @@ void SurfacePixel(const FrameConstants& f, const OctreeView& tree, const CameraR
   }
 }
 
-// A row of surface pixels, eight at a time: their primary rays' first
-// voxels from one walk of the octree (PacketTraversal.h), then each
-// pixel's shading and secondary rays as RenderPixel's. store(x, rgba)
-// keeps a pixel.
+// A row of pixels, eight at a time: their primary rays from one walk of the
+// octree (PacketTraversal.h), each seen by its pixel's visitor, then each
+// pixel made from what its visitor saw, as RenderPixel makes it.
+// store(x, rgba) keeps a pixel.
 template <typename F, typename Store>
-void RenderSurfaceRow(
+void RenderRow(
   const FrameConstants& f, const OctreeView& tree, int y, float* depthRow, std::size_t& secondaryRays, Store store)
 {
   for (int x0 = 0; x0 < f.width; x0 += kPacketLanes)
@@ -52,13 +56,25 @@ void RenderSurfaceRow(
         lods[lane] = pixels[lane].lod;
       }
     }
-    PacketHits hits;
-    FirstHits(tree, rays, lods, valid, hits);
+    using Visitor = std::conditional_t<F::kVolume, BlendVisitor, FirstHitVisitor>;
+    Visitor visitors[kPacketLanes];
+    if constexpr (F::kVolume)
+    {
+      std::fill_n(visitors, kPacketLanes, BlendVisitor{ &f, &tree });
+    }
+    TracePacket(tree, rays, lods, valid, visitors);
     for (int lane = 0; lane < lanes; ++lane)
     {
       if ((valid >> lane) & 1u)
       {
-        SurfacePixel<F>(f, tree, pixels[lane], hits.lane[lane], rgba[lane], depthRow[x0 + lane], secondaryRays);
+        if constexpr (F::kVolume)
+        {
+          ShadeBlend(f, pixels[lane], visitors[lane], rgba[lane], depthRow[x0 + lane]);
+        }
+        else
+        {
+          SurfacePixel<F>(f, tree, pixels[lane], visitors[lane], rgba[lane], depthRow[x0 + lane], secondaryRays);
+        }
       }
       store(x0 + lane, rgba[lane]);
     }
@@ -115,20 +131,8 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
       for (int y = t; y < settings.height; y += threads)
       {
         const std::size_t row = static_cast<std::size_t>(y) * settings.width;
-        if constexpr (!F::kVolume)
-        {
-          RenderSurfaceRow<F>(frame, view, y, image.depth.data() + row, rays,
-            [&](int x, const float pixel[4]) { store(row + x, pixel); });
-        }
-        else
-        {
-          for (int x = 0; x < settings.width; ++x)
-          {
-            float pixel[4];
-            RenderPixel<F>(frame, view, x, y, pixel, image.depth[row + x], rays);
-            store(row + x, pixel);
-          }
-        }
+        RenderRow<F>(frame, view, y, image.depth.data() + row, rays,
+          [&](int x, const float pixel[4]) { store(row + x, pixel); });
       }
       secondary[t] = rays;
     });

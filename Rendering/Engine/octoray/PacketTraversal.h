@@ -1,7 +1,7 @@
-// First hits of eight rays at once, for the CPU backend: one walk of the
-// octree for the packet, each step's arithmetic done in SIMD lanes, one ray
-// per lane. Host only (GCC and Clang vector extensions): the GPU's threads
-// are its lanes already.
+// Eight rays through the octree at once, for the CPU backend: one walk of
+// the octree for the packet, each step's arithmetic done in SIMD lanes, one
+// ray per lane. Host only (GCC and Clang vector extensions): the GPU's
+// threads are its lanes already.
 //
 // The walk is Traverse's (Traversal.h) for every lane at once. Rays of one
 // octant of directions (DirectionSigns) visit a node's children in the same
@@ -10,8 +10,9 @@
 // Each lane keeps its own set of children left, the very set Traverse keeps
 // for that ray, as one byte of a 64-bit word per node; the walk steps to
 // the lowest child any lane has left, and every value a lane computes is
-// the one Traverse computes for its ray, bit for bit. A lane's first hit is
-// therefore Traverse's, and the pictures are the same.
+// the one Traverse computes for its ray, bit for bit. Each lane's visitor
+// therefore sees what Traverse shows it, in the same order, until it says
+// stop, and the pictures are the same.
 //
 // A lane the packet cannot take (a direction in another octant than the
 // first lane's, a zero component, a root that the level of detail stops
@@ -148,15 +149,11 @@ inline PacketInts MetOctants(const PacketFloats midT[3], PacketFloats tEnter, Pa
   return met;
 }
 
-// The first voxel of each lane's ray, as FirstHitVisitor has it.
-struct PacketHits
-{
-  FirstHitVisitor lane[kPacketLanes];
-};
-
 // The walk for the lanes of p (Traverse's loop, TraverseFromRoot, for each
-// lane; see the header). `todo` and the paused nodes hold a set per lane.
-inline void TraversePacket(const OctreeView& tree, const RayPacket& p, PacketHits& hits)
+// lane; see the header), visitors[lane] seeing its lane's voxels. `todo`
+// and the paused nodes hold a set per lane.
+template <typename Visitor>
+void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors[kPacketLanes])
 {
   struct PausedNodes
   {
@@ -166,7 +163,7 @@ inline void TraversePacket(const OctreeView& tree, const RayPacket& p, PacketHit
   };
   PausedNodes paused[kMaxLevel];
   unsigned pausedLevels = 0;
-  std::uint64_t live = p.lanes; // lanes still without a hit
+  std::uint64_t live = p.lanes; // lanes whose visitors still look
   Vec3f lo{ 0.0f, 0.0f, 0.0f };
   float size = 1.0f;
   int level = 0;
@@ -227,13 +224,13 @@ inline void TraversePacket(const OctreeView& tree, const RayPacket& p, PacketHit
       {
         if ((drawn >> (8 * lane)) & 1u)
         {
-          FirstHitVisitor& first = hits.lane[lane];
-          first.found = true;
           const int axis = EntryAxis(c.Lane(lane), m, tEnter[lane]);
-          first.hit = NodeHit{ child, level + 1, tEnter[lane], tExit[lane], axis, childLo, half };
+          if (visitors[lane].Visit(NodeHit{ child, level + 1, tEnter[lane], tExit[lane], axis, childLo, half }))
+          {
+            live &= ~(std::uint64_t{ 0xFF } << (8 * lane));
+          }
         }
       }
-      live &= ~drawn;
       todo &= live;
     }
     const std::uint64_t descending = entering & ~drawn;
@@ -279,18 +276,19 @@ inline void TraversePacket(const OctreeView& tree, const RayPacket& p, PacketHit
   }
 }
 
-// The first hits of up to kPacketLanes rays: `valid` has a bit per lane
-// whose ray exists. Lanes the packet cannot take are traced one by one.
-// The instruction set is FirstHits's choice (below).
-inline void FirstHitsOfPacket(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
-  unsigned valid, PacketHits& hits)
+// Up to kPacketLanes rays, each shown to its visitor as Traverse would show
+// it: `valid` has a bit per lane whose ray exists. Lanes the packet cannot
+// take are traced one by one. The instruction set is TracePacket's choice
+// (below).
+template <typename Visitor>
+void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
+  unsigned valid, Visitor visitors[kPacketLanes])
 {
   RayPacket p;
   p.signs = 8; // none yet
   unsigned alone = 0;
   for (int lane = 0; lane < kPacketLanes; ++lane)
   {
-    hits.lane[lane] = FirstHitVisitor{};
     const Ray& ray = rays[lane];
     NodeHit root;
     if (!((valid >> lane) & 1u) ||
@@ -338,35 +336,37 @@ inline void FirstHitsOfPacket(const OctreeView& tree, const Ray rays[kPacketLane
         p.lodPixels[lane] = p.footprint0[lane] = p.footprintSlope[lane] = 0.0f;
       }
     }
-    TraversePacket(tree, p, hits);
+    TraversePacket(tree, p, visitors);
   }
   for (int lane = 0; lane < kPacketLanes; ++lane)
   {
     if ((alone >> lane) & 1u)
     {
-      Traverse(tree, rays[lane], lods[lane], hits.lane[lane]);
+      Traverse(tree, rays[lane], lods[lane], visitors[lane]);
     }
   }
 }
 
-// FirstHitsOfPacket with everything it calls inlined, compiled for the
+// TracePacketOf with everything it calls inlined, compiled for the
 // baseline instruction set (on x86-64, two SSE registers per lane vector)
 // or, where the processor has it, for AVX2 (eight lanes in one register).
 // Inlining keeps the AVX2 instructions inside their one function, so a
 // processor without them never meets them, and no 256-bit vector crosses a
 // call between code built for different ABIs. No FMA: products and sums
 // round as the per-ray path's do.
-__attribute__((flatten)) inline void FirstHitsBaseline(const OctreeView& tree, const Ray rays[kPacketLanes],
-  const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+template <typename Visitor>
+__attribute__((flatten)) void TracePacketBaseline(const OctreeView& tree, const Ray rays[kPacketLanes],
+  const LevelOfDetail lods[kPacketLanes], unsigned valid, Visitor visitors[kPacketLanes])
 {
-  FirstHitsOfPacket(tree, rays, lods, valid, hits);
+  TracePacketOf(tree, rays, lods, valid, visitors);
 }
 
 #if defined(__x86_64__)
-__attribute__((target("avx2"), flatten)) inline void FirstHitsAvx2(const OctreeView& tree,
-  const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+template <typename Visitor>
+__attribute__((target("avx2"), flatten)) void TracePacketAvx2(const OctreeView& tree, const Ray rays[kPacketLanes],
+  const LevelOfDetail lods[kPacketLanes], unsigned valid, Visitor visitors[kPacketLanes])
 {
-  FirstHitsOfPacket(tree, rays, lods, valid, hits);
+  TracePacketOf(tree, rays, lods, valid, visitors);
 }
 
 inline bool HasAvx2()
@@ -375,10 +375,11 @@ inline bool HasAvx2()
   return avx2;
 }
 #else
-inline void FirstHitsAvx2(const OctreeView& tree, const Ray rays[kPacketLanes],
-  const LevelOfDetail lods[kPacketLanes], unsigned valid, PacketHits& hits)
+template <typename Visitor>
+void TracePacketAvx2(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
+  unsigned valid, Visitor visitors[kPacketLanes])
 {
-  FirstHitsBaseline(tree, rays, lods, valid, hits);
+  TracePacketBaseline(tree, rays, lods, valid, visitors);
 }
 
 inline bool HasAvx2()
@@ -387,9 +388,11 @@ inline bool HasAvx2()
 }
 #endif
 
-inline void FirstHits(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
-  unsigned valid, PacketHits& hits)
+template <typename Visitor>
+void TracePacket(const OctreeView& tree, const Ray rays[kPacketLanes], const LevelOfDetail lods[kPacketLanes],
+  unsigned valid, Visitor visitors[kPacketLanes])
 {
-  HasAvx2() ? FirstHitsAvx2(tree, rays, lods, valid, hits) : FirstHitsBaseline(tree, rays, lods, valid, hits);
+  HasAvx2() ? TracePacketAvx2(tree, rays, lods, valid, visitors)
+            : TracePacketBaseline(tree, rays, lods, valid, visitors);
 }
 }

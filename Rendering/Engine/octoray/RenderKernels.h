@@ -550,14 +550,10 @@ struct CameraRay
   }
 };
 
-// A volume blend mode: what the ray collects through every voxel it meets.
-OCTORAY_HD void BlendPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel, float rgba[4],
+// A volume blend mode's pixel from what its ray collected (BlendVisitor).
+OCTORAY_HD void ShadeBlend(const FrameConstants& f, const CameraRay& pixel, const BlendVisitor& blend, float rgba[4],
   float& depth)
 {
-  BlendVisitor blend;
-  blend.f = &f;
-  blend.tree = &tree;
-  Traverse(tree, pixel.ray, pixel.lod, blend);
   if (!blend.any)
   {
     return;
@@ -704,7 +700,9 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
   }
   if constexpr (F::kVolume)
   {
-    BlendPixel(f, tree, pixel, rgba, depth);
+    BlendVisitor blend{ &f, &tree };
+    Traverse(tree, pixel.ray, pixel.lod, blend);
+    ShadeBlend(f, pixel, blend, rgba, depth);
   }
   else if constexpr (F::kSecondary)
   {
