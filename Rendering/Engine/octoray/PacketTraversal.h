@@ -64,17 +64,6 @@ inline unsigned UnionOfLanes(std::uint64_t sets)
   return static_cast<unsigned>(sets) & 0xFFu;
 }
 
-// Later and Earlier (Traversal.h) lane by lane, with the host's comparison.
-inline PacketFloats Later(PacketFloats a, PacketFloats b)
-{
-  return a > b ? a : b;
-}
-
-inline PacketFloats Earlier(PacketFloats a, PacketFloats b)
-{
-  return a < b ? a : b;
-}
-
 // The packet's rays, lane by lane, and the span of each through the root.
 struct RayPacket
 {
@@ -86,67 +75,17 @@ struct RayPacket
   std::uint64_t lanes = 0; // bytes of 0xFF for the lanes taking part
 };
 
-// NodeCrossings lane by lane.
-struct PacketCrossings
+// One lane's crossings.
+inline NodeCrossings LaneOf(const Crossings<PacketFloats>& c, int lane)
 {
-  PacketFloats nearT[3], midT[3], farT[3];
-
-  NodeCrossings Lane(int lane) const
-  {
-    NodeCrossings c;
-    for (int a = 0; a < 3; ++a)
-    {
-      c.nearT[a] = nearT[a][lane];
-      c.midT[a] = midT[a][lane];
-      c.farT[a] = farT[a][lane];
-    }
-    return c;
-  }
-};
-
-inline PacketFloats Crossing(const RayPacket& p, int a, float plane)
-{
-  return (plane - p.origin[a]) * p.inverse[a];
-}
-
-inline PacketCrossings CrossingsOf(const RayPacket& p, const Vec3f& lo, float size)
-{
-  PacketCrossings c;
+  NodeCrossings one;
   for (int a = 0; a < 3; ++a)
   {
-    c.nearT[a] = Crossing(p, a, NearFace(p.signs, a, lo[a], size));
-    c.midT[a] = Crossing(p, a, lo[a] + 0.5f * size);
-    c.farT[a] = Crossing(p, a, FarFace(p.signs, a, lo[a], size));
+    one.nearT[a] = c.nearT[a][lane];
+    one.midT[a] = c.midT[a][lane];
+    one.farT[a] = c.farT[a][lane];
   }
-  return c;
-}
-
-inline PacketFloats ChildNear(const PacketCrossings& c, unsigned m, int a)
-{
-  return (m >> a) & 1u ? c.midT[a] : c.nearT[a];
-}
-
-inline PacketFloats ChildFar(const PacketCrossings& c, unsigned m, int a)
-{
-  return (m >> a) & 1u ? c.farT[a] : c.midT[a];
-}
-
-// MetOctants lane by lane.
-inline PacketInts MetOctants(const PacketFloats midT[3], PacketFloats tEnter, PacketFloats tExit)
-{
-  PacketInts met = PacketInts{} + 0xFF;
-  for (int a = 0; a < 3; ++a)
-  {
-    const int nearHalf = a == 0 ? 0x55 : (a == 1 ? 0x33 : 0x0F);
-    met &= ((midT[a] >= tEnter) & nearHalf) | ((midT[a] <= tExit) & (~nearHalf & 0xFF));
-  }
-  met &= ~((midT[0] > midT[1]) & 0x22);
-  met &= ~((midT[1] > midT[0]) & 0x44);
-  met &= ~((midT[0] > midT[2]) & 0x0A);
-  met &= ~((midT[2] > midT[0]) & 0x50);
-  met &= ~((midT[1] > midT[2]) & 0x0C);
-  met &= ~((midT[2] > midT[1]) & 0x30);
-  return met;
+  return one;
 }
 
 // The walk for the lanes of p (Traverse's loop, TraverseFromRoot, for each
@@ -167,7 +106,7 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
   Vec3f lo{ 0.0f, 0.0f, 0.0f };
   float size = 1.0f;
   int level = 0;
-  PacketCrossings c = CrossingsOf(p, lo, size);
+  Crossings<PacketFloats> c = CrossingsOf<false>(p, p.signs, lo, size);
   unsigned childMask = ChildMaskOf(tree, 0);
   std::uint32_t firstChild = FirstChildOf(tree, 0);
   std::uint64_t todo = live & LaneSets(static_cast<int>(MirrorOctants(childMask, p.signs)) &
@@ -191,18 +130,13 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
         lo[a] = NodeCorner(lo[a], level);
       }
       size = PowerOfTwo(-level);
-      c = CrossingsOf(p, lo, size);
+      c = CrossingsOf<false>(p, p.signs, lo, size);
       continue;
     }
     const unsigned m = LowestBit(any);
     const std::uint64_t entering = LanesHolding(todo, m); // the lanes that meet child m
     todo &= ~(kEveryLaneByte << m);
-    PacketFloats tEnter = PacketFloats{} - INFINITY, tExit = PacketFloats{} + INFINITY;
-    for (int a = 0; a < 3; ++a)
-    {
-      tEnter = Later(ChildNear(c, m, a), tEnter);
-      tExit = Earlier(ChildFar(c, m, a), tExit);
-    }
+    const ChildSpan<PacketFloats> span = SpanOf(c, m);
     const unsigned octant = m ^ p.signs;
     const float half = 0.5f * size;
     Vec3f childLo = lo;
@@ -215,7 +149,7 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     if (level + 1 < tree.depth)
     {
       drawn = p.lodOn ? entering &
-          LaneBytes(half < p.lodPixels * (p.footprint0 + p.footprintSlope * Later(tEnter, PacketFloats{})))
+          LaneBytes(half < p.lodPixels * (p.footprint0 + p.footprintSlope * Later(span.tEnter, PacketFloats{})))
                     : 0;
     }
     if (drawn)
@@ -224,8 +158,9 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
       {
         if ((drawn >> (8 * lane)) & 1u)
         {
-          const int axis = EntryAxis(c.Lane(lane), m, tEnter[lane]);
-          if (visitors[lane].Visit(NodeHit{ child, level + 1, tEnter[lane], tExit[lane], axis, childLo, half }))
+          const float tEnter = span.tEnter[lane], tExit = span.tExit[lane];
+          const int axis = EntryAxis(LaneOf(c, lane), m, tEnter);
+          if (visitors[lane].Visit(NodeHit{ child, level + 1, tEnter, tExit, axis, childLo, half }))
           {
             live &= ~(std::uint64_t{ 0xFF } << (8 * lane));
           }
@@ -241,13 +176,13 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     PacketFloats innerMidT[3];
     for (int a = 0; a < 3; ++a)
     {
-      innerMidT[a] = Crossing(p, a, childLo[a] + 0.5f * half);
+      innerMidT[a] = Crossing<false>(p, a, childLo[a] + 0.5f * half);
     }
     const std::uint64_t groupMasks = tree.childMasks[child >> 3];
     const unsigned grandchildMask = MaskInWord(groupMasks, child);
     const std::uint64_t met = descending &
       LaneSets(static_cast<int>(MirrorOctants(grandchildMask, p.signs)) &
-        MetOctants(innerMidT, Later(tEnter, p.tMin), Earlier(tExit, p.tMax)));
+        MetOctants(innerMidT, Later(span.tEnter, p.tMin), Earlier(span.tExit, p.tMax)));
     // Every lane that met the child goes on, here or after it, with the
     // children that can still follow it (as Traverse's `after`).
     todo = (todo & ~descending) | (todo & descending & (OctantsAfter(m) * kEveryLaneByte));

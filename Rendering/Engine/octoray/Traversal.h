@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 namespace octoray
 {
@@ -112,17 +113,52 @@ struct NodeHit
   float size;
 };
 
+// The per-node arithmetic below serves one ray (a Ray: floats) and, on the
+// CPU, the lanes of a packet of rays at once (PacketTraversal.h's
+// RayPacket: vectors of floats, one lane per ray), written once for both.
+// Where a comparison picks bits, `Where` and `Unless` take a bool for one
+// ray and a lane mask (0 or -1 per lane) for a packet.
+OCTORAY_HD_INLINE unsigned Where(bool held, unsigned bits)
+{
+  return held ? bits : 0u;
+}
+
+OCTORAY_HD_INLINE unsigned Unless(bool held, unsigned bits)
+{
+  return held ? ~bits : ~0u;
+}
+
+template <typename Lanes>
+OCTORAY_HD_INLINE Lanes Where(Lanes held, unsigned bits)
+{
+  return held & static_cast<int>(bits);
+}
+
+template <typename Lanes>
+OCTORAY_HD_INLINE Lanes Unless(Lanes held, unsigned bits)
+{
+  return ~(held & static_cast<int>(bits));
+}
+
+// The type of a ray's (float) or a packet's (lanes of floats) values.
+template <typename Rays>
+using ValuesOf = std::decay_t<decltype(Rays{}.origin[0])>;
+
 // Where the ray crosses the plane x[a] = p. A ray parallel to the plane
 // never crosses it: -inf where it runs on the plane or beyond it (boxes are
 // half-open, so the plane belongs to the upper side), +inf below it. A ray
-// known to have no parallel axis (MayBeParallel false: almost every ray)
-// skips that test, a third of the work of the traversal's crossings.
-template <bool MayBeParallel = true>
-OCTORAY_HD_INLINE float Crossing(const Ray& ray, int a, float p)
+// known to have no parallel axis (MayBeParallel false: almost every ray,
+// and every lane of a packet) skips that test, a third of the work of the
+// traversal's crossings.
+template <bool MayBeParallel = true, typename Rays>
+OCTORAY_HD_INLINE ValuesOf<Rays> Crossing(const Rays& ray, int a, float p)
 {
-  if (MayBeParallel && ray.inverse[a] == INFINITY) // parallel (SetDirection)
+  if constexpr (MayBeParallel)
   {
-    return p <= ray.origin[a] ? -INFINITY : INFINITY;
+    if (ray.inverse[a] == INFINITY) // parallel (SetDirection)
+    {
+      return p <= ray.origin[a] ? -INFINITY : INFINITY;
+    }
   }
   return (p - ray.origin[a]) * ray.inverse[a];
 }
@@ -133,10 +169,12 @@ OCTORAY_HD_INLINE float Crossing(const Ray& ray, int a, float p)
 // mid plane, then the far face. A child's interval is thus picked from
 // these nine values without any arithmetic, and a child's near and far
 // faces are its parent's near face or mid plane and mid plane or far face.
-struct NodeCrossings
+template <typename T>
+struct Crossings
 {
-  Vec3f nearT, midT, farT;
+  T nearT[3], midT[3], farT[3];
 };
+using NodeCrossings = Crossings<float>;
 
 // Octant bit a set where the ray runs towards -a (a zero component counts
 // as +, as the half-open boxes want).
@@ -160,10 +198,10 @@ OCTORAY_HD_INLINE float FarFace(unsigned signs, int a, float lo, float size)
 // The crossings of the node whose corner is `lo` and side `size`. Its
 // planes are exact dyadic fractions, so the values are the same however the
 // corner was reached.
-template <bool MayBeParallel>
-OCTORAY_HD_INLINE NodeCrossings CrossingsOf(const Ray& ray, unsigned signs, const Vec3f& lo, float size)
+template <bool MayBeParallel, typename Rays>
+OCTORAY_HD_INLINE Crossings<ValuesOf<Rays>> CrossingsOf(const Rays& ray, unsigned signs, const Vec3f& lo, float size)
 {
-  NodeCrossings c;
+  Crossings<ValuesOf<Rays>> c;
   for (int a = 0; a < 3; ++a)
   {
     c.nearT[a] = Crossing<MayBeParallel>(ray, a, NearFace(signs, a, lo[a], size));
@@ -175,8 +213,9 @@ OCTORAY_HD_INLINE NodeCrossings CrossingsOf(const Ray& ray, unsigned signs, cons
 
 // The larger and the smaller of two crossings, which are never NaN: one
 // instruction on the device, where fmaxf is one; a compare on the host,
-// where it is a library call.
-OCTORAY_HD_INLINE float Later(float a, float b)
+// where it is a library call (and, for a packet's lanes, one instruction).
+template <typename T>
+OCTORAY_HD_INLINE T Later(T a, T b)
 {
 #if defined(__CUDA_ARCH__)
   return fmaxf(a, b);
@@ -185,7 +224,8 @@ OCTORAY_HD_INLINE float Later(float a, float b)
 #endif
 }
 
-OCTORAY_HD_INLINE float Earlier(float a, float b)
+template <typename T>
+OCTORAY_HD_INLINE T Earlier(T a, T b)
 {
 #if defined(__CUDA_ARCH__)
   return fminf(a, b);
@@ -196,24 +236,28 @@ OCTORAY_HD_INLINE float Earlier(float a, float b)
 
 // The entry and exit of the child in mirrored octant m: the latest near
 // face and the earliest far face.
+template <typename T>
 struct ChildSpan
 {
-  float tEnter, tExit;
+  T tEnter, tExit;
 };
 
-OCTORAY_HD_INLINE float ChildNear(const NodeCrossings& c, unsigned m, int a)
+template <typename T>
+OCTORAY_HD_INLINE T ChildNear(const Crossings<T>& c, unsigned m, int a)
 {
   return (m >> a) & 1u ? c.midT[a] : c.nearT[a];
 }
 
-OCTORAY_HD_INLINE float ChildFar(const NodeCrossings& c, unsigned m, int a)
+template <typename T>
+OCTORAY_HD_INLINE T ChildFar(const Crossings<T>& c, unsigned m, int a)
 {
   return (m >> a) & 1u ? c.farT[a] : c.midT[a];
 }
 
-OCTORAY_HD_INLINE ChildSpan SpanOf(const NodeCrossings& c, unsigned m)
+template <typename T>
+OCTORAY_HD_INLINE ChildSpan<T> SpanOf(const Crossings<T>& c, unsigned m)
 {
-  ChildSpan s{ -INFINITY, INFINITY };
+  ChildSpan<T> s{ T{} - INFINITY, T{} + INFINITY };
   for (int a = 0; a < 3; ++a)
   {
     s.tEnter = Later(ChildNear(c, m, a), s.tEnter);
@@ -252,23 +296,28 @@ OCTORAY_HD_INLINE int EntryAxis(const NodeCrossings& c, unsigned m, float tEnter
 // planes at once: keeping one of the two (one comparison per pair of axes)
 // lets a ray through a lattice of voxels' edges miss them all, a dotted line
 // of holes.
-OCTORAY_HD_INLINE unsigned MetOctants(const Vec3f& midT, float tEnter, float tExit)
+//
+// For one ray (Vec3f and floats) the octants' bits; for a packet (arrays of
+// lanes) the bits per lane.
+template <typename Triple, typename T>
+OCTORAY_HD_INLINE auto MetOctants(const Triple& midT, T tEnter, T tExit)
 {
-  unsigned met = 0xFFu;
+  using Sets = decltype(Where(tEnter > tExit, 0u)); // unsigned, or lanes of int
+  Sets met = Sets{} + 0xFF;
   for (int a = 0; a < 3; ++a)
   {
     const unsigned nearHalf = a == 0 ? 0x55u : (a == 1 ? 0x33u : 0x0Fu);
-    met &= (midT[a] >= tEnter ? nearHalf : 0u) | (midT[a] <= tExit ? ~nearHalf : 0u);
+    met &= Where(midT[a] >= tEnter, nearHalf) | Where(midT[a] <= tExit, ~nearHalf);
   }
   // Octants with bit a set and bit b clear, for the pairs (x,y), (y,x),
   // (x,z), (z,x), (y,z), (z,y).
-  met &= midT.x > midT.y ? ~0x22u : ~0u;
-  met &= midT.y > midT.x ? ~0x44u : ~0u;
-  met &= midT.x > midT.z ? ~0x0Au : ~0u;
-  met &= midT.z > midT.x ? ~0x50u : ~0u;
-  met &= midT.y > midT.z ? ~0x0Cu : ~0u;
-  met &= midT.z > midT.y ? ~0x30u : ~0u;
-  return met & 0xFFu;
+  met &= Unless(midT[0] > midT[1], 0x22u);
+  met &= Unless(midT[1] > midT[0], 0x44u);
+  met &= Unless(midT[0] > midT[2], 0x0Au);
+  met &= Unless(midT[2] > midT[0], 0x50u);
+  met &= Unless(midT[1] > midT[2], 0x0Cu);
+  met &= Unless(midT[2] > midT[1], 0x30u);
+  return met & 0xFF;
 }
 
 // The octants that hold every bit of m: those the ray can still meet after
@@ -390,7 +439,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     }
     const unsigned m = LowestBit(todo);
     todo &= todo - 1u;
-    const ChildSpan span = SpanOf(c, m);
+    const auto span = SpanOf(c, m);
     const unsigned octant = m ^ signs;
     const float half = 0.5f * size;
     Vec3f childLo = lo;
