@@ -226,15 +226,12 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
   {
     const Ray& ray = rays[lane];
     NodeHit root;
-    if (!((valid >> lane) & 1u) ||
-      !IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, root.tEnter, root.tExit, root.axis) ||
-      root.tExit < ray.tMin || root.tEnter > ray.tMax)
+    if (!((valid >> lane) & 1u) || !MeetsRoot(ray, root))
     {
       continue;
     }
-    const bool parallel = ray.inverse.x == INFINITY || ray.inverse.y == INFINITY || ray.inverse.z == INFINITY;
     const unsigned signs = DirectionSigns(ray);
-    if (parallel || tree.depth == 0 || lods[lane].StopAt(1.0f, root.tEnter) || (p.signs != 8 && signs != p.signs))
+    if (HasParallelAxis(ray) || DrawsRoot(tree, lods[lane], root.tEnter) || (p.signs != 8 && signs != p.signs))
     {
       alone |= 1u << lane;
       continue;

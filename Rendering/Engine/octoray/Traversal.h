@@ -495,6 +495,27 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   }
 }
 
+// The ray's span through the root cube within [tMin, tMax], in hit's
+// tEnter, tExit and axis; false where it has none.
+OCTORAY_HD_INLINE bool MeetsRoot(const Ray& ray, NodeHit& hit)
+{
+  return IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) &&
+    !(hit.tExit < ray.tMin || hit.tEnter > ray.tMax);
+}
+
+// Whether the root is drawn as it is: a tree of one node, or a level of
+// detail that stops there.
+OCTORAY_HD_INLINE bool DrawsRoot(const OctreeView& tree, const LevelOfDetail& lod, float tEnter)
+{
+  return tree.depth == 0 || lod.StopAt(1.0f, tEnter);
+}
+
+// Whether the ray runs parallel to an axis (SetDirection's +inf).
+OCTORAY_HD_INLINE bool HasParallelAxis(const Ray& ray)
+{
+  return ray.inverse.x == INFINITY || ray.inverse.y == INFINITY || ray.inverse.z == INFINITY;
+}
+
 // Visits the drawn voxels (leaves, or nodes where the level of detail
 // stops) that the ray meets within [tMin, tMax], nearest first, until the
 // visitor's Visit(const NodeHit&) returns true.
@@ -521,12 +542,11 @@ template <typename Visitor>
 OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor)
 {
   NodeHit hit;
-  if (!IntersectBox(ray, Vec3f{ 0.0f, 0.0f, 0.0f }, 1.0f, hit.tEnter, hit.tExit, hit.axis) ||
-    hit.tExit < ray.tMin || hit.tEnter > ray.tMax)
+  if (!MeetsRoot(ray, hit))
   {
     return;
   }
-  if (tree.depth == 0 || lod.StopAt(1.0f, hit.tEnter))
+  if (DrawsRoot(tree, lod, hit.tEnter))
   {
     hit.node = 0;
     hit.level = 0;
@@ -535,7 +555,7 @@ OCTORAY_HD void Traverse(const OctreeView& tree, const Ray& ray, const LevelOfDe
     visitor.Visit(hit);
     return;
   }
-  if (ray.inverse.x == INFINITY || ray.inverse.y == INFINITY || ray.inverse.z == INFINITY)
+  if (HasParallelAxis(ray))
   {
     TraverseFromRoot<true>(tree, ray, lod, visitor, hit.tEnter, hit.tExit);
   }
