@@ -139,11 +139,7 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     const ChildSpan<PacketFloats> span = SpanOf(c, m);
     const unsigned octant = m ^ p.signs;
     const float half = 0.5f * size;
-    Vec3f childLo = lo;
-    for (int a = 0; a < 3; ++a)
-    {
-      childLo[a] += (octant >> a) & 1u ? half : 0.0f;
-    }
+    const Vec3f childLo = ChildCorner(lo, octant, half);
     const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
     std::uint64_t drawn = entering; // lanes that stop at the child: all at the leaves
     if (level + 1 < tree.depth)
@@ -196,13 +192,7 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
       pausedLevels |= 1u << level;
     }
     ++level;
-    for (int a = 0; a < 3; ++a)
-    {
-      const PacketFloats tNear = ChildNear(c, m, a);
-      c.farT[a] = ChildFar(c, m, a);
-      c.nearT[a] = tNear;
-      c.midT[a] = innerMidT[a];
-    }
+    EnterChild(c, m, innerMidT);
     lo = childLo;
     size = half;
     childMask = grandchildMask;

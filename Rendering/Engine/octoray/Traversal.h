@@ -266,6 +266,31 @@ OCTORAY_HD_INLINE ChildSpan<T> SpanOf(const Crossings<T>& c, unsigned m)
   return s;
 }
 
+// The crossings of the child in mirrored octant m, once the ray goes into
+// it: its near and far faces are its parent's planes, its mid planes new.
+template <typename T, typename Triple>
+OCTORAY_HD_INLINE void EnterChild(Crossings<T>& c, unsigned m, const Triple& childMidT)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    const T tNear = ChildNear(c, m, a);
+    c.farT[a] = ChildFar(c, m, a);
+    c.nearT[a] = tNear;
+    c.midT[a] = childMidT[a];
+  }
+}
+
+// The corner of the child in (unmirrored) octant `octant` of the node whose
+// corner is lo, for children of side `half`.
+OCTORAY_HD_INLINE Vec3f ChildCorner(Vec3f lo, unsigned octant, float half)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] += (octant >> a) & 1u ? half : 0.0f;
+  }
+  return lo;
+}
+
 // The axis of the face by which the ray enters the child in mirrored octant
 // m at tEnter (SpanOf's): the lowest axis on ties, -1 when the ray starts
 // inside on every axis. Only the voxels drawn need it.
@@ -442,11 +467,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     const auto span = SpanOf(c, m);
     const unsigned octant = m ^ signs;
     const float half = 0.5f * size;
-    Vec3f childLo = lo;
-    for (int a = 0; a < 3; ++a)
-    {
-      childLo[a] += (octant >> a) & 1u ? half : 0.0f;
-    }
+    const Vec3f childLo = ChildCorner(lo, octant, half);
     const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
     if (level + 1 == tree.depth || (lodOn && lod.StopAt(half, span.tEnter)))
     {
@@ -480,13 +501,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       pausedLevels |= 1u << level;
     }
     ++level;
-    for (int a = 0; a < 3; ++a)
-    {
-      const float tNear = ChildNear(c, m, a);
-      c.farT[a] = ChildFar(c, m, a);
-      c.nearT[a] = tNear;
-      c.midT[a] = innerMidT[a];
-    }
+    EnterChild(c, m, innerMidT);
     lo = childLo;
     size = half;
     childMask = grandchildMask;
