@@ -7,9 +7,10 @@
 //                        [--sphere-points N] [--parts modes,off] [--json PATH]
 //
 // --parts picks what runs: `modes` (throughput per mode and scene), `off`
-// (the everything-off frames), `traversal` (one core's primary rays through
-// Traverse against the plain slab-test traversal of ReferenceTraversal.h,
-// in the same run); default modes and off. Image error against time is
+// (the everything-off frames), `traversal` (one core's primary rays in
+// packets of eight, through Traverse one by one, and through the plain
+// slab-test traversal of ReferenceTraversal.h, in the same run); default
+// modes and off. Image error against time is
 // octoray_bench_quality's.
 //
 // Scenes: the bundled LiDAR tile (Data/Particles/lidar_simple.particles, the
@@ -137,7 +138,7 @@ double PrimaryRaySeconds(const FrameConstants& f, const OctreeView& tree, int re
 }
 
 // The same through packets of eight rays along a row (PacketTraversal.h),
-// as the CPU engine traces first hits.
+// as the CPU engine traces its primary rays.
 double PacketPrimaryRaySeconds(const FrameConstants& f, const OctreeView& tree, int repeats, std::uint64_t& hitSum)
 {
   double best = 0.0;
