@@ -1,7 +1,9 @@
 // octoray_bench_cuda: the CUDA backend measured against what the hardware
 // allows, in one run on one GPU:
 //  - octree build of 1 M / 10 M / 100 M points beside a bare CUB radix sort
-//    of the same 63-bit keys with 32-bit indices (the build's floor);
+//    of as many keys of 3 x depth bits with 32-bit indices (the build's
+//    floor), and at depth 10 and less beside the sort of the packed words
+//    the build sorts there;
 //  - update of 1% and 100% of 10 M points beside a full rebuild;
 //  - primary rays and shadow + one-bounce rays at 1920x1080, depth 10 and 16;
 //  - GPU bytes per point at depth 10 and 21, with the points kept for
@@ -19,6 +21,7 @@
 #include <octoray/Engine.h>
 #include <octoray/Frame.h>
 #include <octoray/Morton.h>
+#include <octoray/OctreeKernels.h>
 
 #include "BenchScenes.h"
 
@@ -89,33 +92,43 @@ Cloud MakeCloud(std::size_t n, std::uint64_t seed)
   return c;
 }
 
-// The sort the build cannot beat: CUB's radix sort of (63-bit key, index).
-double SortFloorSeconds(const Cloud& c, int bits)
+// The sort the build cannot beat: CUB's radix sort of n random keys of
+// `bits` bits with 32-bit indices. With `packed`, the sort the build runs
+// where it packs (depth 10 and less): each key above its 32-bit index in one
+// word, sorted by the key's bits alone (SortedKeys, OctreeKernels.h).
+double SortFloorSeconds(std::size_t n, int bits, bool packed)
 {
-  const std::size_t n = c.xyz.size() / 3;
   std::vector<std::uint64_t> keys(n);
   std::mt19937_64 rng(7);
-  for (auto& k : keys)
-  {
-    k = rng() >> (64 - bits);
-  }
-  std::uint64_t *k0, *k1;
-  std::uint32_t *v0, *v1;
-  cudaMalloc(&k0, n * 8);
-  cudaMalloc(&k1, n * 8);
-  cudaMalloc(&v0, n * 4);
-  cudaMalloc(&v1, n * 4);
-  cudaMemcpy(k0, keys.data(), n * 8, cudaMemcpyHostToDevice);
-  std::vector<std::uint32_t> idx(n);
   for (std::size_t i = 0; i < n; ++i)
   {
-    idx[i] = static_cast<std::uint32_t>(i);
+    const std::uint64_t key = rng() >> (64 - bits);
+    keys[i] = packed ? SortedKeys::Pack(key, i) : key;
   }
-  cudaMemcpy(v0, idx.data(), n * 4, cudaMemcpyHostToDevice);
+  std::uint64_t *k0, *k1;
+  std::uint32_t *v0 = nullptr, *v1 = nullptr;
+  cudaMalloc(&k0, n * 8);
+  cudaMalloc(&k1, n * 8);
+  if (!packed)
+  {
+    cudaMalloc(&v0, n * 4);
+    cudaMalloc(&v1, n * 4);
+    std::vector<std::uint32_t> idx(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      idx[i] = static_cast<std::uint32_t>(i);
+    }
+    cudaMemcpy(v0, idx.data(), n * 4, cudaMemcpyHostToDevice);
+  }
   cub::DoubleBuffer<std::uint64_t> kb(k0, k1);
   cub::DoubleBuffer<std::uint32_t> vb(v0, v1);
+  const int shift = SortedKeys::kPackedShift;
+  auto sort = [&](void* temp, std::size_t& bytes) {
+    return packed ? cub::DeviceRadixSort::SortKeys(temp, bytes, kb, n, shift, shift + bits)
+                  : cub::DeviceRadixSort::SortPairs(temp, bytes, kb, vb, n, 0, bits);
+  };
   std::size_t bytes = 0;
-  cub::DeviceRadixSort::SortPairs(nullptr, bytes, kb, vb, n, 0, bits);
+  sort(nullptr, bytes);
   void* temp;
   cudaMalloc(&temp, bytes);
   cudaEvent_t start, stop;
@@ -126,7 +139,7 @@ double SortFloorSeconds(const Cloud& c, int bits)
   {
     cudaMemcpy(kb.Current(), keys.data(), n * 8, cudaMemcpyHostToDevice);
     cudaEventRecord(start);
-    cub::DeviceRadixSort::SortPairs(temp, bytes, kb, vb, n, 0, bits);
+    sort(temp, bytes);
     cudaEventRecord(stop);
     cudaEventSynchronize(stop);
     float ms = 0;
@@ -534,7 +547,8 @@ int Run(int argc, char** argv)
       const int repeats = 7;
       const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { last = engine->Build(c.View(), o); });
       const double t = paired.seconds;
-      const double floor = SortFloorSeconds(c, 3 * depth);
+      const double floor = SortFloorSeconds(n, 3 * depth, false);
+      const double packedFloor = SortedKeys::Packs(depth) ? SortFloorSeconds(n, 3 * depth, true) : 0.0;
       const double bytesPerPoint = double(engine->Memory().Total()) / n;
       const double arrayBytesPerPoint = double(engine->Memory().ArrayBytes()) / n;
       // Without the points kept for updates: what a static scene holds.
@@ -543,15 +557,16 @@ int Run(int argc, char** argv)
       const double leanSeconds = TimeMedian(repeats, [&] { engine->Build(c.View(), lean); });
       const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
       std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
-                  "sort %.3f ms, ratio %.2f, %zu nodes, %.1f GPU bytes/point (%.1f in arrays, the rest the "
+                  "sort %.3f ms (of packed words alone %.3f ms), ratio %.2f, %zu nodes, %.1f GPU bytes/point (%.1f in arrays, the rest the "
                   "allocator's cache); pinned copy of its %.0f MB input %.3f ms beside it, whole call %.2fx that "
                   "(median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
         n, depth, t * 1e3, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
-        last.levelSeconds * 1e3, floor * 1e3, t / floor, last.nodes, bytesPerPoint, arrayBytesPerPoint, uploadMegabytes,
+        last.levelSeconds * 1e3, floor * 1e3, packedFloor * 1e3, t / floor, last.nodes, bytesPerPoint, arrayBytesPerPoint, uploadMegabytes,
         paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3, leanBytesPerPoint);
       records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
         { { "upload_seconds", last.uploadSeconds }, { "key_seconds", last.keySeconds },
           { "sort_seconds", last.sortSeconds }, { "level_seconds", last.levelSeconds },
+          { "packed_sort_seconds", packedFloor },
           { "nodes", double(last.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
           { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },

@@ -237,7 +237,13 @@ public:
   template <typename Key>
   int SortPairs(Key* const keys[2], std::uint32_t* const values[2], std::size_t n, int bits, const char*)
   {
-    return RadixSortPairs(keys[0], values[0], n, bits, threads, keys[1], values[1]);
+    return RadixSort(keys[0], values[0], n, 0, bits, threads, keys[1], values[1]);
+  }
+
+  template <typename Key>
+  int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char*)
+  {
+    return RadixSort<Key>(keys[0], nullptr, n, beginBit, endBit, threads, keys[1], nullptr);
   }
 };
 }

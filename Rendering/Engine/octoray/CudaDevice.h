@@ -308,6 +308,17 @@ public:
     return k.selector;
   }
 
+  template <typename Key>
+  int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char* what)
+  {
+    cub::DoubleBuffer<Key> k(keys[0], keys[1]);
+    const std::string name = std::string("cub::DeviceRadixSort (") + what + ")";
+    std::size_t bytes = 0;
+    CudaCheck(cub::DeviceRadixSort::SortKeys(nullptr, bytes, k, n, beginBit, endBit), name.c_str());
+    CudaCheck(cub::DeviceRadixSort::SortKeys(Temporary(bytes), bytes, k, n, beginBit, endBit), name.c_str());
+    return k.selector;
+  }
+
 private:
   // CUB's temporary storage; its allocation is kept while later calls fit.
   void* Temporary(std::size_t bytes)

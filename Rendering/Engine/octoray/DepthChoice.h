@@ -41,13 +41,14 @@ struct BinPair
 // 0..kDepthHistogramBins-1) and alone (the next kDepthHistogramBins):
 // newNode's bin is the level shared with the previous key (not counted for
 // i == 0), alone's the deeper of the levels shared with either neighbour
-// (-1 when there is none). Bin b is entry b + 1. Keys are full-depth after
-// << toFull (leaf keys of a fixed depth are shifted up).
-OCTORAY_HD BinPair DepthHistogramEntries(const std::uint64_t* sortedKeys, std::size_t n, std::size_t i, int toFull)
+// (-1 when there is none). Bin b is entry b + 1. fullKey(i) is sorted key
+// i at full depth (leaf keys of a fixed depth shifted up).
+template <class FullKey>
+OCTORAY_HD BinPair DepthHistogramEntries(FullKey fullKey, std::size_t n, std::size_t i)
 {
-  const std::uint64_t key = sortedKeys[i] << toFull;
-  const int withPrev = i > 0 ? SharedLevels(sortedKeys[i - 1] << toFull, key) : -1;
-  const int withNext = i + 1 < n ? SharedLevels(key, sortedKeys[i + 1] << toFull) : -1;
+  const std::uint64_t key = fullKey(i);
+  const int withPrev = i > 0 ? SharedLevels(fullKey(i - 1), key) : -1;
+  const int withNext = i + 1 < n ? SharedLevels(key, fullKey(i + 1)) : -1;
   return BinPair{ i > 0 ? withPrev + 1 : -1, kDepthHistogramBins + (withPrev > withNext ? withPrev : withNext) + 1 };
 }
 

@@ -15,6 +15,7 @@
 //   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
+//   SortKeys(keys[2], n, beginBit, endBit, what)    the keys alone, by those bits; stable, returns the same
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
 //   Clock                             Mark(): a point in the order of the loops; Seconds(a, b) once waited for
 //   ReleaseScratch()                  frees the device's own scratch (CUB's temporary storage)
@@ -125,8 +126,9 @@ std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const c
 }
 
 // starts[r] = where the r-th run of equal (key >> shift) among n sorted
-// keys starts, with n after the last run: the nodes one level up (shift 3)
-// or the records of one node (shift 0). `starts` has room for n + 1; the
+// keys starts, with n after the last run: the nodes one level up (shift 3),
+// the leaves (the sorted words' keyShift) or the records of one node
+// (shift 0). `starts` has room for n + 1; the
 // count goes to kCounterSelected, which the host reads only where it does
 // not know it.
 template <class Device, typename Key>
@@ -383,9 +385,8 @@ RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArray
 // the newNode histogram that gives every level's node count.
 struct SortedPoints
 {
-  const std::uint64_t* key;
-  const std::uint32_t* index;
-  std::uint32_t* spare; // the sort's other index array (n + 1 entries): room for run starts
+  SortedKeys keys;
+  std::uint32_t* spare; // an index array the sort left free (n + 1 entries): room for run starts
   int depth;
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
@@ -408,15 +409,25 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   {
     d.Reserve(s.points.key, n, "point keys");
   }
+  // Packed sort words need no index arrays but the one for run starts.
+  const bool packed = SortedKeys::Packs(requestedDepth);
   for (int b = 0; b < 2; ++b)
   {
     d.Reserve(scratch.sortKey[b], n, "sort keys");
-    d.Reserve(scratch.sortIndex[b], n + 1, "sort indices");
+  }
+  d.Reserve(scratch.sortIndex[0], n + 1, "sort indices");
+  if (packed)
+  {
+    d.Release(scratch.sortIndex[1]);
+  }
+  else
+  {
+    d.Reserve(scratch.sortIndex[1], n + 1, "sort indices");
   }
   const PointArraysView pts = s.Points();
   std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
   std::uint64_t* sortKey = scratch.sortKey[0].Get();
-  std::uint32_t* sortIndex = scratch.sortIndex[0].Get();
+  std::uint32_t* sortIndex = packed ? nullptr : scratch.sortIndex[0].Get();
   std::uint64_t* counters = scratch.counters.Get();
   // Only the leaf level's bits need sorting when the depth is known.
   const int leafShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
@@ -436,31 +447,39 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
       {
         pointKey[i] = key;
       }
-      sortKey[i] = key >> leafShift;
-      sortIndex[i] = static_cast<std::uint32_t>(i);
+      SortedKeys::Enter(sortKey, sortIndex, i, key >> leafShift);
     });
   }
   else
   {
     d.ForEach("LeafKeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
-      sortKey[i] = pointKey[i] >> leafShift;
-      sortIndex[i] = static_cast<std::uint32_t>(i);
+      SortedKeys::Enter(sortKey, sortIndex, i, pointKey[i] >> leafShift);
     });
   }
   phases[1] = clock.Mark();
 
   SortedPoints sorted;
   std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
-  std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
   const int bits = requestedDepth > 0 ? 3 * requestedDepth : 3 * kMaxLevel;
-  const int result = d.SortPairs(keys, values, n, bits, "point keys");
-  std::uint64_t* sortedKey = keys[result];
-  sorted.key = sortedKey;
-  sorted.index = values[result];
-  sorted.spare = values[1 - result];
+  if (packed)
+  {
+    const int shift = SortedKeys::kPackedShift;
+    sorted.keys = SortedKeys{ keys[d.SortKeys(keys, n, shift, shift + bits, "point keys")], nullptr, shift };
+    sorted.spare = scratch.sortIndex[0].Get();
+  }
+  else
+  {
+    std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
+    const int result = d.SortPairs(keys, values, n, bits, "point keys");
+    sorted.keys = SortedKeys{ keys[result], values[result], 0 };
+    sorted.spare = values[1 - result];
+  }
+  const SortedKeys sortedKeys = sorted.keys;
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(sortedKey, n, i, leafShift); },
+    OCTORAY_LAMBDA(std::size_t i) {
+      return DepthHistogramEntries([&](std::size_t k) { return sortedKeys.LeafKey(k) << leafShift; }, n, i);
+    },
     counters + kCounterHistogram);
   phases[2] = clock.Mark();
   if (whileSorting)
@@ -481,6 +500,8 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   if (sorted.depth == 0)
   {
     sorted.depth = ChooseDepthFromHistograms(sorted.histogram, sorted.histogram + kDepthHistogramBins);
+    // Full-depth keys, sorted in pairs (they do not pack): to leaf keys.
+    std::uint64_t* sortedKey = keys[sorted.keys.word == keys[0] ? 0 : 1];
     const int shift = 3 * (kMaxLevel - sorted.depth);
     d.ForEach("ShiftKernel", n, OCTORAY_LAMBDA(std::size_t i) { sortedKey[i] >>= shift; });
   }
@@ -524,13 +545,11 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const PointArraysView pts = s.Points();
   std::uint32_t* starts = sorted.spare;
 
-  RunStarts(d, scratch, sorted.key, s.count, 0, starts);
-  const std::uint64_t* sortedKey = sorted.key;
-  const std::uint32_t* sortedIndex = sorted.index;
+  const SortedKeys keys = sorted.keys;
+  RunStarts(d, scratch, keys.word, s.count, keys.keyShift, starts);
   const std::uint32_t leafBegin = view.levelBegin[depth];
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
-    ReduceLeaf(view, pts, sortedIndex, leafBegin + static_cast<std::uint32_t>(j), sortedKey[starts[j]], starts[j],
-      starts[j + 1]);
+    ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
   });
   for (int l = depth - 1; l >= 0; --l)
   {

@@ -52,8 +52,9 @@ struct DriverScratch
   template <typename T>
   using Buffer = typename Device::template Buffer<T>;
 
-  // (key, point) pairs and the sort's second buffers; the spare index
-  // array holds run starts after the sort.
+  // (key, point) pairs, or packed words alone (SortedKeys,
+  // OctreeKernels.h), and the sort's second buffers; an index array the
+  // sort leaves free holds run starts after it.
   Buffer<std::uint64_t> sortKey[2];
   Buffer<std::uint32_t> sortIndex[2];
   Buffer<std::uint64_t> counters; // what loops report to the host (CounterSlot, OctreeDriver.h)

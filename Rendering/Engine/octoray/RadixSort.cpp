@@ -9,9 +9,10 @@
 namespace octoray
 {
 template <typename Key>
-int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, int threads, Key* scratchKeys,
-  std::uint32_t* scratchValues)
+int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int endBit, int threads,
+  Key* scratchKeys, std::uint32_t* scratchValues)
 {
+  const int bits = endBit - beginBit;
   if (n < 2 || bits <= 0)
   {
     return 0;
@@ -22,7 +23,6 @@ int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, in
   const int passes = (bits + 10) / 11;
   const int digitBits = (bits + passes - 1) / passes;
   const std::size_t buckets = std::size_t(1) << digitBits;
-  const std::uint64_t digitMask = buckets - 1;
 
   Key* srcK = keys;
   std::uint32_t* srcV = values;
@@ -34,7 +34,9 @@ int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, in
 
   for (int pass = 0; pass < passes; ++pass)
   {
-    const int shift = pass * digitBits;
+    const int shift = beginBit + pass * digitBits;
+    // The last digit may be narrower: bits from endBit on do not count.
+    const std::uint64_t digitMask = (std::uint64_t(1) << std::min(digitBits, endBit - shift)) - 1;
     std::fill(histogram.begin(), histogram.end(), 0);
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::size_t* h = histogram.data() + c * buckets;
@@ -82,7 +84,10 @@ int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, in
       {
         const std::size_t slot = offset[(srcK[i] >> shift) & digitMask]++;
         dstK[slot] = srcK[i];
-        dstV[slot] = srcV[i];
+        if (srcV)
+        {
+          dstV[slot] = srcV[i];
+        }
       }
     });
     std::swap(srcK, dstK);
@@ -91,8 +96,8 @@ int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, in
   return srcK == keys ? 0 : 1;
 }
 
-template int RadixSortPairs<std::uint64_t>(std::uint64_t*, std::uint32_t*, std::size_t, int, int, std::uint64_t*,
+template int RadixSort<std::uint64_t>(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*,
   std::uint32_t*);
-template int RadixSortPairs<std::uint32_t>(std::uint32_t*, std::uint32_t*, std::size_t, int, int, std::uint32_t*,
+template int RadixSort<std::uint32_t>(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*,
   std::uint32_t*);
 }

@@ -1,5 +1,6 @@
-// CPU least-significant-digit radix sort of (key, index) pairs whose keys
-// are below 2^bits, multi-threaded, stable.
+// CPU least-significant-digit radix sort of keys, alone or with a 32-bit
+// value each, by the bits [beginBit, endBit) of the keys; multi-threaded,
+// stable.
 #pragma once
 
 #include <cstddef>
@@ -7,11 +8,12 @@
 
 namespace octoray
 {
-// Sorts the n pairs (keys[i], values[i]), ping-ponging between them and the
-// two scratch arrays (n entries each); returns where the result is: 0 in
-// keys and values, 1 in the scratch arrays. Passes whose digit is the same
-// for every key are skipped. Key: std::uint64_t or std::uint32_t.
+// Sorts the n keys, and values[i] with keys[i] unless values is null,
+// ping-ponging between them and the scratch arrays (n entries each; no
+// scratchValues without values); returns where the result is: 0 in keys
+// and values, 1 in the scratch arrays. Passes whose digit is the same for
+// every key are skipped. Key: std::uint64_t or std::uint32_t.
 template <typename Key>
-int RadixSortPairs(Key* keys, std::uint32_t* values, std::size_t n, int bits, int threads, Key* scratchKeys,
-  std::uint32_t* scratchValues);
+int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int endBit, int threads,
+  Key* scratchKeys, std::uint32_t* scratchValues);
 }
