@@ -599,7 +599,7 @@ namespace
 std::size_t ExpectRenderPixelsPicture(Engine& cpu, HostOctree& t, const RenderSettings& s)
 {
   Image image;
-  cpu.Render(s, image);
+  const RenderStats stats = cpu.Render(s, image);
   const OctreeView view = t.View();
   const FrameConstants f = MakeFrame(s, view);
   std::size_t rays = 0, hits = 0;
@@ -621,14 +621,17 @@ std::size_t ExpectRenderPixelsPicture(Engine& cpu, HostOctree& t, const RenderSe
       }
     }
   });
+  EXPECT_EQ(stats.secondaryRays, rays);
   return hits;
 }
 }
 
-// The CPU engine traces primary rays in packets: its pictures are those of
-// RenderPixel pixel by pixel, in every value. Surfaces flat, depth-cued and
-// lit with shadows, with and without reflections (the clusters' points
-// reflect); every volume blend mode; with and without level of detail.
+// The CPU engine traces primary rays, and the first hits' shadow rays, in
+// packets: its pictures are those of RenderPixel pixel by pixel, in every
+// value, with as many secondary rays. Surfaces flat, depth-cued and lit with
+// shadows (a directional light, a point light and one of each, the
+// headlight), with and without reflections (the clusters' points reflect);
+// every volume blend mode; with and without level of detail.
 TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
 {
   const Cloud c = GaussianClusters(20000, 46);
@@ -655,13 +658,22 @@ TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
         {
           continue; // the volume modes neither shade nor bounce
         }
-        SCOPED_TRACE("blend " + std::to_string(int(blend)) + ", shade " + std::to_string(int(shade)) +
-          ", bounces " + std::to_string(s.maxBounces) + ", level of detail " + std::to_string(s.lodPixels));
+        SCOPED_TRACE("variant " + std::to_string(variant) + ", blend " + std::to_string(int(blend)) + ", shade " +
+          std::to_string(int(shade)) + ", bounces " + std::to_string(s.maxBounces) + ", level of detail " +
+          std::to_string(s.lodPixels));
         if (shade == ShadeMode::Phong)
         {
-          Light sun;
+          Light sun, lamp;
           sun.position[0] = 1, sun.position[1] = -1, sun.position[2] = 2, sun.position[3] = 0;
-          s.lights.push_back(sun);
+          lamp.position[0] = 3, lamp.position[1] = -2, lamp.position[2] = 4, lamp.position[3] = 1;
+          if (variant != 2)
+          {
+            s.lights.push_back(variant == 3 ? lamp : sun);
+          }
+          if (variant == 1)
+          {
+            s.lights.push_back(lamp);
+          }
           s.shadows = true;
         }
         s.transfer.range[0] = -50;

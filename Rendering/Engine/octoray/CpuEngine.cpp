@@ -16,24 +16,71 @@ namespace octoray
 {
 namespace
 {
-// A surface pixel (RenderPixel's) from the first voxel its ray hits.
+// A surface pixel (RenderPixel's) from the first voxel its ray hits and,
+// with shadows, that hit's shadow rays.
 template <typename F>
 void SurfacePixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel,
-  const FirstHitVisitor& first, float rgba[4], float& depth, std::size_t& secondaryRays)
+  const FirstHitVisitor& first, const TracedShadows* shadows, float rgba[4], float& depth,
+  std::size_t& secondaryRays)
 {
   if constexpr (F::kSecondary)
   {
-    TracedPixel<F>(f, tree, pixel, &first, rgba, depth, secondaryRays);
+    TracedPixel<F>(f, tree, pixel, &first, shadows, rgba, depth, secondaryRays);
   }
   else
   {
-    ShadeFirstHit<F>(f, tree, pixel, first, rgba, depth, secondaryRays);
+    ShadeFirstHit<F>(f, tree, pixel, first, shadows, rgba, depth, secondaryRays);
+  }
+}
+
+// The shadow rays of a packet's first hits, one packet per light: from
+// neighbouring hits towards one light they are about as coherent as the
+// primary rays (a directional light's all parallel). The rays and the test
+// are ShadeSurface's own (SurfaceAt, SampleLight, ShadowRay), so each lane
+// gets what ShadeSurface would have traced for it.
+void TraceShadowPackets(const FrameConstants& f, const OctreeView& tree, const CameraRay pixels[kPacketLanes],
+  const FirstHitVisitor hits[kPacketLanes], unsigned valid, TracedShadows shadows[kPacketLanes])
+{
+  LevelOfDetail lods[kPacketLanes];
+  unsigned hit = 0;
+  for (int lane = 0; lane < kPacketLanes; ++lane)
+  {
+    if (((valid >> lane) & 1u) && hits[lane].found)
+    {
+      shadows[lane].surface = SurfaceAt(tree, pixels[lane].ray, hits[lane].hit);
+      lods[lane] = pixels[lane].lod;
+      hit |= 1u << lane;
+    }
+  }
+  for (int i = 0; hit && i < LightsOf(f); ++i)
+  {
+    Ray rays[kPacketLanes];
+    unsigned facing = 0;
+    for (int lane = 0; lane < kPacketLanes; ++lane)
+    {
+      if ((hit >> lane) & 1u)
+      {
+        const LightSample light = SampleLight(f, i, shadows[lane].surface);
+        if (light.cosine > 0.0f)
+        {
+          rays[lane] = ShadowRay(shadows[lane].surface, hits[lane].hit, light);
+          facing |= 1u << lane;
+        }
+      }
+    }
+    FirstHitVisitor blockers[kPacketLanes];
+    TracePacket(tree, rays, lods, facing, blockers);
+    for (int lane = 0; lane < kPacketLanes; ++lane)
+    {
+      shadows[lane].occluded[i] = blockers[lane].found;
+    }
   }
 }
 
 // A row of pixels, eight at a time: their primary rays from one walk of the
-// octree (PacketTraversal.h), each seen by its pixel's visitor, then each
-// pixel made from what its visitor saw, as RenderPixel makes it.
+// octree (PacketTraversal.h), each seen by its pixel's visitor, and the
+// first hits' shadow rays as packets too; then each pixel made from what
+// its visitors saw, as RenderPixel makes it.
 // store(x, rgba) keeps a pixel.
 template <typename F, typename Store>
 void RenderRow(
@@ -63,6 +110,11 @@ void RenderRow(
       std::fill_n(visitors, kPacketLanes, BlendVisitor{ &f, &tree });
     }
     TracePacket(tree, rays, lods, valid, visitors);
+    TracedShadows shadows[kPacketLanes];
+    if constexpr (F::kShadows)
+    {
+      TraceShadowPackets(f, tree, pixels, visitors, valid, shadows);
+    }
     for (int lane = 0; lane < lanes; ++lane)
     {
       if ((valid >> lane) & 1u)
@@ -73,7 +125,8 @@ void RenderRow(
         }
         else
         {
-          SurfacePixel<F>(f, tree, pixels[lane], visitors[lane], rgba[lane], depthRow[x0 + lane], secondaryRays);
+          SurfacePixel<F>(f, tree, pixels[lane], visitors[lane], F::kShadows ? &shadows[lane] : nullptr, rgba[lane],
+            depthRow[x0 + lane], secondaryRays);
         }
       }
       store(x0 + lane, rgba[lane]);

@@ -16,7 +16,8 @@
 //
 // A lane the packet cannot take (a direction in another octant than the
 // first lane's, a zero component, a root that the level of detail stops
-// at) is traced alone by Traverse.
+// at) is traced alone by Traverse, and so is every ray of a packet of
+// fewer than kMinPacketRays.
 #pragma once
 
 #include "Traversal.h"
@@ -26,6 +27,10 @@
 namespace octoray
 {
 constexpr int kPacketLanes = 8;
+// A walk of the packet costs about what four rays alone do (the "packets"
+// and "Traverse" columns of octoray_bench_render --parts traversal): fewer
+// rays than this are traced alone.
+constexpr int kMinPacketRays = 4;
 
 typedef float PacketFloats __attribute__((vector_size(4 * kPacketLanes)));
 typedef std::int32_t PacketInts __attribute__((vector_size(4 * kPacketLanes)));
@@ -211,7 +216,7 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
 {
   RayPacket p;
   p.signs = 8; // none yet
-  unsigned alone = 0;
+  unsigned alone = 0, packed = 0; // a bit per lane
   for (int lane = 0; lane < kPacketLanes; ++lane)
   {
     const Ray& ray = rays[lane];
@@ -228,6 +233,7 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
     }
     p.signs = signs;
     p.lanes |= std::uint64_t{ 0xFF } << (8 * lane);
+    packed |= 1u << lane;
     for (int a = 0; a < 3; ++a)
     {
       p.origin[a][lane] = ray.origin[a];
@@ -241,6 +247,11 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
     p.footprint0[lane] = lods[lane].footprint0;
     p.footprintSlope[lane] = lods[lane].footprintSlope;
     p.lodOn = p.lodOn || lods[lane].pixels > 0.0f;
+  }
+  if (__builtin_popcount(packed) < kMinPacketRays)
+  {
+    alone |= packed;
+    p.lanes = 0;
   }
   if (p.lanes)
   {

@@ -274,11 +274,81 @@ OCTORAY_HD Vec3f ShadowRayOrigin(const Vec3f& surface, const Vec3f& normal, cons
   return surface + hit.size * normal;
 }
 
+// A surface hit where it is lit: the point, its shading normal and the
+// direction back along the ray.
+struct SurfacePoint
+{
+  Vec3f point, normal, view;
+};
+
+OCTORAY_HD SurfacePoint SurfaceAt(const OctreeView& tree, const Ray& ray, const NodeHit& hit)
+{
+  return SurfacePoint{ EntryPoint(ray, hit), SurfaceNormal(tree, ray, hit), -ray.direction };
+}
+
+OCTORAY_HD int LightsOf(const FrameConstants& f)
+{
+  return f.lightCount > 0 ? f.lightCount : 1; // none set: the headlight
+}
+
+// Light i as a surface point sees it: the unit direction towards it, its
+// colour and distance, and the cosine at which it falls (<= 0: the surface
+// faces away; nothing to add, no shadow ray).
+struct LightSample
+{
+  Vec3f direction, color;
+  float distance, cosine;
+};
+
+OCTORAY_HD LightSample SampleLight(const FrameConstants& f, int i, const SurfacePoint& s)
+{
+  LightSample light{ s.view, Vec3f{ 1.0f, 1.0f, 1.0f }, INFINITY, 0.0f }; // the headlight
+  if (f.lightCount > 0)
+  {
+    const UnitLight& l = f.lights[i];
+    const Vec3f towards = l.directional ? l.position : l.position - s.point;
+    light.color = l.color;
+    light.distance = l.directional ? INFINITY : Length(towards);
+    light.direction = Normalize(towards);
+  }
+  light.cosine = Dot(s.normal, light.direction);
+  return light;
+}
+
+// The shadow ray from a surface hit towards a light it faces.
+OCTORAY_HD Ray ShadowRay(const SurfacePoint& s, const NodeHit& hit, const LightSample& light)
+{
+  Ray shadow;
+  shadow.origin = ShadowRayOrigin(s.point, s.normal, hit);
+  SetDirection(shadow, light.direction);
+  shadow.tMin = 0.0f;
+  shadow.tMax = light.distance;
+  return shadow;
+}
+
+// Whether a voxel lies on the ray.
+OCTORAY_HD bool Occluded(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod)
+{
+  FirstHitVisitor blocker;
+  Traverse(tree, ray, lod, blocker);
+  return blocker.found;
+}
+
+// The shadow rays of one hit, traced by the caller already (the CPU's
+// packets of them): the surface point they left from, and whether each
+// light's met a voxel, by light index.
+struct TracedShadows
+{
+  SurfacePoint surface;
+  bool occluded[kMaxLights];
+};
+
 // Lit colour of a surface hit (before reflection): depth cue, or Phong
-// (ambient + diffuse + specular) from every light that sees the hit.
+// (ambient + diffuse + specular) from every light that sees the hit. The
+// shadow rays are traced here unless `traced` holds them.
 template <typename F>
 OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit,
-  float tFromNear, const LevelOfDetail& lod, std::size_t& secondaryRays)
+  float tFromNear, const LevelOfDetail& lod, const TracedShadows* traced, std::size_t& secondaryRays)
 {
   const Vec3f albedo = RgbOf(NodeColor(f, tree, hit.node));
   if (f.shade == ShadeMode::DepthCue)
@@ -290,48 +360,28 @@ OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, c
   {
     return albedo;
   }
-  const Vec3f n = SurfaceNormal(tree, ray, hit);
-  const Vec3f p = EntryPoint(ray, hit);
-  const Vec3f view = -ray.direction;
+  const SurfacePoint s = traced ? traced->surface : SurfaceAt(tree, ray, hit);
   Vec3f lit = f.ambient * albedo;
-  const int lights = f.lightCount > 0 ? f.lightCount : 1;
-  for (int i = 0; i < lights; ++i)
+  for (int i = 0; i < LightsOf(f); ++i)
   {
-    Vec3f l = view; // the headlight
-    Vec3f color{ 1.0f, 1.0f, 1.0f };
-    float distance = INFINITY;
-    if (f.lightCount > 0)
-    {
-      const UnitLight& light = f.lights[i];
-      l = light.directional ? light.position : light.position - p;
-      color = light.color;
-      distance = light.directional ? INFINITY : Length(l);
-      l = Normalize(l);
-    }
-    const float nl = Dot(n, l);
+    const LightSample light = SampleLight(f, i, s);
+    const float nl = light.cosine;
     if (nl <= 0.0f)
     {
       continue;
     }
     if constexpr (F::kShadows)
     {
-      Ray shadow;
-      shadow.origin = ShadowRayOrigin(p, n, hit);
-      SetDirection(shadow, l);
-      shadow.tMin = 0.0f;
-      shadow.tMax = distance;
-      FirstHitVisitor blocker;
-      Traverse(tree, shadow, lod, blocker);
       ++secondaryRays;
-      if (blocker.found)
+      if (traced ? traced->occluded[i] : Occluded(tree, ShadowRay(s, hit, light), lod))
       {
         continue;
       }
     }
-    const Vec3f r = 2.0f * nl * n - l; // l mirrored about n
-    const float rv = Dot(r, view);
+    const Vec3f r = 2.0f * nl * s.normal - light.direction; // the light mirrored about the normal
+    const float rv = Dot(r, s.view);
     const float spec = rv > 0.0f ? f.specular * PortablePow(rv, f.specularPower) : 0.0f;
-    lit += color * (f.diffuse * nl * albedo + Vec3f{ spec, spec, spec });
+    lit += light.color * (f.diffuse * nl * albedo + Vec3f{ spec, spec, spec });
   }
   return lit;
 }
@@ -578,27 +628,31 @@ OCTORAY_HD void ShadeBlend(const FrameConstants& f, const CameraRay& pixel, cons
   depth = pixel.DepthAt(f, blend.firstT);
 }
 
-// A surface, first hit only, from the voxel its ray hits first (if any).
+// A surface, first hit only, from the voxel its ray hits first (if any);
+// its shadow rays from `shadows` where the caller traced them.
 template <typename F>
 OCTORAY_HD void ShadeFirstHit(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel,
-  const FirstHitVisitor& first, float rgba[4], float& depth, std::size_t& secondaryRays)
+  const FirstHitVisitor& first, const TracedShadows* shadows, float rgba[4], float& depth,
+  std::size_t& secondaryRays)
 {
   if (first.found)
   {
     const float tHit = first.hit.tEnter > pixel.ray.tMin ? first.hit.tEnter : pixel.ray.tMin;
     depth = pixel.DepthAt(f, tHit);
     const float tFromNear = static_cast<float>(pixel.tBase) + tHit;
-    const Vec3f rgb = ShadeSurface<F>(f, tree, pixel.ray, first.hit, tFromNear, pixel.lod, secondaryRays);
+    const Vec3f rgb = ShadeSurface<F>(f, tree, pixel.ray, first.hit, tFromNear, pixel.lod, shadows, secondaryRays);
     rgba[0] = rgb.x, rgba[1] = rgb.y, rgba[2] = rgb.z, rgba[3] = 1.0f;
   }
 }
 
 // A surface: the first voxel, then the mirror and refracted rays it spawns,
 // each carrying its weight in the pixel, until the bounce limit. The first
-// voxel is primaryHit where the caller traced the pixel's ray already.
+// voxel is primaryHit, and its shadow rays primaryShadows, where the caller
+// traced them already.
 template <typename F>
 OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, const CameraRay& pixel,
-  const FirstHitVisitor* primaryHit, float rgba[4], float& depth, std::size_t& secondaryRays)
+  const FirstHitVisitor* primaryHit, const TracedShadows* primaryShadows, float rgba[4], float& depth,
+  std::size_t& secondaryRays)
 {
   PendingRay pending[kMaxPendingRays];
   int top = 0;
@@ -608,6 +662,7 @@ OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, con
   while (top > 0)
   {
     const PendingRay path = pending[--top];
+    const TracedShadows* shadows = primary ? primaryShadows : nullptr;
     FirstHitVisitor first;
     if (primary && primaryHit)
     {
@@ -630,7 +685,7 @@ OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, con
       rgba[3] = 1.0f;
       primary = false;
     }
-    const Vec3f rgb = ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, pixel.lod, secondaryRays);
+    const Vec3f rgb = ShadeSurface<F>(f, tree, path.ray, hit, path.tFromNear + tHit, pixel.lod, shadows, secondaryRays);
     const bool canBounce = path.bounces < f.maxBounces;
     const float reflectivity = Clamp01(canBounce && tree.reflectivity ? tree.reflectivity[hit.node] : 0.0f);
     const float ior = canBounce && tree.refraction ? tree.refraction[hit.node] : 0.0f;
@@ -706,13 +761,13 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
   }
   else if constexpr (F::kSecondary)
   {
-    TracedPixel<F>(f, tree, pixel, nullptr, rgba, depth, secondaryRays);
+    TracedPixel<F>(f, tree, pixel, nullptr, nullptr, rgba, depth, secondaryRays);
   }
   else
   {
     FirstHitVisitor first;
     Traverse(tree, pixel.ray, pixel.lod, first);
-    ShadeFirstHit<F>(f, tree, pixel, first, rgba, depth, secondaryRays);
+    ShadeFirstHit<F>(f, tree, pixel, first, nullptr, rgba, depth, secondaryRays);
   }
 }
 
