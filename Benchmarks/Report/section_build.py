@@ -306,6 +306,9 @@ def _cuda(ctx):
     # And since the pinned staging: the upload's own time beside the plain
     # and registered copies, and the memory with and without kept points.
     staging = all("pageable_upload_seconds" in r for r in builds)
+    # And since the packed sort: CUB's sort of the words the build sorts
+    # at depth 10 and less (0 where it sorts pairs).
+    packed = any(r.get("packed_sort_seconds") for r in builds)
     rows, csv_rows, staging_rows = [], [], []
     for r in builds:
         if staging:
@@ -323,7 +326,12 @@ def _cuda(ctx):
                                                  r["level_seconds"] * 1e3)]
         row += [seconds(r["peer_seconds"]), "%.0f" % (r["seconds"] / r["peer_seconds"])]
         if phases:
-            row += ["%.1f" % (device / r["peer_seconds"]), count(r["nodes"])]
+            row += ["%.1f" % (device / r["peer_seconds"])]
+        if packed:
+            p = r.get("packed_sort_seconds")
+            row += [seconds(p) if p else "pairs", "%.1f" % (device / p) if p and phases else ""]
+        if phases:
+            row += [count(r["nodes"])]
         if upload:
             # Runs since the overlapped upload pair each build with a copy
             # and record the median of the pairs' ratios.
@@ -333,11 +341,12 @@ def _cuda(ctx):
         rows.append(row)
         csv_rows.append([r["n"], r["depth"], r["seconds"], r["peer_seconds"], mem.get((r["n"], r["depth"])),
                          r.get("key_seconds", ""), r.get("sort_seconds", ""), r.get("level_seconds", ""),
-                         r.get("nodes", "")])
+                         r.get("nodes", ""), r.get("packed_sort_seconds", "")])
     csv = ctx.write_csv("build-cuda", ["points", "depth", "build_s", "cub_sort_s", "gpu_bytes_per_point",
-                                       "keys_s", "sort_s", "levels_s", "nodes"], csv_rows)
+                                       "keys_s", "sort_s", "levels_s", "nodes", "packed_sort_s"], csv_rows)
     header = ["points", "depth", "whole call"] + (["device phases, ms (keys / sort / levels)"] if phases else []) + \
-        ["bare CUB sort", "call / sort"] + (["phases / sort", "nodes"] if phases else []) + \
+        ["bare CUB sort", "call / sort"] + (["phases / sort"] if phases else []) + \
+        (["CUB sort of packed words", "phases / packed sort"] if packed else []) + (["nodes"] if phases else []) + \
         (["pinned copy of the input", "call / copy"] if upload else []) + ["GPU bytes/point"]
     updates = [r for r in records if r["name"].startswith("update")]
     urows = [[r["name"].split()[1], count(r["n"]), r["depth"], seconds(r["seconds"]), seconds(r["peer_seconds"]),
@@ -351,20 +360,27 @@ def _cuda(ctx):
         "the sort buffers the engine keeps for rebuilds and the memory its allocator keeps for the next build (split "
         "in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
         "to the device (cudaMemcpy), what a whole call from host arrays cannot beat, timed after each of the 7 "
-        "builds; *call / copy* is the median of those 7 pairs' ratios.%s" % (gpu_source(ctx, name), "" if phases else
+        "builds; *call / copy* is the median of those 7 pairs' ratios. At depth 10 and less the build sorts one "
+        "64-bit word per point, its leaf key above its 32-bit index, by the key's bits alone (`SortKeys`: a third "
+        "fewer bytes a pass than pairs); *CUB sort of packed words* is that sort of as many words, timed the same "
+        "way, and *pairs* marks the depths whose keys do not fit beside an index.%s" % (gpu_source(ctx, name), "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),
         "",
         ctx.table(header, rows),
         "",
         "[CSV](%s)" % csv,
         "",
-        "The engine's own sort runs at the floor; what separates the whole call from the sort is the upload of the "
-        "points from pageable memory (most of it at 10 M and more) and the levels: one CUB select plus one kernel "
-        "per level, and the leaf kernel's gather of every point's attributes in random order (Benchmarks/gpu/"
-        "profile-build.txt: at 100 M points it moves 9.2 GB through DRAM at about 2 TB/s in 4.5 ms, a 64-byte "
-        "burst for each point's 8-byte record of colour and reflectivity; with one array per attribute, two "
-        "bursts a point, it moved 16 GB in 7.8 ms: profile-build-arrays.txt). A caller with pinned or device-resident points would not "
-        "pay the upload.",
+        "The engine's own sort runs at its floor, the packed one at depth 10; what separates the whole call from the "
+        "sort is the upload of the points from pageable memory (most of it at 10 M and more) and the levels: one "
+        "CUB select plus one kernel per level, and the leaf kernel's gather of every point's attributes in random "
+        "order (Benchmarks/gpu/profile-build.txt: at 100 M points it moves about 8.5 GB through DRAM in 4.5 ms, a "
+        "64-byte burst for each point's 8-byte record of colour and reflectivity; with one array per attribute, two "
+        "bursts a point, it moved 16 GB in 7.8 ms: profile-build-arrays.txt). The gather is bound by how many "
+        "random places the memory serves a second, not by bytes: with 32-byte L2 fills it moved 5.0 GB instead of "
+        "8.3 in the same 4.6 ms, and a loop over the points that gathered the records in sorted order before the "
+        "leaves, one independent load a thread, took 4.6 ms by itself (Benchmarks/gpu/variants-packed-sort.txt). "
+        "So the gather costs about one more sort, and the device phases stay above twice the sort. A caller with "
+        "pinned or device-resident points would not pay the upload.",
         "",
     ]
     repeats = {n: repeated_call_ratios(ctx, n) for n in (10000000, 100000000)}
@@ -465,10 +481,13 @@ def _cuda(ctx):
         r = ten[0]
         if phases:
             device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+            against = "bare CUB radix sort " + seconds(r["peer_seconds"])
+            ratio = "%.1f× the sort" % (device / r["peer_seconds"])
+            if r.get("packed_sort_seconds"):
+                against += " (of the packed words the build sorts: %s)" % seconds(r["packed_sort_seconds"])
+                ratio += " (%.1f×)" % (device / r["packed_sort_seconds"])
             summary.append(("CUDA octree build, 10 M points, depth 10, device phases (GPU run; whole call with "
-                            "the upload: %s)" % seconds(r["seconds"]), seconds(device),
-                            "bare CUB radix sort " + seconds(r["peer_seconds"]),
-                            "%.1f× the sort" % (device / r["peer_seconds"])))
+                            "the upload: %s)" % seconds(r["seconds"]), seconds(device), against, ratio))
         else:
             summary.append(("CUDA octree build, 10 M points, depth 10 (whole call, GPU run)", seconds(r["seconds"]),
                             "bare CUB radix sort " + seconds(r["peer_seconds"]),

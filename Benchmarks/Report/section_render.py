@@ -109,7 +109,8 @@ Reading these tables:
 - Shadows and reflections add secondary rays (the last column); Mrays/s counts them, so those rows are not slower
   per ray, only per frame.
 - The CPU backend traces each frame's primary rays eight at a time (the packets of the one-core section below) and
-  its shadow and mirror rays one at a time, so the secondary rays cost more per ray than the primary ones.
+  the first hits' shadow rays eight at a time too, one packet per light; mirror rays, and the shadow rays of what they
+  hit, go one at a time, so those secondary rays cost more per ray than the primary ones.
 - How level of detail and the bounce limit trade error for time is in the quality section.
 
 ### One core: packets of rays, Traverse and the plain slab-test traversal

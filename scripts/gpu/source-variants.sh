@@ -3,7 +3,9 @@
 # machine: for each NAME in SOURCE_VARIANTS, every .gpu-vtk/variants/FILE.NAME.h
 # replaces Rendering/Engine/octoray/FILE.h (Traversal.h, CudaUpload.h, ...)
 # in a copy of the tree with a build folder of its own; "main" names the
-# tree itself. All are built first (in parallel), then `octoray_bench_cuda
+# tree itself; a .gpu-vtk/variants/FILE.NAME.cpp replaces FILE.cpp there
+# alike (CpuEngine.cpp, which the render headers' callers live in). All are
+# built first (in parallel), then `octoray_bench_cuda
 # --only SECTION` (default render) runs ROUNDS times (default 1) over all of
 # them in turn, so that a drift of the card's clocks reaches every variant
 # alike. A variant file is made here from the commit Benchmarks/gpu/COMMAND.md
@@ -39,8 +41,10 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
   # Tracked files and new ones not yet in the index the copy arrived with.
   git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$src"
   cp -r .gpu-vtk "$src/"
-  for f in .gpu-vtk/variants/*."$v".h; do
-    [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".h).h"
+  for ext in h cpp; do
+    for f in .gpu-vtk/variants/*."$v".$ext; do
+      [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".$ext).$ext"
+    done
   done
   # The tests belong to the tree's own headers: built in "main" alone.
   targets=(octoray_bench_cuda)
