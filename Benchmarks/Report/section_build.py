@@ -692,9 +692,10 @@ thesis's dense pointer skeleton of the same depth, 8 B × (8^(L+1)−1)/7:
 
 Reading these figures:
 
-- The sort is most of the build and gains little from a second thread on this VM: at depth 8 it is 24 bits = 3
-  passes of 8-bit digits (RadixSort.cpp) over (u64 key, u32 index) pairs, bound by the scattered writes rather than
-  by compute. 2-thread medians on this shared machine swing from run to run; read the 1-thread column for ratios.
+- The sort is most of the build and gains little from a second thread on this VM: with the automatic depth it sorts
+  full-depth keys, 63 bits = 6 passes of 11-bit digits (RadixSort.cpp), over (u64 key, u32 index) pairs, bound by
+  the scattered writes rather than by compute (a fixed depth of 10 and less sorts one u64 word a point instead, the
+  leaf key above the index: OctreeKernels.h's SortedKeys). 2-thread medians on this shared machine swing from run to run; read the 1-thread column for ratios.
 - B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, full-depth key 8 B, sorted key +
   index 12 B, scratch key + index 12 B); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
   octoray only at shallow depth on uniform data; from depth 9 on it is larger and grows 8× per level.
