@@ -128,9 +128,8 @@ std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const c
 // starts[r] = where the r-th run of equal (key >> shift) among n sorted
 // keys starts, with n after the last run: the nodes one level up (shift 3),
 // the leaves (the sorted words' keyShift) or the records of one node
-// (shift 0). `starts` has room for n + 1; the
-// count goes to kCounterSelected, which the host reads only where it does
-// not know it.
+// (shift 0). `starts` has room for n + 1; the count goes to
+// kCounterSelected, which the host reads only where it does not know it.
 template <class Device, typename Key>
 void RunStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int shift,
   std::uint32_t* starts)
