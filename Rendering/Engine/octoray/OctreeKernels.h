@@ -137,6 +137,10 @@ struct SortedKeys
 };
 
 // Leaf `node` holds the sorted points [begin, end): key, topology and means.
+// The points' records are read in random order, which the memory's rate of
+// random reads bounds: neither 32-byte fills nor a loop that gathered them
+// in sorted order first made it faster on an H100
+// (Benchmarks/gpu/variants-packed-sort.txt).
 OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, const SortedKeys& sorted,
   std::uint32_t node, std::uint32_t begin, std::uint32_t end)
 {
