@@ -29,6 +29,49 @@ TEST_P(OctreeBuild, GaussianClusters)
   ExpectDepthRule(t, c);
 }
 
+// The automatic depth sorts packed keys down to level 10 first and sorts
+// the full keys only where those levels do not settle the depth rule
+// (OctreeDriver.h): clouds whose rule lands deeper than 10, at 10, and on
+// coincident points, which no level separates further, against the
+// brute-force octree and the rule worked out from it.
+TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
+{
+  std::mt19937_64 rng(47);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Tight clusters of 8 points at random places: no level holds many lone
+  // points until the clusters split (level 17 for `deep`).
+  auto clusters = [&](double spread) {
+    Cloud c;
+    for (int k = 0; k < 300; ++k)
+    {
+      const double x = u(rng), y = u(rng), z = u(rng);
+      for (int i = 0; i < 8; ++i)
+      {
+        c.Add(x + spread * u(rng), y + spread * u(rng), z + spread * u(rng), rng);
+      }
+    }
+    return c;
+  };
+  const Cloud deep = clusters(1e-5);
+  const Cloud tenth = clusters(2e-3); // the rule lands on level 10 itself
+  Cloud coincident;
+  for (int i = 0; i < 600; ++i)
+  {
+    const double corner = i % 3 == 0 ? 0.0 : (i % 3 == 1 ? 1.0 : 0.25);
+    coincident.Add(corner, corner, 1.0 - corner, rng);
+  }
+  const std::pair<const Cloud*, int> cases[] = { { &deep, 17 }, { &tenth, 10 }, { &coincident, 2 } };
+  for (const auto& [c, depth] : cases)
+  {
+    SCOPED_TRACE("expected depth " + std::to_string(depth));
+    BuildAndCompare(*engine, *c, 0);
+    HostOctree t;
+    engine->CopyToHost(t);
+    EXPECT_EQ(t.depth, depth);
+    ExpectDepthRule(t, *c);
+  }
+}
+
 // One point, coincident points, flat and collinear data and data far from
 // the origin are rows of the stability table (TestStability.cpp).
 TEST_P(OctreeBuild, TwoOppositeCorners)

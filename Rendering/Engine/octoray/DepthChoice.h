@@ -65,21 +65,32 @@ inline std::uint64_t NodesAtLevel(const std::uint64_t newNode[kDepthHistogramBin
   return nodes;
 }
 
-// newNode[b + 1] and alone[b + 1] count keys per bin b in -1..21.
-inline int ChooseDepthFromHistograms(const std::uint64_t newNode[kDepthHistogramBins],
-  const std::uint64_t alone[kDepthHistogramBins])
+// The depth from the histograms of keys sorted down to level `known`
+// (newNode[b + 1] and alone[b + 1] count keys per bin b in -1..21; with
+// known < kMaxLevel the bins from `known` on lump keys whose deeper levels
+// were not sorted). The bins below `known` are exact, and they settle the
+// rule at a level up to `known` unless no level up to it holds half
+// singletons and one of them already has as many nodes as level `known`:
+// whether a deeper level would separate more points is then not known, and
+// the answer is 0. With known == kMaxLevel, never 0.
+inline int ChooseDepthWithin(const std::uint64_t newNode[kDepthHistogramBins],
+  const std::uint64_t alone[kDepthHistogramBins], int known)
 {
-  const std::uint64_t distinctAtMax = NodesAtLevel(newNode, kMaxLevel);
+  const std::uint64_t distinctAtKnown = NodesAtLevel(newNode, known);
   std::uint64_t singletons = alone[0]; // bin -1: a lone point
-  for (int level = 1; level <= kMaxLevel; ++level)
+  for (int level = 1; level <= known; ++level)
   {
     singletons += alone[level]; // bin level-1
     const std::uint64_t distinct = NodesAtLevel(newNode, level);
-    if (2 * singletons >= distinct || distinct == distinctAtMax)
+    if (2 * singletons >= distinct)
     {
       return level;
     }
+    if (distinct == distinctAtKnown)
+    {
+      return known == kMaxLevel ? level : 0; // no deeper level separates more, or none known
+    }
   }
-  return kMaxLevel;
+  return known == kMaxLevel ? kMaxLevel : 0;
 }
 }

@@ -390,26 +390,22 @@ struct SortedPoints
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
-// Keys (computed, or the stored ones when they are current), sort, and one
-// histogram of neighbouring keys: the node count of every level and, for an
-// automatic depth (requestedDepth 0), the depth. The loops are queued
-// first, then whileSorting() runs on the host, then one copy to the host
-// brings the histogram and the key check. Marks on `clock`: the keys, and
-// the sort with the histogram, each its own span.
-// (A std::function: nvcc does not let a host lambda's type be a template
-// argument of a function that holds device lambdas.)
+// The automatic depth first sorts packed words at this depth: the levels
+// down to it settle the depth rule for most scenes (ChooseDepthWithin).
+constexpr int kProvisionalDepth = 10;
+static_assert(SortedKeys::Packs(kProvisionalDepth), "the provisional sort packs");
+
+// Queues the sort of the state's points by their keys at `sortDepth`
+// (kMaxLevel: full depth), packed where they fit: the keys (computed, or
+// the stored ones), the sort, and the histogram of neighbouring sorted keys.
+// marks[0] is put on `clock` after the keys, marks[1] after the histogram.
 template <class Device>
-SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[3],
-  const std::function<void()>& whileSorting)
+SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  int sortDepth, bool computeKeys, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
 {
   const std::size_t n = s.count;
-  if (s.keepPoints)
-  {
-    d.Reserve(s.points.key, n, "point keys");
-  }
   // Packed sort words need no index arrays but the one for run starts.
-  const bool packed = SortedKeys::Packs(requestedDepth);
+  const bool packed = SortedKeys::Packs(sortDepth);
   for (int b = 0; b < 2; ++b)
   {
     d.Reserve(scratch.sortKey[b], n, "sort keys");
@@ -427,13 +423,8 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
   std::uint64_t* sortKey = scratch.sortKey[0].Get();
   std::uint32_t* sortIndex = packed ? nullptr : scratch.sortIndex[0].Get();
-  std::uint64_t* counters = scratch.counters.Get();
-  // Only the leaf level's bits need sorting when the depth is known.
-  const int leafShift = requestedDepth > 0 ? 3 * (kMaxLevel - requestedDepth) : 0;
-  phases[0] = clock.Mark();
-  // The cube holds every point (fitted or checked): a point outside is a
-  // bug, read after the sort with the histogram.
-  const FirstFailure outside = ArmFirstFailure(d, scratch);
+  // Only the bits down to sortDepth need sorting.
+  const int leafShift = 3 * (kMaxLevel - sortDepth);
   if (computeKeys)
   {
     d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
@@ -455,11 +446,12 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
       SortedKeys::Enter(sortKey, sortIndex, i, pointKey[i] >> leafShift);
     });
   }
-  phases[1] = clock.Mark();
+  marks[0] = clock.Mark();
 
   SortedPoints sorted;
+  sorted.depth = sortDepth;
   std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
-  const int bits = requestedDepth > 0 ? 3 * requestedDepth : 3 * kMaxLevel;
+  const int bits = 3 * sortDepth;
   if (packed)
   {
     const int shift = SortedKeys::kPackedShift;
@@ -474,35 +466,79 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     sorted.spare = values[1 - result];
   }
   const SortedKeys sortedKeys = sorted.keys;
+  std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
     OCTORAY_LAMBDA(std::size_t i) {
       return DepthHistogramEntries([&](std::size_t k) { return sortedKeys.LeafKey(k) << leafShift; }, n, i);
     },
     counters + kCounterHistogram);
-  phases[2] = clock.Mark();
+  marks[1] = clock.Mark();
+  return sorted;
+}
+
+// The histogram of a queued sort, and the key check of its keys: one copy
+// to the host. A point outside the cube is an error naming it.
+template <class Device>
+void ReadHistogram(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, SortedPoints& sorted)
+{
+  static_assert(kCounterFirst == kCounterHistogram + 2 * kDepthHistogramBins, "one copy: histograms, key check");
+  std::uint64_t report[2 * kDepthHistogramBins + 1];
+  d.ToHost(scratch.counters.Get() + kCounterHistogram, 2 * kDepthHistogramBins + 1, report,
+    "NeighbourHistogramKernel");
+  if (report[2 * kDepthHistogramBins] != kNoIndex)
+  {
+    const std::size_t outside = report[2 * kDepthHistogramBins];
+    throw Error(OutsideCubeMessage(outside, ReadPosition(d, s.Points(), outside)));
+  }
+  std::copy_n(report, 2 * kDepthHistogramBins, sorted.histogram);
+}
+
+// Sorted points of the state inside `cube` at the requested depth, or at
+// the automatic one (requestedDepth 0), with every level's node count. The
+// loops are queued first, then whileSorting() runs on the host, then one
+// copy brings the histogram. The automatic depth sorts packed words at
+// kProvisionalDepth first; only where the levels down to it do not settle
+// the depth rule are the full-depth keys sorted too, in pairs. Marks on
+// `clock`: phases[0..2] around the keys and the sort, phases[3..5] around
+// those of the full-depth sort (-1: none).
+// (A std::function: nvcc does not let a host lambda's type be a template
+// argument of a function that holds device lambdas.)
+template <class Device>
+SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[6],
+  const std::function<void()>& whileSorting)
+{
+  if (s.keepPoints)
+  {
+    d.Reserve(s.points.key, s.count, "point keys");
+  }
+  std::fill_n(phases, 6, -1);
+  phases[0] = clock.Mark();
+  // The cube holds every point (fitted or checked): a point outside is a
+  // bug, read after the sort with the histogram.
+  const FirstFailure outside = ArmFirstFailure(d, scratch);
+  const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
+  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, computeKeys, outside, clock, phases + 1);
   if (whileSorting)
   {
     whileSorting();
   }
-
-  static_assert(kCounterFirst == kCounterHistogram + 2 * kDepthHistogramBins, "one copy: histograms, key check");
-  std::uint64_t report[2 * kDepthHistogramBins + 1];
-  d.ToHost(counters + kCounterHistogram, 2 * kDepthHistogramBins + 1, report, "NeighbourHistogramKernel");
-  if (report[2 * kDepthHistogramBins] != kNoIndex)
+  ReadHistogram(d, scratch, s, sorted);
+  if (requestedDepth == 0)
   {
-    const std::size_t outside = report[2 * kDepthHistogramBins];
-    throw Error(OutsideCubeMessage(outside, ReadPosition(d, pts, outside)));
-  }
-  std::copy_n(report, 2 * kDepthHistogramBins, sorted.histogram);
-  sorted.depth = requestedDepth;
-  if (sorted.depth == 0)
-  {
-    sorted.depth = ChooseDepthFromHistograms(sorted.histogram, sorted.histogram + kDepthHistogramBins);
-    // Full-depth keys, sorted in pairs (they do not pack): to leaf keys.
-    std::uint64_t* sortedKey = keys[sorted.keys.word == keys[0] ? 0 : 1];
-    const int shift = 3 * (kMaxLevel - sorted.depth);
-    d.ForEach("ShiftKernel", n, OCTORAY_LAMBDA(std::size_t i) { sortedKey[i] >>= shift; });
+    const int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
+    if (depth == 0)
+    {
+      phases[3] = clock.Mark();
+      const bool keysKept = DataOrNull(s.points.key) != nullptr; // written by the first sort's keys
+      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, outside, clock, phases + 4);
+      ReadHistogram(d, scratch, s, sorted);
+    }
+    const int sortedAt = sorted.depth; // the depth of the sorted keys
+    sorted.depth = depth ? depth : ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
+    // The leaf keys: the sorted keys without their bits below the depth.
+    sorted.keys.keyShift += 3 * (sortedAt - sorted.depth);
   }
   return sorted;
 }
@@ -572,7 +608,7 @@ BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   BuildStats stats;
   stats.points = s.count;
   typename Device::Clock clock;
-  int phases[3];
+  int phases[6];
   const SortedPoints sorted =
     SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, clock, phases, whileSorting);
   const int levelsBegin = clock.Mark();
@@ -581,6 +617,11 @@ BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   d.Synchronize("octree build");
   stats.keySeconds = clock.Seconds(phases[0], phases[1]);
   stats.sortSeconds = clock.Seconds(phases[1], phases[2]);
+  if (phases[3] >= 0) // the automatic depth's full-depth sort
+  {
+    stats.keySeconds += clock.Seconds(phases[3], phases[4]);
+    stats.sortSeconds += clock.Seconds(phases[4], phases[5]);
+  }
   stats.levelSeconds = clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
   stats.cube = cube;

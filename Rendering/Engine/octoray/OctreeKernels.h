@@ -114,7 +114,7 @@ struct SortedKeys
   const std::uint32_t* index; // null: packed
   int keyShift;               // kPackedShift when packed, else 0
 
-  static OCTORAY_HD bool Packs(int depth) { return depth > 0 && 3 * depth <= 64 - kPackedShift; }
+  static constexpr OCTORAY_HD bool Packs(int depth) { return depth > 0 && 3 * depth <= 64 - kPackedShift; }
   static OCTORAY_HD std::uint64_t Pack(std::uint64_t leafKey, std::size_t point)
   {
     return leafKey << kPackedShift | static_cast<std::uint32_t>(point);
