@@ -37,23 +37,8 @@ TEST_P(OctreeBuild, GaussianClusters)
 TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 {
   std::mt19937_64 rng(47);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  // Tight clusters of 8 points at random places: no level holds many lone
-  // points until the clusters split (level 17 for `deep`).
-  auto clusters = [&](double spread) {
-    Cloud c;
-    for (int k = 0; k < 300; ++k)
-    {
-      const double x = u(rng), y = u(rng), z = u(rng);
-      for (int i = 0; i < 8; ++i)
-      {
-        c.Add(x + spread * u(rng), y + spread * u(rng), z + spread * u(rng), rng);
-      }
-    }
-    return c;
-  };
-  const Cloud deep = clusters(1e-5);
-  const Cloud tenth = clusters(2e-3); // the rule lands on level 10 itself
+  const Cloud deep = TightClusters(300, 1e-5, 47);
+  const Cloud tenth = TightClusters(300, 2e-3, 48); // the rule lands on level 10 itself
   Cloud coincident;
   for (int i = 0; i < 600; ++i)
   {
