@@ -152,7 +152,9 @@ class Context:
                     if commands and line.strip():
                         break
                     continue
-                current += line.split("#")[0].strip()
+                if commands and not current and line.strip().startswith("#"):
+                    break  # the remarks that begin the next call
+                current += line.split(" #")[0].strip()
                 if current.endswith("\\"):
                     current = current[:-1] + " "
                 else:
