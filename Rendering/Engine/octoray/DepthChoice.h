@@ -2,7 +2,8 @@
 // at least half of the non-empty leaves hold a single point (the median leaf
 // holds one point), or at which no deeper level separates any more points
 // (coincident points), and at least 1. One pass over the sorted full-depth
-// keys yields the answer for all 21 levels at once: two neighbouring keys
+// keys yields the answer for all 21 levels at once (over keys sorted down to
+// a level, for the levels down to it: ChooseDepthWithin): two neighbouring keys
 // share their ancestors down to level SharedLevels(a, b), so a key starts a
 // new node at every level below that, and is alone in its node at every
 // level below what it shares with either neighbour.

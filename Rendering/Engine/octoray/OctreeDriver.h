@@ -527,18 +527,18 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   ReadHistogram(d, scratch, s, sorted);
   if (requestedDepth == 0)
   {
-    const int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
+    int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
     if (depth == 0)
     {
       phases[3] = clock.Mark();
       const bool keysKept = DataOrNull(s.points.key) != nullptr; // written by the first sort's keys
       sorted = QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, outside, clock, phases + 4);
       ReadHistogram(d, scratch, s, sorted);
+      depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }
-    const int sortedAt = sorted.depth; // the depth of the sorted keys
-    sorted.depth = depth ? depth : ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
-    // The leaf keys: the sorted keys without their bits below the depth.
-    sorted.keys.keyShift += 3 * (sortedAt - sorted.depth);
+    // The leaf keys: the sorted keys (at sorted.depth) without their bits below the depth.
+    sorted.keys.keyShift += 3 * (sorted.depth - depth);
+    sorted.depth = depth;
   }
   return sorted;
 }
