@@ -107,26 +107,31 @@ TEST(CpuDevice, SelectKeepsOrderAndCounts)
   });
 }
 
-// Stable, for both key widths and keys below 2^bits (the passes cover
-// `bits`), with the result where the return value says.
-template <typename Key>
+// Stable, for both key widths with 32-bit values and for 32-bit keys with
+// 64-bit ones (a leaf key with a record of two words), keys below 2^bits
+// (the passes cover `bits`), with the result where the return value says.
+template <typename Key, typename Value = std::uint32_t>
 void ExpectStableSort(int bits)
 {
-  SCOPED_TRACE("bits " + std::to_string(bits));
+  SCOPED_TRACE("bits " + std::to_string(bits) + ", values of " + std::to_string(8 * sizeof(Value)) + " bits");
   OnEverySplit([bits](std::size_t n, CpuDevice& d) {
     const std::vector<std::uint64_t> random = RandomKeys(n, bits, n + d.threads);
     std::vector<Key> k0(random.begin(), random.end()), k1(n);
-    std::vector<std::uint32_t> v0(n), v1(n);
-    std::iota(v0.begin(), v0.end(), 0u);
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> reference;
+    std::vector<Value> v0(n), v1(n);
+    std::vector<std::pair<std::uint64_t, Value>> reference;
     for (std::size_t i = 0; i < n; ++i)
     {
-      reference.emplace_back(k0[i], static_cast<std::uint32_t>(i));
+      v0[i] = static_cast<Value>(i);
+      if constexpr (sizeof(Value) == 8)
+      {
+        v0[i] |= ~static_cast<Value>(i) << 32; // both halves travel
+      }
+      reference.emplace_back(k0[i], v0[i]);
     }
     std::stable_sort(reference.begin(), reference.end(),
       [](const auto& a, const auto& b) { return a.first < b.first; });
     Key* keys[2] = { k0.data(), k1.data() };
-    std::uint32_t* values[2] = { v0.data(), v1.data() };
+    Value* values[2] = { v0.data(), v1.data() };
     const int result = d.SortPairs(keys, values, n, bits, "test");
     ASSERT_TRUE(result == 0 || result == 1);
     for (std::size_t i = 0; i < n; ++i)
@@ -143,10 +148,12 @@ TEST(CpuDevice, SortPairsIsStable)
   ExpectStableSort<std::uint64_t>(30);
   ExpectStableSort<std::uint32_t>(29);
   ExpectStableSort<std::uint32_t>(5);
+  ExpectStableSort<std::uint32_t, std::uint64_t>(30);
+  ExpectStableSort<std::uint32_t, std::uint64_t>(6);
 }
 
 // Keys alone, by their bits [beginBit, endBit), other bits set below and
-// above them: stable, as the build's packed words need (OctreeKernels.h).
+// above them: stable.
 void ExpectStableKeySort(int beginBit, int endBit)
 {
   SCOPED_TRACE("bits " + std::to_string(beginBit) + " to " + std::to_string(endBit));

@@ -29,7 +29,7 @@ TEST_P(OctreeBuild, GaussianClusters)
   ExpectDepthRule(t, c);
 }
 
-// The automatic depth sorts packed keys down to level 10 first and sorts
+// The automatic depth sorts 32-bit keys down to level 10 first and sorts
 // the full keys only where those levels do not settle the depth rule
 // (OctreeDriver.h): clouds whose rule lands deeper than 10, at 10, and on
 // coincident points, which no level separates further, against the
@@ -54,6 +54,68 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
     engine->CopyToHost(t);
     EXPECT_EQ(t.depth, depth);
     ExpectDepthRule(t, *c);
+  }
+}
+
+// The sort moves each point's record with its key where the record is one
+// or two words and the leaf keys fit 32 bits, and gathers the records by
+// index otherwise (SortedKeys, OctreeKernels.h); without kept points it may
+// overwrite them. Every record width, at depths that sort 32-bit and 64-bit
+// keys and at the automatic depth, with and without kept points, against
+// the brute-force octree; then an update of every point reads the kept
+// records again.
+TEST_P(OctreeBuild, RecordsOfEveryWidth)
+{
+  const Cloud every = GaussianClusters(4000, 23);
+  auto only = [](Cloud c, bool colours, bool scalars, bool reflectivity, bool normals, bool refraction) {
+    if (!colours) c.rgb.clear();
+    if (!scalars) c.scalar.clear();
+    if (!reflectivity) c.reflectivity.clear();
+    if (!normals) c.normal.clear();
+    if (!refraction) c.refraction.clear();
+    return c;
+  };
+  const std::pair<const char*, Cloud> clouds[] = {
+    { "no attributes (0 words)", only(every, false, false, false, false, false) },
+    { "colours (1 word)", only(every, true, false, false, false, false) },
+    { "colours and reflectivity (2 words)", only(every, true, false, true, false, false) },
+    { "colours, scalars and normals (3 words)", only(every, true, true, false, true, false) },
+    { "every attribute (5 words)", every },
+    // Its automatic depth lies beyond the provisional sort's: the full-depth
+    // sort reads the records again.
+    { "deep clusters, colours and reflectivity (2 words)",
+      only(TightClusters(300, 1e-5, 47), true, false, true, false, false) } };
+  for (const auto& [label, cloud] : clouds)
+  {
+    for (int depth : { 7, 0, 14 })
+    {
+      for (bool keep : { false, true })
+      {
+        SCOPED_TRACE(std::string(label) + ", depth " + std::to_string(depth) + (keep ? ", points kept" : ""));
+        BuildOptions options;
+        options.depth = depth;
+        options.keepPoints = keep;
+        engine->Build(cloud.View(), options);
+        HostOctree t;
+        engine->CopyToHost(t);
+        ExpectMatchesReference(t, cloud);
+        if (!keep)
+        {
+          continue;
+        }
+        Cloud moved = cloud;
+        for (double& v : moved.xyz)
+        {
+          v *= 0.5; // every point stays in the cube
+        }
+        PositionsView all;
+        all.count = moved.Size();
+        all.xyzDouble = moved.xyz.data();
+        engine->Update(all);
+        engine->CopyToHost(t);
+        ExpectMatchesReference(t, moved);
+      }
+    }
   }
 }
 

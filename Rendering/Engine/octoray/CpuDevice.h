@@ -234,8 +234,8 @@ public:
     *count = offsets[chunks];
   }
 
-  template <typename Key>
-  int SortPairs(Key* const keys[2], std::uint32_t* const values[2], std::size_t n, int bits, const char*)
+  template <typename Key, typename Value>
+  int SortPairs(Key* const keys[2], Value* const values[2], std::size_t n, int bits, const char*)
   {
     return RadixSort(keys[0], values[0], n, 0, bits, threads, keys[1], values[1]);
   }
@@ -243,7 +243,7 @@ public:
   template <typename Key>
   int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char*)
   {
-    return RadixSort<Key>(keys[0], nullptr, n, beginBit, endBit, threads, keys[1], nullptr);
+    return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, beginBit, endBit, threads, keys[1], nullptr);
   }
 };
 }

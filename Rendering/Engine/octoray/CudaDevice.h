@@ -296,11 +296,11 @@ public:
     CudaCheck(cub::DeviceSelect::If(Temporary(bytes), bytes, in, out, count, n, selected), "cub::DeviceSelect");
   }
 
-  template <typename Key>
-  int SortPairs(Key* const keys[2], std::uint32_t* const values[2], std::size_t n, int bits, const char* what)
+  template <typename Key, typename Value>
+  int SortPairs(Key* const keys[2], Value* const values[2], std::size_t n, int bits, const char* what)
   {
     cub::DoubleBuffer<Key> k(keys[0], keys[1]);
-    cub::DoubleBuffer<std::uint32_t> v(values[0], values[1]);
+    cub::DoubleBuffer<Value> v(values[0], values[1]);
     const std::string name = std::string("cub::DeviceRadixSort (") + what + ")";
     std::size_t bytes = 0;
     CudaCheck(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, n, 0, bits), name.c_str());

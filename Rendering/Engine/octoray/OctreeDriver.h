@@ -15,6 +15,7 @@
 //   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
+//                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
 //   SortKeys(keys[2], n, beginBit, endBit, what)    the keys alone, by those bits; stable, returns the same
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
 //   Clock                             Mark(): a point in the order of the loops; Seconds(a, b) once waited for
@@ -380,49 +381,150 @@ RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArray
   return cube;
 }
 
-// Sorted (leaf key, point) pairs of the state's points, the leaf level and
-// the newNode histogram that gives every level's node count.
+// The state's points sorted by their leaf keys, the leaf level and the
+// newNode histogram that gives every level's node count.
 struct SortedPoints
 {
   SortedKeys keys;
-  std::uint32_t* spare; // an index array the sort left free (n + 1 entries): room for run starts
+  std::uint32_t* spare; // a 32-bit array the sort left free (n + 1 entries): room for run starts
   int depth;
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
-// The automatic depth first sorts packed words at this depth: the levels
+// The automatic depth first sorts 32-bit keys of this depth: the levels
 // down to it settle the depth rule for most scenes (ChooseDepthWithin).
 constexpr int kProvisionalDepth = 10;
-static_assert(SortedKeys::Packs(kProvisionalDepth), "the provisional sort packs");
+static_assert(SortedKeys::Narrow(kProvisionalDepth), "the provisional sort has 32-bit keys");
 
-// Queues the sort of the state's points by their keys at `sortDepth`
-// (kMaxLevel: full depth), packed where they fit: the keys (computed, or
-// the stored ones), the sort, and the histogram of neighbouring sorted keys.
-// marks[0] is put on `clock` after the keys, marks[1] after the histogram.
-template <class Device>
-SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int sortDepth, bool computeKeys, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
+// Where the keys kernel writes each point's leaf key, and its index where
+// the records do not travel with the keys.
+struct SortInput
 {
-  const std::size_t n = s.count;
-  // Packed sort words need no index arrays but the one for run starts.
-  const bool packed = SortedKeys::Packs(sortDepth);
+  std::uint64_t* wideKey;
+  std::uint32_t* narrowKey;
+  std::uint32_t* index;
+
+  OCTORAY_HD void Enter(std::size_t i, std::uint64_t leafKey) const
+  {
+    if (narrowKey)
+    {
+      narrowKey[i] = static_cast<std::uint32_t>(leafKey);
+    }
+    else
+    {
+      wideKey[i] = leafKey;
+    }
+    if (index)
+    {
+      index[i] = static_cast<std::uint32_t>(i);
+    }
+  }
+};
+
+// Reserves the key and index arrays of a sort (32-bit keys where they fit:
+// SortedKeys) and releases those it does not use.
+template <class Device>
+SortInput ReserveSortInput(Device& d, DriverScratch<Device>& scratch, std::size_t n, bool narrow, bool indexed)
+{
   for (int b = 0; b < 2; ++b)
   {
-    d.Reserve(scratch.sortKey[b], n, "sort keys");
+    if (narrow)
+    {
+      d.Release(scratch.sortKey[b]);
+      d.Reserve(scratch.narrowKey[b], n + 1, "sort keys");
+    }
+    else
+    {
+      d.Release(scratch.narrowKey[b]);
+      d.Reserve(scratch.sortKey[b], n, "sort keys");
+    }
+    if (indexed)
+    {
+      d.Reserve(scratch.sortIndex[b], n + 1, "sort indices");
+    }
+    else
+    {
+      d.Release(scratch.sortIndex[b]);
+    }
   }
-  d.Reserve(scratch.sortIndex[0], n + 1, "sort indices");
-  if (packed)
+  return SortInput{ narrow ? nullptr : scratch.sortKey[0].Get(), narrow ? scratch.narrowKey[0].Get() : nullptr,
+    indexed ? scratch.sortIndex[0].Get() : nullptr };
+}
+
+// The records that travel with the keys: [0] the state's own, which the
+// sort may overwrite where nothing reads them after it (`consumable`), else
+// a copy; [1] the sort's second buffer.
+template <class Device>
+void ReserveTravellingRecords(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, bool consumable,
+  std::uint32_t* records[2])
+{
+  const std::size_t words = s.count * s.points.layout.stride;
+  d.Reserve(scratch.sortRecords[1], words, "sort records");
+  records[1] = scratch.sortRecords[1].Get();
+  if (consumable)
   {
-    d.Release(scratch.sortIndex[1]);
+    d.Release(scratch.sortRecords[0]);
+    records[0] = s.points.records.Get();
+    return;
+  }
+  d.Reserve(scratch.sortRecords[0], words, "sort records");
+  const std::uint32_t* from = s.points.records.Get();
+  std::uint32_t* to = records[0] = scratch.sortRecords[0].Get();
+  d.ForEach("CopyRecordsKernel", words, OCTORAY_LAMBDA(std::size_t w) { to[w] = from[w]; });
+}
+
+// Sorts the n 32-bit keys of `bits` bits with the records of `stride`
+// words (none, one or two) that travel with them; returns the sorted keys.
+template <class Device>
+SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, int bits,
+  bool recordsConsumable, std::uint32_t*& spare)
+{
+  const std::size_t n = s.count;
+  const int stride = s.points.layout.stride;
+  std::uint32_t* keys[2] = { scratch.narrowKey[0].Get(), scratch.narrowKey[1].Get() };
+  std::uint32_t* records[2] = { nullptr, nullptr };
+  int result = 0;
+  if (stride == 0)
+  {
+    result = d.SortKeys(keys, n, 0, bits, "point keys");
   }
   else
   {
-    d.Reserve(scratch.sortIndex[1], n + 1, "sort indices");
+    ReserveTravellingRecords(d, scratch, s, recordsConsumable, records);
+    if (stride == 1)
+    {
+      result = d.SortPairs(keys, records, n, bits, "point keys and records");
+    }
+    else
+    {
+      static_assert(sizeof(std::uint64_t) == 2 * sizeof(std::uint32_t), "a record of two words is one value");
+      std::uint64_t* pairs[2] = { reinterpret_cast<std::uint64_t*>(records[0]),
+        reinterpret_cast<std::uint64_t*>(records[1]) };
+      result = d.SortPairs(keys, pairs, n, bits, "point keys and records");
+    }
   }
+  spare = keys[1 - result];
+  return SortedKeys{ nullptr, keys[result], nullptr, records[result], 0 };
+}
+
+// Queues the sort of the state's points by their keys at `sortDepth`
+// (kMaxLevel: full depth): the keys (computed, or the stored ones), the
+// sort, and the histogram of neighbouring sorted keys. beforeSort(), if
+// given, runs on the host between the keys and the sort; the points'
+// records must exist after it. Without keepRecords the sort may overwrite
+// them. Marks on `clock`: marks[0] after the keys, marks[1] before the
+// sort, marks[2] after the histogram.
+template <class Device>
+SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  int sortDepth, bool computeKeys, bool keepRecords, const FirstFailure& outside, typename Device::Clock& clock,
+  int marks[3], const std::function<void()>& beforeSort)
+{
+  const std::size_t n = s.count;
+  const bool narrow = SortedKeys::Narrow(sortDepth);
+  const bool travel = SortedKeys::RecordsTravel(sortDepth, s.points.layout.stride);
+  const SortInput input = ReserveSortInput(d, scratch, n, narrow, !travel);
   const PointArraysView pts = s.Points();
   std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
-  std::uint64_t* sortKey = scratch.sortKey[0].Get();
-  std::uint32_t* sortIndex = packed ? nullptr : scratch.sortIndex[0].Get();
   // Only the bits down to sortDepth need sorting.
   const int leafShift = 3 * (kMaxLevel - sortDepth);
   if (computeKeys)
@@ -437,32 +539,41 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
       {
         pointKey[i] = key;
       }
-      SortedKeys::Enter(sortKey, sortIndex, i, key >> leafShift);
+      input.Enter(i, key >> leafShift);
     });
   }
   else
   {
-    d.ForEach("LeafKeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
-      SortedKeys::Enter(sortKey, sortIndex, i, pointKey[i] >> leafShift);
-    });
+    d.ForEach("LeafKeysKernel", n, OCTORAY_LAMBDA(std::size_t i) { input.Enter(i, pointKey[i] >> leafShift); });
   }
   marks[0] = clock.Mark();
+  if (beforeSort)
+  {
+    beforeSort();
+  }
+  marks[1] = clock.Mark();
 
   SortedPoints sorted;
   sorted.depth = sortDepth;
-  std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
   const int bits = 3 * sortDepth;
-  if (packed)
+  if (narrow && travel)
   {
-    const int shift = SortedKeys::kPackedShift;
-    sorted.keys = SortedKeys{ keys[d.SortKeys(keys, n, shift, shift + bits, "point keys")], nullptr, shift };
-    sorted.spare = scratch.sortIndex[0].Get();
+    sorted.keys = SortNarrowKeys(d, scratch, s, bits, !keepRecords, sorted.spare);
+  }
+  else if (narrow)
+  {
+    std::uint32_t* keys[2] = { scratch.narrowKey[0].Get(), scratch.narrowKey[1].Get() };
+    std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
+    const int result = d.SortPairs(keys, values, n, bits, "point keys");
+    sorted.keys = SortedKeys{ nullptr, keys[result], values[result], nullptr, 0 };
+    sorted.spare = keys[1 - result];
   }
   else
   {
+    std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
     std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
     const int result = d.SortPairs(keys, values, n, bits, "point keys");
-    sorted.keys = SortedKeys{ keys[result], values[result], 0 };
+    sorted.keys = SortedKeys{ keys[result], nullptr, values[result], nullptr, 0 };
     sorted.spare = values[1 - result];
   }
   const SortedKeys sortedKeys = sorted.keys;
@@ -473,10 +584,9 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
       return DepthHistogramEntries([&](std::size_t k) { return sortedKeys.LeafKey(k) << leafShift; }, n, i);
     },
     counters + kCounterHistogram);
-  marks[1] = clock.Mark();
+  marks[2] = clock.Mark();
   return sorted;
 }
-
 // The histogram of a queued sort, and the key check of its keys: one copy
 // to the host. A point outside the cube is an error naming it.
 template <class Device>
@@ -495,44 +605,45 @@ void ReadHistogram(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
 }
 
 // Sorted points of the state inside `cube` at the requested depth, or at
-// the automatic one (requestedDepth 0), with every level's node count. The
-// loops are queued first, then whileSorting() runs on the host, then one
-// copy brings the histogram. The automatic depth sorts packed words at
-// kProvisionalDepth first; only where the levels down to it do not settle
-// the depth rule are the full-depth keys sorted too, in pairs. Marks on
-// `clock`: phases[0..2] around the keys and the sort, phases[3..5] around
-// those of the full-depth sort (-1: none).
+// the automatic one (requestedDepth 0), with every level's node count.
+// beforeSort() runs on the host between the keys and the sort (QueueSort),
+// then one copy brings the histogram. The automatic depth sorts 32-bit keys
+// at kProvisionalDepth first; only where the levels down to it do not
+// settle the depth rule are the full-depth keys sorted too, with the
+// points' indices. Marks on `clock`: phases[0..3] around the keys and the
+// sort (QueueSort's marks after the first), phases[4..7] around those of
+// the full-depth sort (-1: none).
 // (A std::function: nvcc does not let a host lambda's type be a template
 // argument of a function that holds device lambdas.)
 template <class Device>
 SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[6],
-  const std::function<void()>& whileSorting)
+  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[8],
+  const std::function<void()>& beforeSort)
 {
   if (s.keepPoints)
   {
     d.Reserve(s.points.key, s.count, "point keys");
   }
-  std::fill_n(phases, 6, -1);
+  std::fill_n(phases, 8, -1);
   phases[0] = clock.Mark();
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
   const FirstFailure outside = ArmFirstFailure(d, scratch);
   const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
-  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, computeKeys, outside, clock, phases + 1);
-  if (whileSorting)
-  {
-    whileSorting();
-  }
+  // The full-depth sort after the provisional one reads the records again.
+  const bool keepRecords = s.keepPoints || requestedDepth == 0;
+  SortedPoints sorted =
+    QueueSort(d, scratch, s, cube, sortDepth, computeKeys, keepRecords, outside, clock, phases + 1, beforeSort);
   ReadHistogram(d, scratch, s, sorted);
   if (requestedDepth == 0)
   {
     int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
     if (depth == 0)
     {
-      phases[3] = clock.Mark();
+      phases[4] = clock.Mark();
       const bool keysKept = DataOrNull(s.points.key) != nullptr; // written by the first sort's keys
-      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, outside, clock, phases + 4);
+      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, true, outside, clock,
+        phases + 5, nullptr);
       ReadHistogram(d, scratch, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }
@@ -581,7 +692,14 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   std::uint32_t* starts = sorted.spare;
 
   const SortedKeys keys = sorted.keys;
-  RunStarts(d, scratch, keys.word, s.count, keys.keyShift, starts);
+  if (keys.narrowKey)
+  {
+    RunStarts(d, scratch, keys.narrowKey, s.count, keys.keyShift, starts);
+  }
+  else
+  {
+    RunStarts(d, scratch, keys.wideKey, s.count, keys.keyShift, starts);
+  }
   const std::uint32_t leafBegin = view.levelBegin[depth];
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
     ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
@@ -599,28 +717,29 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
 }
 
 // Keys, sort and levels of the state's points inside `cube`: the octree.
-// whileSorting(), if given, runs on the host while the device sorts. The
-// phases' times are the device's (Device::Clock).
+// beforeSort(), if given, runs on the host while the device computes the
+// keys; the points' records must exist after it. The phases' times are the
+// device's (Device::Clock); the time between the keys and the sort (the
+// device waiting for beforeSort) counts in none.
 template <class Device>
 BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, const std::function<void()>& whileSorting = nullptr)
+  int requestedDepth, bool computeKeys, const std::function<void()>& beforeSort = nullptr)
 {
   BuildStats stats;
   stats.points = s.count;
   typename Device::Clock clock;
-  int phases[6];
-  const SortedPoints sorted =
-    SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, clock, phases, whileSorting);
+  int phases[8];
+  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, clock, phases, beforeSort);
   const int levelsBegin = clock.Mark();
   LinkLevels(d, scratch, s, sorted, cube);
   const int levelsEnd = clock.Mark();
   d.Synchronize("octree build");
   stats.keySeconds = clock.Seconds(phases[0], phases[1]);
-  stats.sortSeconds = clock.Seconds(phases[1], phases[2]);
-  if (phases[3] >= 0) // the automatic depth's full-depth sort
+  stats.sortSeconds = clock.Seconds(phases[2], phases[3]);
+  if (phases[4] >= 0) // the automatic depth's full-depth sort
   {
-    stats.keySeconds += clock.Seconds(phases[3], phases[4]);
-    stats.sortSeconds += clock.Seconds(phases[4], phases[5]);
+    stats.keySeconds += clock.Seconds(phases[4], phases[5]);
+    stats.sortSeconds += clock.Seconds(phases[6], phases[7]);
   }
   stats.levelSeconds = clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
@@ -644,11 +763,7 @@ void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   d.Release(s.points.xyzDouble);
   d.Release(s.points.records);
   d.Release(s.points.key);
-  for (int b = 0; b < 2; ++b)
-  {
-    d.Release(scratch.sortKey[b]);
-    d.Release(scratch.sortIndex[b]);
-  }
+  DriverScratch<Device>::ForEachSortBuffer(scratch, [&](auto& buffer) { d.Release(buffer); });
   d.Release(scratch.counters);
   d.ReleaseScratch();
 }
@@ -676,12 +791,13 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.count = n;
   s.attributes = points.Attributes();
   s.keepPoints = options.keepPoints;
+  s.points.layout = RecordLayoutOf(points); // the sort's shape depends on it
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
   StagedAttributes<Device> attributes = PrepareAttributes(d, points);
   BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true, [&] {
-    // The leaf level needs the attributes, the sort does not: they are
-    // copied while the device sorts.
+    // The keys need the positions alone: the attributes are copied while
+    // the device computes them, and become records that the sort moves.
     phase = std::chrono::steady_clock::now();
     FillAttributes(d, points, attributes);
     const float* scalar = attributes.values[kAttributeScalar].Get();

@@ -103,44 +103,42 @@ OCTORAY_HD bool ComputePointKey(const PointArraysView& pts, const RootCube& cube
 }
 
 // The points in the order of their leaf keys, as the build's sort leaves
-// them. Where a leaf key and a 32-bit point index fit one word (depth 10 and
-// less), the sort moves those words alone (Pack), a third fewer bytes than
-// (key, index) pairs; deeper leaf keys travel with their indices.
+// them. Leaf keys of depth 10 and less fit 32 bits; each travels with its
+// point's record where that is one or two words (RecordsTravel), so that
+// the leaf pass reads the records in order. Gathering them in sorted order
+// from the points' own records instead costs a random read each, which on
+// an H100 took longer than the sort (Benchmarks/gpu/profile-build.txt).
+// Other keys travel with their points' indices.
 struct SortedKeys
 {
-  static constexpr int kPackedShift = 32; // a packed word: (leaf key << 32) | point
+  const std::uint64_t* wideKey;   // leaf keys deeper than 32 bits, else null
+  const std::uint32_t* narrowKey; // leaf keys of 32 bits and less, else null
+  const std::uint32_t* index;     // the points, where their records did not travel
+  const std::uint32_t* records;   // the records in sorted order (the layout's stride), where they travelled
+  int keyShift;                   // bits of the sorted keys below the leaf level
 
-  const std::uint64_t* word;
-  const std::uint32_t* index; // null: packed
-  int keyShift;               // kPackedShift when packed, else 0
+  static constexpr OCTORAY_HD bool Narrow(int depth) { return 3 * depth <= 32; }
+  static constexpr OCTORAY_HD bool RecordsTravel(int depth, int stride) { return Narrow(depth) && stride <= 2; }
 
-  static constexpr OCTORAY_HD bool Packs(int depth) { return depth > 0 && 3 * depth <= 64 - kPackedShift; }
-  static OCTORAY_HD std::uint64_t Pack(std::uint64_t leafKey, std::size_t point)
+  OCTORAY_HD std::uint64_t LeafKey(std::size_t s) const
   {
-    return leafKey << kPackedShift | static_cast<std::uint32_t>(point);
+    return (narrowKey ? std::uint64_t(narrowKey[s]) : wideKey[s]) >> keyShift;
   }
-  // Point i's entry before the sort: its word, and its index unless packed
-  // (no index array).
-  static OCTORAY_HD void Enter(std::uint64_t* word, std::uint32_t* index, std::size_t i, std::uint64_t leafKey)
+  // The attribute vector of the s-th point in sorted order.
+  OCTORAY_HD void Attributes(const PointArraysView& pts, std::size_t s, float v[kSlotCount]) const
   {
-    word[i] = index ? leafKey : Pack(leafKey, i);
-    if (index)
+    if (records)
     {
-      index[i] = static_cast<std::uint32_t>(i);
+      RecordAttributes(records + s * pts.layout.stride, pts.layout, v);
     }
-  }
-  OCTORAY_HD std::uint64_t LeafKey(std::size_t s) const { return word[s] >> keyShift; }
-  OCTORAY_HD std::uint32_t Point(std::size_t s) const
-  {
-    return index ? index[s] : static_cast<std::uint32_t>(word[s]);
+    else
+    {
+      pts.Attributes(index[s], v);
+    }
   }
 };
 
 // Leaf `node` holds the sorted points [begin, end): key, topology and means.
-// The points' records are read in random order, which the memory's rate of
-// random reads bounds: neither 32-byte fills nor a loop that gathered them
-// in sorted order first made it faster on an H100
-// (Benchmarks/gpu/variants-packed-sort.txt).
 OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, const SortedKeys& sorted,
   std::uint32_t node, std::uint32_t begin, std::uint32_t end)
 {
@@ -161,7 +159,7 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   float v[kSlotCount] = {};
   for (std::uint32_t s = begin; s < end; ++s)
   {
-    pts.Attributes(sorted.Point(s), v);
+    sorted.Attributes(pts, s, v);
     for (int k = 0; k < kSlotCount; ++k)
     {
       sum[k] += v[k];

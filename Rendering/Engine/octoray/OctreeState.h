@@ -52,16 +52,33 @@ struct DriverScratch
   template <typename T>
   using Buffer = typename Device::template Buffer<T>;
 
-  // (key, point) pairs, or packed words alone (SortedKeys,
-  // OctreeKernels.h), and the sort's second buffers; an index array the
-  // sort leaves free holds run starts after it.
+  // The sort's keys (64- or 32-bit) with the points' indices or records
+  // (SortedKeys, OctreeKernels.h), each with its second buffer; the 32-bit
+  // key or index array the sort leaves free holds run starts after it.
   Buffer<std::uint64_t> sortKey[2];
+  Buffer<std::uint32_t> narrowKey[2];
   Buffer<std::uint32_t> sortIndex[2];
+  Buffer<std::uint32_t> sortRecords[2];
   Buffer<std::uint64_t> counters; // what loops report to the host (CounterSlot, OctreeDriver.h)
+
+  // fn(buffer) for each sort buffer of `scratch` (const or not).
+  template <class Scratch, class Fn>
+  static void ForEachSortBuffer(Scratch& scratch, Fn&& fn)
+  {
+    for (int b = 0; b < 2; ++b)
+    {
+      fn(scratch.sortKey[b]);
+      fn(scratch.narrowKey[b]);
+      fn(scratch.sortIndex[b]);
+      fn(scratch.sortRecords[b]);
+    }
+  }
 
   std::size_t Bytes() const
   {
-    return sortKey[0].Bytes() + sortKey[1].Bytes() + sortIndex[0].Bytes() + sortIndex[1].Bytes() + counters.Bytes();
+    std::size_t bytes = counters.Bytes();
+    ForEachSortBuffer(*this, [&](const auto& buffer) { bytes += buffer.Bytes(); });
+    return bytes;
   }
 };
 

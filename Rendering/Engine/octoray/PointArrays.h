@@ -54,6 +54,23 @@ OCTORAY_HD void StoreInRecord(std::uint32_t* records, const PointRecordLayout& l
   memcpy(records + i * layout.stride + layout.offset[attribute], words, sizeof words);
 }
 
+// The attribute vector of one record (slots of absent attributes are left
+// alone).
+OCTORAY_HD void RecordAttributes(const std::uint32_t* record, const PointRecordLayout& layout, float v[kSlotCount])
+{
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const int offset = layout.offset[A::kIndex];
+    if (offset < 0)
+    {
+      return;
+    }
+    typename A::Type value;
+    memcpy(&value, record + offset, sizeof value);
+    AttributeValue<typename A::Type>::ToSlots(value, v + A::kSlot);
+  });
+}
+
 // The point arrays a backend holds, each a Buffer<its type>.
 template <template <typename> class Buffer>
 struct PointArrays
@@ -84,18 +101,7 @@ struct PointArraysView
   // The point's attribute vector (slots of absent attributes are left alone).
   OCTORAY_HD void Attributes(std::size_t i, float v[kSlotCount]) const
   {
-    const std::uint32_t* record = records + i * layout.stride;
-    ForEachAttribute([&](auto a) {
-      using A = decltype(a);
-      const int offset = layout.offset[A::kIndex];
-      if (offset < 0)
-      {
-        return;
-      }
-      typename A::Type value;
-      memcpy(&value, record + offset, sizeof value);
-      AttributeValue<typename A::Type>::ToSlots(value, v + A::kSlot);
-    });
+    RecordAttributes(records + i * layout.stride, layout, v);
   }
 };
 

@@ -8,9 +8,9 @@
 
 namespace octoray
 {
-template <typename Key>
-int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int endBit, int threads,
-  Key* scratchKeys, std::uint32_t* scratchValues)
+template <typename Key, typename Value>
+int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit, int threads, Key* scratchKeys,
+  Value* scratchValues)
 {
   const int bits = endBit - beginBit;
   if (n < 2 || bits <= 0)
@@ -25,9 +25,9 @@ int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int
   const std::size_t buckets = std::size_t(1) << digitBits;
 
   Key* srcK = keys;
-  std::uint32_t* srcV = values;
+  Value* srcV = values;
   Key* dstK = scratchKeys;
-  std::uint32_t* dstV = scratchValues;
+  Value* dstV = scratchValues;
 
   const int chunks = n < kParallelPassMinItems ? 1 : threads;
   std::vector<std::size_t> histogram(static_cast<std::size_t>(chunks) * buckets);
@@ -96,8 +96,7 @@ int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int
   return srcK == keys ? 0 : 1;
 }
 
-template int RadixSort<std::uint64_t>(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*,
-  std::uint32_t*);
-template int RadixSort<std::uint32_t>(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*,
-  std::uint32_t*);
+template int RadixSort(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*, std::uint32_t*);
+template int RadixSort(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*, std::uint32_t*);
+template int RadixSort(std::uint32_t*, std::uint64_t*, std::size_t, int, int, int, std::uint32_t*, std::uint64_t*);
 }

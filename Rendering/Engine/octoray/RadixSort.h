@@ -1,6 +1,5 @@
-// CPU least-significant-digit radix sort of keys, alone or with a 32-bit
-// value each, by the bits [beginBit, endBit) of the keys; multi-threaded,
-// stable.
+// CPU least-significant-digit radix sort of keys, alone or with a value
+// each, by the bits [beginBit, endBit) of the keys; multi-threaded, stable.
 #pragma once
 
 #include <cstddef>
@@ -12,8 +11,10 @@ namespace octoray
 // ping-ponging between them and the scratch arrays (n entries each; no
 // scratchValues without values); returns where the result is: 0 in keys
 // and values, 1 in the scratch arrays. Passes whose digit is the same for
-// every key are skipped. Key: std::uint64_t or std::uint32_t.
-template <typename Key>
-int RadixSort(Key* keys, std::uint32_t* values, std::size_t n, int beginBit, int endBit, int threads,
-  Key* scratchKeys, std::uint32_t* scratchValues);
+// every key are skipped. Key: std::uint64_t or std::uint32_t; Value:
+// std::uint32_t, or std::uint64_t with 32-bit keys (a leaf key and a point's
+// record of two words, OctreeKernels.h's SortedKeys).
+template <typename Key, typename Value = std::uint32_t>
+int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit, int threads, Key* scratchKeys,
+  Value* scratchValues);
 }
