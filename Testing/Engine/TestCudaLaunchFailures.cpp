@@ -95,7 +95,7 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   const Cloud first = UniformCloud(1500, 61);
   // Its automatic depth lies beyond level 10: the full-depth sort runs too,
   // from the kept keys (LeafKeysKernel). Records of two words (colours and
-  // reflectivity) travel with the first sort's keys, copied (CopyRecordsKernel).
+  // reflectivity) travel with the first sort's keys.
   Cloud second = TightClusters(300, 1e-5, 47);
   second.scalar.clear();
   second.normal.clear();
@@ -104,8 +104,8 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   fixedDepth.depth = 6;
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
-  for (const char* kernel : { "PointRecordsKernel", "KeysKernel", "CopyRecordsKernel", "NeighbourHistogramKernel",
-         "LeafKeysKernel", "LeafKernel", "InnerKernel" })
+  for (const char* kernel : { "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel", "LeafKeysKernel",
+         "LeafKernel", "InnerKernel" })
   {
     SCOPED_TRACE(kernel);
     auto engine = CreateEngine(Backend::CUDA);

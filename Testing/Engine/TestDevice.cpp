@@ -152,6 +152,48 @@ TEST(CpuDevice, SortPairsIsStable)
   ExpectStableSort<std::uint32_t, std::uint64_t>(6);
 }
 
+// SortPairsFrom: the same order as a stable sort, the values written to
+// their own array and their input left as it is; keys of `keyBits` random
+// bits sorted by `bits`, so that passes over all-zero digits are skipped
+// (which changes where the passes end).
+template <typename Key, typename Value>
+void ExpectSortFromLeavesItsInput(int bits, int keyBits)
+{
+  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(keyBits));
+  OnEverySplit([=](std::size_t n, CpuDevice& d) {
+    const std::vector<std::uint64_t> random = RandomKeys(n, keyBits, n + d.threads);
+    std::vector<Key> k0(random.begin(), random.end()), k1(n);
+    std::vector<Value> in(n), out(n);
+    std::vector<std::pair<Key, Value>> reference;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      in[i] = static_cast<Value>(~i);
+      reference.emplace_back(k0[i], in[i]);
+    }
+    const std::vector<Value> input = in;
+    std::stable_sort(reference.begin(), reference.end(),
+      [](const auto& a, const auto& b) { return a.first < b.first; });
+    Key* keys[2] = { k0.data(), k1.data() };
+    const int result = d.SortPairsFrom(keys, in.data(), out.data(), n, bits, "test");
+    ASSERT_TRUE(result == 0 || result == 1);
+    EXPECT_EQ(in, input) << "the input values changed";
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
+      ASSERT_EQ(out[i], reference[i].second) << "position " << i;
+    }
+  });
+}
+
+TEST(CpuDevice, SortPairsFromLeavesItsInput)
+{
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(30, 30); // 3 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(30, 20); // the third skipped
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(24, 24); // 3 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(12, 12); // 2 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(12, 0);  // none moves
+}
+
 // Keys alone, by their bits [beginBit, endBit), other bits set below and
 // above them: stable.
 void ExpectStableKeySort(int beginBit, int endBit)

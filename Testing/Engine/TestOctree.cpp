@@ -59,11 +59,10 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 
 // The sort moves each point's record with its key where the record is one
 // or two words and the leaf keys fit 32 bits, and gathers the records by
-// index otherwise (SortedKeys, OctreeKernels.h); without kept points it may
-// overwrite them. Every record width, at depths that sort 32-bit and 64-bit
-// keys and at the automatic depth, with and without kept points, against
-// the brute-force octree; then an update of every point reads the kept
-// records again.
+// index otherwise (SortedKeys, OctreeKernels.h). Every record width, at
+// depths that sort 32-bit and 64-bit keys and at the automatic depth, with
+// and without kept points, against the brute-force octree; then an update
+// of every point reads the kept records again.
 TEST_P(OctreeBuild, RecordsOfEveryWidth)
 {
   const Cloud every = GaussianClusters(4000, 23);

@@ -146,8 +146,12 @@ public:
     std::memset(data, byte, n * sizeof(T));
   }
   void Synchronize(const char*) {}
-  std::size_t ScratchBytes() const { return 0; }
-  void ReleaseScratch() {}
+  std::size_t ScratchBytes() const { return Scratch32.Bytes() + Scratch64.Bytes(); }
+  void ReleaseScratch()
+  {
+    Scratch32.Release();
+    Scratch64.Release();
+  }
   std::size_t CachedBytes() const { return 0; }
   void TrimCache() {}
 
@@ -240,10 +244,44 @@ public:
     return RadixSort(keys[0], values[0], n, 0, bits, threads, keys[1], values[1]);
   }
 
+  // SortPairs with the values read from valuesIn, which stays as it is,
+  // and written in sorted order to valuesOut.
+  template <typename Key, typename Value>
+  int SortPairsFrom(Key* const keys[2], const Value* valuesIn, Value* valuesOut, std::size_t n, int bits, const char*)
+  {
+    Value* second = SortScratch(Value(), n);
+    // The values end beside their keys: in valuesOut where the passes end
+    // in the keys' second array.
+    const bool odd = RadixSortPasses(bits) % 2 == 1;
+    const int result = RadixSort(keys[0], odd ? second : valuesOut, n, 0, bits, threads, keys[1],
+      odd ? valuesOut : second, valuesIn);
+    if ((result == 1) != odd) // a pass was skipped
+    {
+      std::copy_n(second, n, valuesOut);
+    }
+    return result;
+  }
+
   template <typename Key>
   int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char*)
   {
     return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, beginBit, endBit, threads, keys[1], nullptr);
   }
+
+private:
+  // SortPairsFrom's second value array, kept while later sorts fit.
+  std::uint32_t* SortScratch(std::uint32_t, std::size_t n)
+  {
+    Scratch32.Reserve(n);
+    return Scratch32.Get();
+  }
+  std::uint64_t* SortScratch(std::uint64_t, std::size_t n)
+  {
+    Scratch64.Reserve(n);
+    return Scratch64.Get();
+  }
+
+  HostBuffer<std::uint32_t> Scratch32;
+  HostBuffer<std::uint64_t> Scratch64;
 };
 }

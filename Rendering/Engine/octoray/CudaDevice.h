@@ -308,6 +308,24 @@ public:
     return k.selector;
   }
 
+  // SortPairs with the values read from valuesIn, which stays as it is,
+  // and written in sorted order to valuesOut: CUB's form that leaves its
+  // input alone, its second buffers in the temporary storage. The keys end
+  // in keys[1].
+  template <typename Key, typename Value>
+  int SortPairsFrom(Key* const keys[2], const Value* valuesIn, Value* valuesOut, std::size_t n, int bits,
+    const char* what)
+  {
+    const std::string name = std::string("cub::DeviceRadixSort (") + what + ")";
+    std::size_t bytes = 0;
+    CudaCheck(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys[0], keys[1], valuesIn, valuesOut, n, 0, bits),
+      name.c_str());
+    CudaCheck(cub::DeviceRadixSort::SortPairs(Temporary(bytes), bytes, keys[0], keys[1], valuesIn, valuesOut, n, 0,
+                bits),
+      name.c_str());
+    return 1;
+  }
+
   template <typename Key>
   int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char* what)
   {

@@ -16,6 +16,8 @@
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
+//   SortPairsFrom(keys[2], valuesIn, valuesOut, n, bits, what)   the same, the values read from valuesIn (left as
+//                                     it is) and written in sorted order to valuesOut
 //   SortKeys(keys[2], n, beginBit, endBit, what)    the keys alone, by those bits; stable, returns the same
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
 //   Clock                             Mark(): a point in the order of the loops; Seconds(a, b) once waited for
@@ -451,73 +453,54 @@ SortInput ReserveSortInput(Device& d, DriverScratch<Device>& scratch, std::size_
     indexed ? scratch.sortIndex[0].Get() : nullptr };
 }
 
-// The records that travel with the keys: [0] the state's own, which the
-// sort may overwrite where nothing reads them after it (`consumable`), else
-// a copy; [1] the sort's second buffer.
-template <class Device>
-void ReserveTravellingRecords(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, bool consumable,
-  std::uint32_t* records[2])
-{
-  const std::size_t words = s.count * s.points.layout.stride;
-  d.Reserve(scratch.sortRecords[1], words, "sort records");
-  records[1] = scratch.sortRecords[1].Get();
-  if (consumable)
-  {
-    d.Release(scratch.sortRecords[0]);
-    records[0] = s.points.records.Get();
-    return;
-  }
-  d.Reserve(scratch.sortRecords[0], words, "sort records");
-  const std::uint32_t* from = s.points.records.Get();
-  std::uint32_t* to = records[0] = scratch.sortRecords[0].Get();
-  d.ForEach("CopyRecordsKernel", words, OCTORAY_LAMBDA(std::size_t w) { to[w] = from[w]; });
-}
-
-// Sorts the n 32-bit keys of `bits` bits with the records of `stride`
-// words (none, one or two) that travel with them; returns the sorted keys.
+// Sorts the n 32-bit keys of `bits` bits with the points' records of
+// `stride` words (none, one or two) that travel with them, into the sort's
+// record array (the state's records stay as they are); returns the sorted
+// keys and the key array the sort left free.
 template <class Device>
 SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, int bits,
-  bool recordsConsumable, std::uint32_t*& spare)
+  std::uint32_t*& spare)
 {
   const std::size_t n = s.count;
   const int stride = s.points.layout.stride;
   std::uint32_t* keys[2] = { scratch.narrowKey[0].Get(), scratch.narrowKey[1].Get() };
-  std::uint32_t* records[2] = { nullptr, nullptr };
   int result = 0;
+  std::uint32_t* sortedRecords = nullptr;
   if (stride == 0)
   {
+    d.Release(scratch.sortRecords);
     result = d.SortKeys(keys, n, 0, bits, "point keys");
   }
   else
   {
-    ReserveTravellingRecords(d, scratch, s, recordsConsumable, records);
+    d.Reserve(scratch.sortRecords, n * stride, "sort records");
+    const std::uint32_t* records = s.points.records.Get();
+    sortedRecords = scratch.sortRecords.Get();
     if (stride == 1)
     {
-      result = d.SortPairs(keys, records, n, bits, "point keys and records");
+      result = d.SortPairsFrom(keys, records, sortedRecords, n, bits, "point keys and records");
     }
     else
     {
       static_assert(sizeof(std::uint64_t) == 2 * sizeof(std::uint32_t), "a record of two words is one value");
-      std::uint64_t* pairs[2] = { reinterpret_cast<std::uint64_t*>(records[0]),
-        reinterpret_cast<std::uint64_t*>(records[1]) };
-      result = d.SortPairs(keys, pairs, n, bits, "point keys and records");
+      result = d.SortPairsFrom(keys, reinterpret_cast<const std::uint64_t*>(records),
+        reinterpret_cast<std::uint64_t*>(sortedRecords), n, bits, "point keys and records");
     }
   }
   spare = keys[1 - result];
-  return SortedKeys{ nullptr, keys[result], nullptr, records[result], 0 };
+  return SortedKeys{ nullptr, keys[result], nullptr, sortedRecords, 0 };
 }
 
 // Queues the sort of the state's points by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys (computed, or the stored ones), the
 // sort, and the histogram of neighbouring sorted keys. beforeSort(), if
 // given, runs on the host between the keys and the sort; the points'
-// records must exist after it. Without keepRecords the sort may overwrite
-// them. Marks on `clock`: marks[0] after the keys, marks[1] before the
-// sort, marks[2] after the histogram.
+// records must exist after it. Marks on `clock`: marks[0] after the keys,
+// marks[1] before the sort, marks[2] after the histogram.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int sortDepth, bool computeKeys, bool keepRecords, const FirstFailure& outside, typename Device::Clock& clock,
-  int marks[3], const std::function<void()>& beforeSort)
+  int sortDepth, bool computeKeys, const FirstFailure& outside, typename Device::Clock& clock, int marks[3],
+  const std::function<void()>& beforeSort)
 {
   const std::size_t n = s.count;
   const bool narrow = SortedKeys::Narrow(sortDepth);
@@ -558,7 +541,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   const int bits = 3 * sortDepth;
   if (narrow && travel)
   {
-    sorted.keys = SortNarrowKeys(d, scratch, s, bits, !keepRecords, sorted.spare);
+    sorted.keys = SortNarrowKeys(d, scratch, s, bits, sorted.spare);
   }
   else if (narrow)
   {
@@ -630,10 +613,7 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   // bug, read after the sort with the histogram.
   const FirstFailure outside = ArmFirstFailure(d, scratch);
   const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
-  // The full-depth sort after the provisional one reads the records again.
-  const bool keepRecords = s.keepPoints || requestedDepth == 0;
-  SortedPoints sorted =
-    QueueSort(d, scratch, s, cube, sortDepth, computeKeys, keepRecords, outside, clock, phases + 1, beforeSort);
+  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, computeKeys, outside, clock, phases + 1, beforeSort);
   ReadHistogram(d, scratch, s, sorted);
   if (requestedDepth == 0)
   {
@@ -642,8 +622,8 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     {
       phases[4] = clock.Mark();
       const bool keysKept = DataOrNull(s.points.key) != nullptr; // written by the first sort's keys
-      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, true, outside, clock,
-        phases + 5, nullptr);
+      sorted =
+        QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, outside, clock, phases + 5, nullptr);
       ReadHistogram(d, scratch, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }

@@ -52,13 +52,14 @@ struct DriverScratch
   template <typename T>
   using Buffer = typename Device::template Buffer<T>;
 
-  // The sort's keys (64- or 32-bit) with the points' indices or records
-  // (SortedKeys, OctreeKernels.h), each with its second buffer; the 32-bit
-  // key or index array the sort leaves free holds run starts after it.
+  // The sort's keys (64- or 32-bit) and the points' indices, each with its
+  // second buffer, or the points' records in sorted order (SortedKeys,
+  // OctreeKernels.h); the 32-bit key or index array the sort leaves free
+  // holds run starts after it.
   Buffer<std::uint64_t> sortKey[2];
   Buffer<std::uint32_t> narrowKey[2];
   Buffer<std::uint32_t> sortIndex[2];
-  Buffer<std::uint32_t> sortRecords[2];
+  Buffer<std::uint32_t> sortRecords;
   Buffer<std::uint64_t> counters; // what loops report to the host (CounterSlot, OctreeDriver.h)
 
   // fn(buffer) for each sort buffer of `scratch` (const or not).
@@ -70,8 +71,8 @@ struct DriverScratch
       fn(scratch.sortKey[b]);
       fn(scratch.narrowKey[b]);
       fn(scratch.sortIndex[b]);
-      fn(scratch.sortRecords[b]);
     }
+    fn(scratch.sortRecords);
   }
 
   std::size_t Bytes() const

@@ -8,26 +8,38 @@
 
 namespace octoray
 {
+// 11-bit digits keep a pass's histogram (2048 counters per thread) in L1
+// while needing only 6 passes for 63-bit keys; the digit width is evened
+// out over the passes so that e.g. 30 bits take 3 passes of 10.
+int RadixSortPasses(int bits)
+{
+  return (bits + 10) / 11;
+}
+
 template <typename Key, typename Value>
 int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit, int threads, Key* scratchKeys,
-  Value* scratchValues)
+  Value* scratchValues, const Value* valuesIn)
 {
   const int bits = endBit - beginBit;
   if (n < 2 || bits <= 0)
   {
+    if (valuesIn)
+    {
+      std::copy_n(valuesIn, n, values);
+    }
     return 0;
   }
-  // 11-bit digits keep a pass's histogram (2048 counters per thread) in L1
-  // while needing only 6 passes for 63-bit keys; the digit width is evened
-  // out over the passes so that e.g. 30 bits take 3 passes of 10.
-  const int passes = (bits + 10) / 11;
+  const int passes = RadixSortPasses(bits);
   const int digitBits = (bits + passes - 1) / passes;
   const std::size_t buckets = std::size_t(1) << digitBits;
 
   Key* srcK = keys;
-  Value* srcV = values;
   Key* dstK = scratchKeys;
-  Value* dstV = scratchValues;
+  // The values follow their keys' buffers: [0] beside keys, [1] beside the
+  // scratch keys; the first pass that moves reads them from valuesIn.
+  Value* const valueBuffers[2] = { values, scratchValues };
+  const Value* srcV = valuesIn ? valuesIn : values;
+  int into = 1;
 
   const int chunks = n < kParallelPassMinItems ? 1 : threads;
   std::vector<std::size_t> histogram(static_cast<std::size_t>(chunks) * buckets);
@@ -86,17 +98,25 @@ int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit,
         dstK[slot] = srcK[i];
         if (srcV)
         {
-          dstV[slot] = srcV[i];
+          valueBuffers[into][slot] = srcV[i];
         }
       }
     });
     std::swap(srcK, dstK);
-    std::swap(srcV, dstV);
+    srcV = srcV ? valueBuffers[into] : nullptr;
+    into = 1 - into;
+  }
+  if (valuesIn && srcV == valuesIn) // no pass moved anything
+  {
+    std::copy_n(valuesIn, n, values);
   }
   return srcK == keys ? 0 : 1;
 }
 
-template int RadixSort(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*, std::uint32_t*);
-template int RadixSort(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*, std::uint32_t*);
-template int RadixSort(std::uint32_t*, std::uint64_t*, std::size_t, int, int, int, std::uint32_t*, std::uint64_t*);
+template int RadixSort(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*, std::uint32_t*,
+  const std::uint32_t*);
+template int RadixSort(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*, std::uint32_t*,
+  const std::uint32_t*);
+template int RadixSort(std::uint32_t*, std::uint64_t*, std::size_t, int, int, int, std::uint32_t*, std::uint64_t*,
+  const std::uint64_t*);
 }
