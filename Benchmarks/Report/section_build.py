@@ -306,9 +306,10 @@ def _cuda(ctx):
     # And since the pinned staging: the upload's own time beside the plain
     # and registered copies, and the memory with and without kept points.
     staging = all("pageable_upload_seconds" in r for r in builds)
-    # And since the packed sort: CUB's sort of the words the build sorts
-    # at depth 10 and less (0 where it sorts pairs).
-    packed = any(r.get("packed_sort_seconds") for r in builds)
+    # And since the records travel with the keys: CUB's sort of what the
+    # build sorts at depth 10 and less, 32-bit keys with 8-byte records (0
+    # deeper, where it sorts the floor's pairs).
+    own = any(r.get("build_sort_seconds") for r in builds)
     rows, csv_rows, staging_rows = [], [], []
     for r in builds:
         if staging:
@@ -327,8 +328,8 @@ def _cuda(ctx):
         row += [seconds(r["peer_seconds"]), "%.0f" % (r["seconds"] / r["peer_seconds"])]
         if phases:
             row += ["%.1f" % (device / r["peer_seconds"])]
-        if packed:
-            p = r.get("packed_sort_seconds")
+        if own:
+            p = r.get("build_sort_seconds")
             row += [seconds(p) if p else "pairs", "%.1f" % (device / p) if p and phases else ""]
         if phases:
             row += [count(r["nodes"])]
@@ -341,12 +342,13 @@ def _cuda(ctx):
         rows.append(row)
         csv_rows.append([r["n"], r["depth"], r["seconds"], r["peer_seconds"], mem.get((r["n"], r["depth"])),
                          r.get("key_seconds", ""), r.get("sort_seconds", ""), r.get("level_seconds", ""),
-                         r.get("nodes", ""), r.get("packed_sort_seconds", "")])
+                         r.get("nodes", ""), r.get("build_sort_seconds", "")])
     csv = ctx.write_csv("build-cuda", ["points", "depth", "build_s", "cub_sort_s", "gpu_bytes_per_point",
-                                       "keys_s", "sort_s", "levels_s", "nodes", "packed_sort_s"], csv_rows)
+                                       "keys_s", "sort_s", "levels_s", "nodes", "build_sort_s"], csv_rows)
     header = ["points", "depth", "whole call"] + (["device phases, ms (keys / sort / levels)"] if phases else []) + \
         ["bare CUB sort", "call / sort"] + (["phases / sort"] if phases else []) + \
-        (["CUB sort of packed words", "phases / packed sort"] if packed else []) + (["nodes"] if phases else []) + \
+        (["CUB sort of 32-bit keys with records", "phases / that sort"] if own else []) + \
+        (["nodes"] if phases else []) + \
         (["pinned copy of the input", "call / copy"] if upload else []) + ["GPU bytes/point"]
     updates = [r for r in records if r["name"].startswith("update")]
     urows = [[r["name"].split()[1], count(r["n"]), r["depth"], seconds(r["seconds"]), seconds(r["peer_seconds"]),
@@ -356,31 +358,38 @@ def _cuda(ctx):
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
         "events in the same run. Medians of 7. The device phases are the device's own time (CUDA events between "
-        "them); the attributes' upload runs while the device computes keys and sorts. GPU bytes per point include "
+        "them); the attributes' upload runs while the device computes the keys. GPU bytes per point include "
         "the sort buffers the engine keeps for rebuilds and the memory its allocator keeps for the next build (split "
         "in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
         "to the device (cudaMemcpy), what a whole call from host arrays cannot beat, timed after each of the 7 "
-        "builds; *call / copy* is the median of those 7 pairs' ratios. At depth 10 and less the build sorts one "
-        "64-bit word per point, its leaf key above its 32-bit index, by the key's bits alone (`SortKeys`: a third "
-        "fewer bytes a pass than pairs); *CUB sort of packed words* is that sort of as many words, timed the same "
-        "way, and *pairs* marks the depths whose keys do not fit beside an index.%s" % (gpu_source(ctx, name), "" if phases else
+        "builds; *call / copy* is the median of those 7 pairs' ratios. At depth 10 and less the leaf keys fit 32 "
+        "bits and the build sorts each with its point's record of attributes (here 8 bytes: colour and "
+        "reflectivity; records of one or two words travel so, longer ones are gathered by index, "
+        "OctreeKernels.h's SortedKeys); *CUB sort of 32-bit keys with records* is that sort of as many random "
+        "keys, timed the same way, the same 12 bytes a point and pass as the floor's pairs, and *pairs* marks the "
+        "depths whose keys do not fit 32 bits.%s" % (gpu_source(ctx, name), "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),
         "",
         ctx.table(header, rows),
         "",
         "[CSV](%s)" % csv,
         "",
-        "The engine's own sort runs at its floor, the packed one at depth 10; what separates the whole call from the "
-        "sort is the upload of the points from pageable memory (most of it at 10 M and more) and the levels: one "
-        "CUB select plus one kernel per level, and the leaf kernel's gather of every point's attributes in random "
-        "order (Benchmarks/gpu/profile-build.txt: at 100 M points it moves about 8.5 GB through DRAM in 4.5 ms, a "
-        "64-byte burst for each point's 8-byte record of colour and reflectivity; with one array per attribute, two "
-        "bursts a point, it moved 16 GB in 7.8 ms: profile-build-arrays.txt). The gather is bound by how many "
-        "random places the memory serves a second, not by bytes: with 32-byte L2 fills it moved 5.0 GB instead of "
-        "8.3 in the same 4.6 ms, and a loop over the points that gathered the records in sorted order before the "
-        "leaves, one independent load a thread, took 4.6 ms by itself (Benchmarks/gpu/variants-packed-sort.txt). "
-        "So the gather costs about one more sort, and the device phases stay above twice the sort. A caller with "
-        "pinned or device-resident points would not pay the upload.",
+        "The engine's sort runs at its floor. What separates the whole call from it is the upload of the points "
+        "from pageable memory (most of it at 10 M and more); what separates the device phases from it are the "
+        "keys, the bounds before them, the histogram of neighbouring keys and the levels: one kernel for the "
+        "leaves and one CUB select plus one kernel per level above them (Benchmarks/gpu/profile-build.txt lists "
+        "them for 100 M points). Before the records travelled with the keys, the leaf kernel gathered each "
+        "point's record from its place in the input, a random read a point: at 100 M points that kernel took "
+        "4.55 ms and moved 8.3 GB, bound by how many random places the memory serves a second (32-byte fills and "
+        "a separate gather loop took as long: Benchmarks/gpu/variants-packed-sort.txt). Moving the records with "
+        "the keys costs the sort about 1.3 ms more at 100 M points (its 12 bytes a point and pass against 8 for "
+        "packed words) and saved the leaves 2.1 ms; 64 registers a loop thread (at least 4 blocks a "
+        "multiprocessor, CudaDevice.h) took 0.8 ms more off the leaf kernel and 0.14 ms off the inner levels. "
+        "Against the engine before, built side by side in one call and run in turn, the device phases went from "
+        "11.9–12.0 to 9.8–10.0 ms at 100 M points and from 1.83–1.88 to 1.57 ms at 10 M "
+        "(Benchmarks/gpu/variants-records.txt, call 3). The sort now waits for the attributes, which it used to "
+        "overlap, and the whole call stayed where it was within the runs' spread. A caller with pinned or "
+        "device-resident points would not pay the upload.",
         "",
     ]
     repeats = {n: repeated_call_ratios(ctx, n) for n in (10000000, 100000000)}
@@ -402,7 +411,8 @@ def _cuda(ctx):
         text += [
             "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
             "16 MB and more through page-locked buffers on up to 8 host threads (Rendering/Engine/octoray/"
-            "CudaUpload.h), the positions first and the attributes while the device sorts; *upload* is the host's "
+            "CudaUpload.h), the positions first and the attributes while the device computes the keys; *upload* is the "
+            "host's "
             "time in those copies; *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
             "arrays in place for the copy, *pinned* is the floor above. GPU bytes per point: the arrays alone; "
             "with the memory that the engine's allocator keeps for the next build (with the points kept, a "
@@ -483,9 +493,10 @@ def _cuda(ctx):
             device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
             against = "bare CUB radix sort " + seconds(r["peer_seconds"])
             ratio = "%.1f× the sort" % (device / r["peer_seconds"])
-            if r.get("packed_sort_seconds"):
-                against += " (of the packed words the build sorts: %s)" % seconds(r["packed_sort_seconds"])
-                ratio += " (%.1f×)" % (device / r["packed_sort_seconds"])
+            if r.get("build_sort_seconds"):
+                against += " (of the 32-bit keys with 8-byte records the build sorts: %s)" % \
+                    seconds(r["build_sort_seconds"])
+                ratio += " (%.1f×)" % (device / r["build_sort_seconds"])
             summary.append(("CUDA octree build, 10 M points, depth 10, device phases (GPU run; whole call with "
                             "the upload: %s)" % seconds(r["seconds"]), seconds(device), against, ratio))
         else:
@@ -692,12 +703,14 @@ thesis's dense pointer skeleton of the same depth, 8 B × (8^(L+1)−1)/7:
 
 Reading these figures:
 
-- The sort is most of the build and gains little from a second thread on this VM: with the automatic depth it sorts
-  full-depth keys, 63 bits = 6 passes of 11-bit digits (RadixSort.cpp), over (u64 key, u32 index) pairs, bound by
-  the scattered writes rather than by compute (a fixed depth of 10 and less sorts one u64 word a point instead, the
-  leaf key above the index: OctreeKernels.h's SortedKeys). 2-thread medians on this shared machine swing from run to run; read the 1-thread column for ratios.
-- B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, full-depth key 8 B, sorted key +
-  index 12 B, scratch key + index 12 B); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
+- The sort is the largest phase and gains little from a second thread on this VM: the automatic depth first sorts
+  32-bit keys of 10 levels, 30 bits = 3 passes of 10-bit digits (RadixSort.cpp), each with its point's record where
+  that is one or two words, else with its index (OctreeKernels.h's SortedKeys), bound by the scattered writes rather
+  than by compute; only where those levels do not settle the depth does it sort the full-depth keys too (63 bits, 6
+  passes, with indices). 2-thread medians on this shared machine swing from run to run; read the 1-thread column
+  for ratios.
+- B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, full-depth key 8 B, the sort's keys
+  and their second buffer, the records in sorted order); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
   octoray only at shallow depth on uniform data; from depth 9 on it is larger and grows 8× per level.
 - vtkSMPTools in Debian's ParaView defaults to the Sequential backend; the benchmark switches it to STDThread so
   vtkStaticPointLocator's threaded build is measured.
