@@ -491,6 +491,30 @@ SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState
   return SortedKeys{ nullptr, keys[result], nullptr, sortedRecords, 0 };
 }
 
+// Sorts the n keys of `bits` bits in `keyBuffers` (32- or 64-bit) with
+// their points' indices; returns the sorted keys and the index array the
+// sort left free.
+template <class Device, class KeyBuffer>
+SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuffer (&keyBuffers)[2],
+  std::size_t n, int bits, std::uint32_t*& spare)
+{
+  using Key = std::remove_pointer_t<decltype(keyBuffers[0].Get())>;
+  Key* keys[2] = { keyBuffers[0].Get(), keyBuffers[1].Get() };
+  std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
+  const int result = d.SortPairs(keys, values, n, bits, "point keys");
+  spare = values[1 - result];
+  SortedKeys sorted{ nullptr, nullptr, values[result], nullptr, 0 };
+  if constexpr (sizeof(Key) == sizeof(std::uint32_t))
+  {
+    sorted.narrowKey = keys[result];
+  }
+  else
+  {
+    sorted.wideKey = keys[result];
+  }
+  return sorted;
+}
+
 // Queues the sort of the state's points by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys (computed, or the stored ones), the
 // sort, and the histogram of neighbouring sorted keys. beforeSort(), if
@@ -539,25 +563,17 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   SortedPoints sorted;
   sorted.depth = sortDepth;
   const int bits = 3 * sortDepth;
-  if (narrow && travel)
+  if (travel)
   {
     sorted.keys = SortNarrowKeys(d, scratch, s, bits, sorted.spare);
   }
   else if (narrow)
   {
-    std::uint32_t* keys[2] = { scratch.narrowKey[0].Get(), scratch.narrowKey[1].Get() };
-    std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
-    const int result = d.SortPairs(keys, values, n, bits, "point keys");
-    sorted.keys = SortedKeys{ nullptr, keys[result], values[result], nullptr, 0 };
-    sorted.spare = keys[1 - result];
+    sorted.keys = SortKeysWithIndices(d, scratch, scratch.narrowKey, n, bits, sorted.spare);
   }
   else
   {
-    std::uint64_t* keys[2] = { scratch.sortKey[0].Get(), scratch.sortKey[1].Get() };
-    std::uint32_t* values[2] = { scratch.sortIndex[0].Get(), scratch.sortIndex[1].Get() };
-    const int result = d.SortPairs(keys, values, n, bits, "point keys");
-    sorted.keys = SortedKeys{ keys[result], nullptr, values[result], nullptr, 0 };
-    sorted.spare = values[1 - result];
+    sorted.keys = SortKeysWithIndices(d, scratch, scratch.sortKey, n, bits, sorted.spare);
   }
   const SortedKeys sortedKeys = sorted.keys;
   std::uint64_t* counters = scratch.counters.Get();
@@ -570,6 +586,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   marks[2] = clock.Mark();
   return sorted;
 }
+
 // The histogram of a queued sort, and the key check of its keys: one copy
 // to the host. A point outside the cube is an error naming it.
 template <class Device>

@@ -107,7 +107,7 @@ OCTORAY_HD bool ComputePointKey(const PointArraysView& pts, const RootCube& cube
 // point's record where that is one or two words (RecordsTravel), so that
 // the leaf pass reads the records in order. Gathering them in sorted order
 // from the points' own records instead costs a random read each, which on
-// an H100 took longer than the sort (Benchmarks/gpu/profile-build.txt).
+// an H100 took longer than the sort (Benchmarks/gpu/variants-records.txt).
 // Other keys travel with their points' indices.
 struct SortedKeys
 {
