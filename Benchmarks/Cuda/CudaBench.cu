@@ -573,8 +573,9 @@ int Run(int argc, char** argv)
       const double leanSeconds = TimeMedian(repeats, [&] { engine->Build(c.View(), lean); });
       const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
       std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
-                  "sort %.3f ms (of 32-bit keys with 8-byte records %.3f ms), ratio %.2f, %zu nodes, %.1f GPU bytes/point (%.1f "
-                  "in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input %.3f ms beside it, "
+                  "sort %.3f ms (of 32-bit keys with 8-byte records %.3f ms), ratio %.2f, %zu nodes, %.1f GPU "
+                  "bytes/point (%.1f in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input "
+                  "%.3f ms beside it, "
                   "whole call %.2fx that (median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
         n, depth, t * 1e3, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
         last.levelSeconds * 1e3, floor * 1e3, buildSort * 1e3, t / floor, last.nodes, bytesPerPoint,

@@ -66,12 +66,20 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 TEST_P(OctreeBuild, RecordsOfEveryWidth)
 {
   const Cloud every = GaussianClusters(4000, 23);
+  // The cloud with the attributes not named cleared.
   auto only = [](Cloud c, bool colours, bool scalars, bool reflectivity, bool normals, bool refraction) {
-    if (!colours) c.rgb.clear();
-    if (!scalars) c.scalar.clear();
-    if (!reflectivity) c.reflectivity.clear();
-    if (!normals) c.normal.clear();
-    if (!refraction) c.refraction.clear();
+    for (auto [keep, values] : { std::pair{ scalars, &c.scalar }, std::pair{ reflectivity, &c.reflectivity },
+           std::pair{ normals, &c.normal }, std::pair{ refraction, &c.refraction } })
+    {
+      if (!keep)
+      {
+        values->clear();
+      }
+    }
+    if (!colours)
+    {
+      c.rgb.clear();
+    }
     return c;
   };
   const std::pair<const char*, Cloud> clouds[] = {
