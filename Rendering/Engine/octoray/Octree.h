@@ -265,11 +265,11 @@ struct BuildStats
   double seconds = 0.0;      // whole build, wall clock
   // The host's time copying the caller's arrays to the device and queueing
   // the attributes' conversion into point records (colours, normals); the
-  // attributes are copied while the device sorts.
+  // attributes are copied while the device computes the keys.
   double uploadSeconds = 0.0;
   // The device's time (the host's on the CPU backend) of each phase:
   double keySeconds = 0.0;   // bounds (with their copy to the host) and Morton keys
-  double sortSeconds = 0.0;  // radix sort of (key, index) and the neighbour histogram
+  double sortSeconds = 0.0;  // radix sort of the keys with their records or indices, and the neighbour histogram
   double levelSeconds = 0.0; // unique keys per level, links and averages
 };
 
