@@ -399,7 +399,8 @@ def _cuda(ctx):
         ratios = sorted(both + repeats[100000000])
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 100 M points and depth 10 it was %s "
-            "in this run and %s in %d more runs on a machine of the same kind ([gpu/%s](gpu/%s)), %.2f–%.2f in all; "
+            "in this run and %s in %d more runs of the engine at 40104ca on a machine of the same kind "
+            "([gpu/%s](gpu/%s)), %.2f–%.2f in all; "
             "at 10 M, "
             "%s in those runs." % (", ".join("%.2f" % r for r in both),
                                    ", ".join("%.2f" % r for r in repeats[100000000]), len(repeats[100000000]),
