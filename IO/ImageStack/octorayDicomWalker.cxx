@@ -20,6 +20,45 @@ const char* DelimiterName(uint16_t element)
     : element == 0xE0DD    ? "sequence delimiter"
                            : "element";
 }
+
+// The image elements GDCM 3.0 reads through gdcm::Attribute, with the VR
+// the standard gives each: an Attribute asserts (stops the process) when the
+// VR a file states is another (a fuzzed Columns stated as IS did).
+struct ImageElement
+{
+  uint16_t Group;
+  uint16_t Element;
+  const char* VR;
+};
+constexpr ImageElement ImageElements[] = {
+  { 0x0020, 0x0032, "DS" }, // image position (patient)
+  { 0x0020, 0x0037, "DS" }, // image orientation (patient)
+  { 0x0028, 0x0002, "US" }, // samples per pixel
+  { 0x0028, 0x0006, "US" }, // planar configuration
+  { 0x0028, 0x0008, "IS" }, // number of frames
+  { 0x0028, 0x0010, "US" }, // rows
+  { 0x0028, 0x0011, "US" }, // columns
+  { 0x0028, 0x0030, "DS" }, // pixel spacing
+  { 0x0028, 0x0100, "US" }, // bits allocated
+  { 0x0028, 0x0101, "US" }, // bits stored
+  { 0x0028, 0x0102, "US" }, // high bit
+  { 0x0028, 0x0103, "US" }, // pixel representation
+  { 0x0028, 0x1052, "DS" }, // rescale intercept
+  { 0x0028, 0x1053, "DS" }, // rescale slope
+};
+
+// The VR the standard gives h's element where GDCM needs it, else null.
+const char* RequiredImageVR(const Header& h)
+{
+  for (const ImageElement& e : ImageElements)
+  {
+    if (h.Is(e.Group, e.Element))
+    {
+      return e.VR;
+    }
+  }
+  return nullptr;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -53,6 +92,7 @@ bool DataSetWalker::DataSet(
         h.Name() + " at byte " + std::to_string(pos) +
         (depth == 0 ? " in the data set" : " inside an item"));
     }
+    const uint64_t start = pos;
     if (depth == 0)
     {
       this->HasNumberOfFrames |= h.Is(0x0028, 0x0008);
@@ -67,14 +107,22 @@ bool DataSetWalker::DataSet(
       {
         return false;
       }
-      continue;
     }
-    if (!this->E.CheckFits(h, end, "DICOM element") ||
-      !this->DefinedLengthValue(h, depth, enc))
+    else
     {
-      return false;
+      if (!this->E.CheckFits(h, end, "DICOM element") || !this->DefinedLengthValue(h, depth, enc))
+      {
+        return false;
+      }
+      pos = h.ValueStart + h.Length;
     }
-    pos = h.ValueStart + h.Length;
+    // A sound element that GDCM still cannot take.
+    const char* required = depth == 0 && enc.Explicit ? RequiredImageVR(h) : nullptr;
+    if (required && std::string(h.VR, 2) != required)
+    {
+      return this->E.Fail("DICOM element " + h.Name() + " at byte " + std::to_string(start) + " has VR " +
+        std::string(h.VR, 2) + " where the standard gives " + required + ", which GDCM 3.0 cannot read");
+    }
   }
   if (itemStart > 0)
   {

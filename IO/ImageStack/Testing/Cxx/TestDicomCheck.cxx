@@ -418,6 +418,27 @@ void TestGdcmRules()
       " comes without a number of frames (0028,0008), which GDCM 3.0 cannot read");
   g.Element(0x0028, 0x0008, "IS", "2 ");
   CHECK_SOUND(g);
+
+  // An image element that GDCM reads as an attribute, stated with another
+  // VR than the standard's (a fuzzed file had columns as IS): GDCM asserts.
+  for (const std::string vr : { "US", "IS" })
+  {
+    const bool standard = vr == "US";
+    Dicom e = Part10(ExplicitLE);
+    const size_t columnsAt = e.Size();
+    e.Element(0x0028, 0x0011, vr.c_str(), standard ? std::string("\2\0", 2) : std::string("2 "));
+    e.Element(0x7FE0, 0x0010, "OW", std::string(8, '\x7'));
+    if (standard)
+    {
+      CHECK_SOUND(e);
+    }
+    else
+    {
+      CHECK_EQ_STR(e.Check(),
+        "DICOM element (0028,0011) at byte " + std::to_string(columnsAt) +
+          " has VR IS where the standard gives US, which GDCM 3.0 cannot read");
+    }
+  }
 }
 } // namespace
 
