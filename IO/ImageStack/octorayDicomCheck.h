@@ -20,9 +20,9 @@
 // or item without its delimiter, stray items or delimiters, nesting deeper
 // than DicomMaximumDepth, and an image element that GDCM reads as an
 // attribute (rows, columns, bits, spacing, position...) stated with another
-// VR than the standard's, on which GDCM asserts too. Not checked: the values themselves (GDCM reads them;
-// what it cannot decode it reports), a deflated data set (only its file
-// meta group is walked).
+// VR than the standard's, on which GDCM asserts too. Not checked: the values
+// themselves (GDCM reads them; what it cannot decode it reports), a deflated
+// data set (only its file meta group is walked).
 #ifndef octorayDicomCheck_h
 #define octorayDicomCheck_h
 
