@@ -194,20 +194,22 @@ TEST(CpuDevice, SortPairsFromLeavesItsInput)
   ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(12, 0);  // none moves
 }
 
-// Keys alone, by their bits [beginBit, endBit), other bits set below and
-// above them: stable.
-void ExpectStableKeySort(int beginBit, int endBit)
+// Keys alone, by their low `bits`, other bits set above them: stable (the
+// last pass masks its digit at `bits`).
+template <typename Key>
+void ExpectStableKeySort(int bits)
 {
-  SCOPED_TRACE("bits " + std::to_string(beginBit) + " to " + std::to_string(endBit));
+  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(8 * sizeof(Key)));
   OnEverySplit([=](std::size_t n, CpuDevice& d) {
-    // Random bits outside the range tell apart keys that the sort sees equal.
-    std::vector<std::uint64_t> k0 = RandomKeys(n, 63, n + d.threads), k1(n);
-    const std::uint64_t mask = ((std::uint64_t(1) << (endBit - beginBit)) - 1) << beginBit;
-    std::vector<std::uint64_t> reference = k0;
-    std::stable_sort(reference.begin(), reference.end(),
-      [mask](std::uint64_t a, std::uint64_t b) { return (a & mask) < (b & mask); });
-    std::uint64_t* keys[2] = { k0.data(), k1.data() };
-    const int result = d.SortKeys(keys, n, beginBit, endBit, "test");
+    // Random bits above the range tell apart keys that the sort sees equal.
+    const std::vector<std::uint64_t> random = RandomKeys(n, 8 * sizeof(Key) - 1, n + d.threads);
+    std::vector<Key> k0(random.begin(), random.end()), k1(n);
+    const Key mask = static_cast<Key>((std::uint64_t(1) << bits) - 1);
+    std::vector<Key> reference = k0;
+    std::stable_sort(
+      reference.begin(), reference.end(), [mask](Key a, Key b) { return (a & mask) < (b & mask); });
+    Key* keys[2] = { k0.data(), k1.data() };
+    const int result = d.SortKeys(keys, n, bits, "test");
     ASSERT_TRUE(result == 0 || result == 1);
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -216,11 +218,13 @@ void ExpectStableKeySort(int beginBit, int endBit)
   });
 }
 
-TEST(CpuDevice, SortKeysByABitRangeIsStable)
+TEST(CpuDevice, SortKeysByTheirLowBitsIsStable)
 {
-  ExpectStableKeySort(32, 62);
-  ExpectStableKeySort(32, 35);
-  ExpectStableKeySort(8, 29);
+  ExpectStableKeySort<std::uint64_t>(30);
+  ExpectStableKeySort<std::uint64_t>(3);
+  ExpectStableKeySort<std::uint64_t>(29);
+  ExpectStableKeySort<std::uint32_t>(30);
+  ExpectStableKeySort<std::uint32_t>(5);
 }
 
 TEST(CpuDevice, RunStartsAndFirstFailedStep)

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <memory>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 namespace octoray
@@ -146,11 +147,13 @@ public:
     std::memset(data, byte, n * sizeof(T));
   }
   void Synchronize(const char*) {}
-  std::size_t ScratchBytes() const { return Scratch32.Bytes() + Scratch64.Bytes(); }
+  std::size_t ScratchBytes() const
+  {
+    return std::apply([](const auto&... buffer) { return (buffer.Bytes() + ...); }, Scratch);
+  }
   void ReleaseScratch()
   {
-    Scratch32.Release();
-    Scratch64.Release();
+    std::apply([](auto&... buffer) { (buffer.Release(), ...); }, Scratch);
   }
   std::size_t CachedBytes() const { return 0; }
   void TrimCache() {}
@@ -249,7 +252,7 @@ public:
   template <typename Key, typename Value>
   int SortPairsFrom(Key* const keys[2], const Value* valuesIn, Value* valuesOut, std::size_t n, int bits, const char*)
   {
-    Value* second = SortScratch(Value(), n);
+    Value* second = SortScratch<Value>(n);
     // The values end beside their keys: in valuesOut where the passes end
     // in the keys' second array.
     const bool odd = RadixSortPasses(bits) % 2 == 1;
@@ -263,25 +266,21 @@ public:
   }
 
   template <typename Key>
-  int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char*)
+  int SortKeys(Key* const keys[2], std::size_t n, int bits, const char*)
   {
-    return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, beginBit, endBit, threads, keys[1], nullptr);
+    return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, 0, bits, threads, keys[1], nullptr);
   }
 
 private:
   // SortPairsFrom's second value array, kept while later sorts fit.
-  std::uint32_t* SortScratch(std::uint32_t, std::size_t n)
+  template <typename Value>
+  Value* SortScratch(std::size_t n)
   {
-    Scratch32.Reserve(n);
-    return Scratch32.Get();
-  }
-  std::uint64_t* SortScratch(std::uint64_t, std::size_t n)
-  {
-    Scratch64.Reserve(n);
-    return Scratch64.Get();
+    HostBuffer<Value>& buffer = std::get<HostBuffer<Value>>(Scratch);
+    buffer.Reserve(n);
+    return buffer.Get();
   }
 
-  HostBuffer<std::uint32_t> Scratch32;
-  HostBuffer<std::uint64_t> Scratch64;
+  std::tuple<HostBuffer<std::uint32_t>, HostBuffer<std::uint64_t>> Scratch;
 };
 }

@@ -332,13 +332,13 @@ public:
   }
 
   template <typename Key>
-  int SortKeys(Key* const keys[2], std::size_t n, int beginBit, int endBit, const char* what)
+  int SortKeys(Key* const keys[2], std::size_t n, int bits, const char* what)
   {
     cub::DoubleBuffer<Key> k(keys[0], keys[1]);
     const std::string name = std::string("cub::DeviceRadixSort (") + what + ")";
     std::size_t bytes = 0;
-    CudaCheck(cub::DeviceRadixSort::SortKeys(nullptr, bytes, k, n, beginBit, endBit), name.c_str());
-    CudaCheck(cub::DeviceRadixSort::SortKeys(Temporary(bytes), bytes, k, n, beginBit, endBit), name.c_str());
+    CudaCheck(cub::DeviceRadixSort::SortKeys(nullptr, bytes, k, n, 0, bits), name.c_str());
+    CudaCheck(cub::DeviceRadixSort::SortKeys(Temporary(bytes), bytes, k, n, 0, bits), name.c_str());
     return k.selector;
   }
 

@@ -18,7 +18,7 @@
 //                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
 //   SortPairsFrom(keys[2], valuesIn, valuesOut, n, bits, what)   the same, the values read from valuesIn (left as
 //                                     it is) and written in sorted order to valuesOut
-//   SortKeys(keys[2], n, beginBit, endBit, what)    the keys alone, by those bits; stable, returns the same
+//   SortKeys(keys[2], n, bits, what)  the keys alone; stable, returns the same
 //   Synchronize(what)                 waits for the loops so far; a fault among them is reported as `what`'s
 //   Clock                             Mark(): a point in the order of the loops; Seconds(a, b) once waited for
 //   ReleaseScratch()                  frees the device's own scratch (CUB's temporary storage)
@@ -469,7 +469,7 @@ SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState
   if (stride == 0)
   {
     d.Release(scratch.sortRecords);
-    result = d.SortKeys(keys, n, 0, bits, "point keys");
+    result = d.SortKeys(keys, n, bits, "point keys");
   }
   else
   {
