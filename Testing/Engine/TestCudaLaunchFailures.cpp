@@ -104,8 +104,8 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   fixedDepth.depth = 6;
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
-  for (const char* kernel : { "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel", "LeafKeysKernel",
-         "LeafKernel", "InnerKernel" })
+  for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
+         "LeafKeysKernel", "LeafKernel", "InnerKernel" })
   {
     SCOPED_TRACE(kernel);
     auto engine = CreateEngine(Backend::CUDA);

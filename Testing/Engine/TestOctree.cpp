@@ -241,6 +241,65 @@ TEST_P(OctreeBuild, EmptyAndNonFiniteInputAreErrors)
   EXPECT_THROW(engine->Build(c.View(), deep), Error);
 }
 
+// 1.5 M points of double positions, 36 MB: the CUDA backend copies them
+// through its pinned staging, in pieces of a few megabytes that it reduces
+// to bounds as they land (Device::StageReduced). The cube must be the one
+// fitted to every point, wherever an extreme lies: in the first or last
+// point, or in a point whose coordinates a 4 MB boundary splits; and an
+// error must name the first non-finite point however far into the copy.
+TEST_P(OctreeBuild, BoundsOfAnUploadInPieces)
+{
+  const std::size_t n = 1500000;
+  std::mt19937_64 rng(24);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> xyz(3 * n);
+  for (double& x : xyz)
+  {
+    x = u(rng);
+  }
+  const std::size_t split = (std::size_t(4) << 20) / sizeof(double) / 3; // its z after the boundary
+  const std::pair<std::size_t, double> extremes[] = { { 3 * 0 + 1, -3.5 }, { 3 * split + 2, 4.25 },
+    { 3 * (2 * split) + 0, 6.0 }, { 3 * (5 * split + 1) + 1, 2.5 }, { 3 * (n - 1) + 2, -5.0 },
+    { 3 * (n / 2) + 0, -1.75 } };
+  for (const auto& e : extremes)
+  {
+    xyz[e.first] = e.second;
+  }
+  double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+  for (std::size_t e = 0; e < xyz.size(); ++e)
+  {
+    lo[e % 3] = std::min(lo[e % 3], xyz[e]);
+    hi[e % 3] = std::max(hi[e % 3], xyz[e]);
+  }
+  PointCloudView v;
+  v.count = n;
+  v.xyzDouble = xyz.data();
+  BuildOptions options;
+  options.depth = 2;
+  options.keepPoints = false;
+  const RootCube expected = RootCube::FromBounds(lo, hi);
+  const BuildStats stats = engine->Build(v, options);
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_EQ(stats.cube.origin[a], expected.origin[a]) << "axis " << a;
+  }
+  EXPECT_EQ(stats.cube.size, expected.size);
+  EXPECT_EQ(stats.points, n);
+
+  xyz[3 * (7 * split) + 2] = std::nan("");
+  xyz[3 * (n - 2) + 0] = -INFINITY;
+  try
+  {
+    engine->Build(v, options);
+    FAIL() << "no error for NaN input";
+  }
+  catch (const Error& e)
+  {
+    const std::string first = "point " + std::to_string(7 * split) + " has a non-finite coordinate";
+    EXPECT_NE(std::string(e.what()).find(first), std::string::npos) << e.what();
+  }
+}
+
 TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
 {
   const Cloud c = UniformCloud(20000, 22);

@@ -106,6 +106,13 @@ public:
   {
     return Staged<T>{ host };
   }
+  template <typename T, typename R, typename Map, typename Combine>
+  Staged<T> StageReduced(const T* host, std::size_t n, const char* what, R identity, Map map, Combine combine,
+    R& result)
+  {
+    result = Reduce(n, identity, [&](std::size_t e) { return map(e, host[e]); }, combine);
+    return Stage(host, n, what);
+  }
   template <typename T>
   Staged<T> Prepare(const T* host, std::size_t n, const char* what)
   {

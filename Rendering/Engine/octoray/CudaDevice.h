@@ -10,6 +10,7 @@
 #include "CudaSupport.h"
 #include "CudaUpload.h"
 
+#include <cub/block/block_reduce.cuh>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_select.cuh>
@@ -17,6 +18,7 @@
 #include <thrust/iterator/transform_iterator.h>
 
 #include <algorithm>
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,6 +104,45 @@ __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* co
     }
   }
 }
+
+// A reduction over a few elements is one block; over many, a grid of at
+// most kMaxRangeBlocks that strides through them.
+constexpr std::size_t kRangeItemsPerThread = 16;
+constexpr unsigned kMaxRangeBlocks = 1024;
+
+inline unsigned RangeBlocks(std::size_t elements)
+{
+  return std::max(1u, std::min(kMaxRangeBlocks, Blocks((elements + kRangeItemsPerThread - 1) / kRangeItemsPerThread)));
+}
+
+// The reduction of elements [begin, end) of `data`: combine over every
+// map(e, data[e]), one result a block in partial[blockIdx.x].
+template <typename T, typename R, typename Map, typename Combine>
+__global__ void ReduceRangeKernel(const T* data, std::size_t begin, std::size_t end, R identity, Map map,
+  Combine combine, R* partial)
+{
+  using BlockReduce = cub::BlockReduce<R, kBlock>;
+  __shared__ typename BlockReduce::TempStorage temp;
+  R sum = identity;
+  const std::size_t stride = gridDim.x * std::size_t(blockDim.x);
+  for (std::size_t e = begin + blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; e < end; e += stride)
+  {
+    sum = combine(sum, map(e, data[e]));
+  }
+  sum = BlockReduce(temp).Reduce(sum, combine);
+  if (threadIdx.x == 0)
+  {
+    partial[blockIdx.x] = sum;
+  }
+}
+
+// Reads the partial results of ReduceRangeKernel for the final reduction.
+template <typename R>
+struct PartialResult
+{
+  const R* partial;
+  __host__ __device__ R operator()(std::size_t i) const { return partial[i]; }
+};
 }
 
 class CudaDevice
@@ -194,6 +235,37 @@ public:
     {
       Upload(staged, source, n, what);
     }
+    return staged;
+  }
+  // Stage, with the reduction of the elements: each piece of the copy is
+  // reduced on the stream that copied it as soon as it lands (CudaUpload.h),
+  // while the rest of the array is still on its way, and the pieces'
+  // results once the copy is complete.
+  template <typename T, typename R, typename Map, typename Combine>
+  Staged<T> StageReduced(const T* source, std::size_t n, const char* what, R identity, Map map, Combine combine,
+    R& result)
+  {
+    Staged<T> staged;
+    result = identity;
+    if (!source)
+    {
+      return staged;
+    }
+    Reserve(staged, n, what);
+    Buffer<R> partial;
+    Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
+      "partial reductions");
+    const T* data = staged.Get();
+    R* partials = partial.Get();
+    std::atomic<std::size_t> used{ 0 };
+    Staging.Copy(staged.Get(), source, n * sizeof(T), what, cuda::QueuedLoops::WaitFor,
+      [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
+        const unsigned blocks = cuda::RangeBlocks((end - begin) / sizeof(T));
+        const std::size_t slot = used.fetch_add(blocks);
+        LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
+          data, begin / sizeof(T), end / sizeof(T), identity, map, combine, partials + slot);
+      });
+    result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine);
     return staged;
   }
   // Stage in two steps, for a copy that overlaps loops: Prepare takes the

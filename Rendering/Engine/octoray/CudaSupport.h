@@ -41,10 +41,18 @@ inline dim3 LaunchGrid(const char* kernel, dim3 grid)
 // reports and that a test can refuse (the name of a __global__ function, or
 // of the loop CudaDevice::ForEach runs), checked at once.
 template <typename... Parameters, typename... Arguments>
+void LaunchOn(cudaStream_t stream, const char* name, void (*kernel)(Parameters...), dim3 grid, dim3 block,
+  Arguments&&... arguments)
+{
+  kernel<<<LaunchGrid(name, grid), block, 0, stream>>>(std::forward<Arguments>(arguments)...);
+  CudaCheckLaunch(name);
+}
+
+// The same on the default stream, where the engine's loops run.
+template <typename... Parameters, typename... Arguments>
 void Launch(const char* name, void (*kernel)(Parameters...), dim3 grid, dim3 block, Arguments&&... arguments)
 {
-  kernel<<<LaunchGrid(name, grid), block>>>(std::forward<Arguments>(arguments)...);
-  CudaCheckLaunch(name);
+  LaunchOn(0, name, kernel, grid, block, std::forward<Arguments>(arguments)...);
 }
 
 // Makes an engine's device current for the scope of one of its calls and

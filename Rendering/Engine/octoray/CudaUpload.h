@@ -7,7 +7,9 @@
 // buffers of its own, filling one while the copy engine reads the other,
 // so the host copies and the DMA overlap and several host threads keep
 // the bus busy. Arrays already in device memory (a CUDA simulation's) and
-// page-locked host arrays are copied directly. Only compiled by nvcc.
+// page-locked host arrays are copied directly. A caller may queue work on
+// each piece as it lands (Landed), which then runs while the rest of the
+// array is still on its way. Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"
@@ -15,6 +17,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <vector>
 
 namespace octoray
@@ -29,6 +32,18 @@ constexpr std::size_t kStagingThreshold = std::size_t(16) << 20;
 // not overlap) are a small part of it.
 constexpr std::size_t kStagingPiece = std::size_t(4) << 20;
 constexpr int kMaxStagingThreads = 8;
+// Stripes start at multiples of this, so that no piece splits an element.
+constexpr std::size_t kStripeAlignment = 256;
+
+// Work queued on a piece of a copy, bytes [begin, end) of the destination,
+// once it has landed: on `stream`, in whose order the piece's copy ran.
+using Landed = std::function<void(std::size_t begin, std::size_t end, cudaStream_t stream)>;
+
+// The most pieces a copy of `bytes` lands in (each stripe's last one may be short).
+inline std::size_t MaxPieces(std::size_t bytes)
+{
+  return bytes / kStagingPiece + kMaxStagingThreads + 1;
+}
 
 // Whether CUDA can copy from `p` without staging: device, managed or
 // page-locked host memory.
@@ -61,13 +76,19 @@ public:
   ~HostStaging() { Free(); }
 
   // Copies `bytes` from `source` (host or device memory) to `device` on the
-  // current device; returns once the copy is complete.
+  // current device; returns once the copy, and the work `landed` queued on
+  // its pieces, is complete.
   void Copy(void* device, const void* source, std::size_t bytes, const char* what,
-    QueuedLoops queued = QueuedLoops::WaitFor)
+    QueuedLoops queued = QueuedLoops::WaitFor, const Landed& landed = nullptr)
   {
     if (bytes < kStagingThreshold || DirectlyCopyable(source) || !Allocate())
     {
       CudaCheck(cudaMemcpy(device, source, bytes, cudaMemcpyDefault), what);
+      if (landed)
+      {
+        landed(0, bytes, 0);
+        CudaCheck(cudaStreamSynchronize(0), what);
+      }
       return;
     }
     int current = 0;
@@ -78,10 +99,13 @@ public:
       CudaCheck(cudaStreamSynchronize(0), what);
     }
     const int stripes = static_cast<int>(Lanes.size());
-    ParallelChunks(bytes, stripes, [&](std::size_t begin, std::size_t end, int stripe) {
+    const std::size_t units = (bytes + kStripeAlignment - 1) / kStripeAlignment;
+    ParallelChunks(units, stripes, [&](std::size_t first, std::size_t last, int stripe) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
-      CopyStripe(Lanes[stripe], static_cast<char*>(device) + begin, static_cast<const char*>(source) + begin,
-        end - begin, what);
+      const std::size_t begin = first * kStripeAlignment;
+      const std::size_t end = std::min(last * kStripeAlignment, bytes);
+      CopyStripe(Lanes[stripe], static_cast<char*>(device), static_cast<const char*>(source), begin, end, what,
+        landed);
     });
   }
 
@@ -94,16 +118,29 @@ private:
     cudaEvent_t copied[2] = { nullptr, nullptr };
   };
 
-  static void CopyStripe(Lane& lane, char* device, const char* source, std::size_t bytes, const char* what)
+  // Bytes [begin, end) of the copy, through the lane's two pinned buffers.
+  // Returns, or throws, once the lane has finished what it queued: the
+  // destination may be freed right after.
+  static void CopyStripe(Lane& lane, char* device, const char* source, std::size_t begin, std::size_t end,
+    const char* what, const Landed& landed)
   {
-    for (std::size_t offset = 0, piece = 0; offset < bytes; offset += kStagingPiece, ++piece)
+    struct Drain
+    {
+      cudaStream_t stream;
+      ~Drain() { cudaStreamSynchronize(stream); }
+    } drain{ lane.stream };
+    for (std::size_t offset = begin, piece = 0; offset < end; offset += kStagingPiece, ++piece)
     {
       const int b = static_cast<int>(piece & 1);
-      const std::size_t n = std::min(kStagingPiece, bytes - offset);
+      const std::size_t n = std::min(kStagingPiece, end - offset);
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
       std::memcpy(lane.pinned[b], source + offset, n);
       CudaCheck(cudaMemcpyAsync(device + offset, lane.pinned[b], n, cudaMemcpyHostToDevice, lane.stream), what);
       CudaCheck(cudaEventRecord(lane.copied[b], lane.stream), what);
+      if (landed)
+      {
+        landed(offset, offset + n, lane.stream);
+      }
     }
     CudaCheck(cudaStreamSynchronize(lane.stream), what);
   }

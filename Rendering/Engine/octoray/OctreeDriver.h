@@ -7,6 +7,8 @@
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
 //   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
+//   StageReduced(host, n, what, identity, map, combine, result)   Stage, and combine over every map(e, host[e])
+//                                     into result: on CUDA reduced piece by piece as the copy lands
 //   Prepare(host, n, what), Fill(staged, host, n, what)   Stage in two steps; the copy overlaps loops queued between
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
@@ -92,6 +94,22 @@ StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const d
     d.Stage(xyzDouble, xyzDouble ? 3 * n : 0, what) };
 }
 
+// StagePositions, with the positions' bounds (PositionBounds) reduced as
+// the copy lands: on CUDA they cost the build nothing beyond its upload.
+template <class Device>
+StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
+  std::size_t n, const char* what, Bounds& bounds)
+{
+  Bounds fromFloat, fromDouble;
+  StagedPositions<Device> staged{
+    d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, what, EmptyBounds(), CoordinateBounds(), BoundsUnion(), fromFloat),
+    d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, what, EmptyBounds(), CoordinateBounds(), BoundsUnion(),
+      fromDouble)
+  };
+  bounds = MergeBounds(fromFloat, fromDouble);
+  return staged;
+}
+
 // The first index at which a device loop failed, in the scratch counter
 // kCounterFirst: armed (filled with ones, kNoIndex) before the loop, each
 // failure reported inside it, and read after it, alone (FirstFailedStep) or
@@ -143,12 +161,19 @@ void RunStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::
     starts, scratch.counters.Get() + kCounterSelected);
 }
 
+// The bounds of positions where the device's loops read them, and the
+// first non-finite point.
 template <class Device>
 Bounds PositionBounds(Device& d, const PointArraysView& pts)
 {
+  const float* xyzFloat = pts.xyzFloat;
+  const double* xyzDouble = pts.xyzDouble;
   return d.Reduce(
-    pts.count, EmptyBounds(), OCTORAY_LAMBDA(std::size_t i) { return PointBounds(pts, i); },
-    OCTORAY_LAMBDA(const Bounds& a, const Bounds& b) { return MergeBounds(a, b); });
+    3 * pts.count, EmptyBounds(),
+    OCTORAY_LAMBDA(std::size_t e) {
+      return xyzDouble ? CoordinateBounds()(e, xyzDouble[e]) : CoordinateBounds()(e, xyzFloat[e]);
+    },
+    BoundsUnion());
 }
 
 // A point of positions where the device's loops read them (the state's, or
@@ -355,15 +380,14 @@ ScalarRange FiniteScalarRange(Device& d, const float* scalar, std::size_t n)
   return r.lo <= r.hi ? r : ScalarRange{};
 }
 
-// The cube a build uses: fitted to the staged positions, or the caller's
-// fixed one, which must hold them all. Checked before anything is replaced,
+// The cube a build uses: fitted to the bounds `b` of the staged positions,
+// or the caller's fixed one, which must hold them all. Checked before anything is replaced,
 // so that a refused build leaves the octree as it was; errors name the
 // first offending point with its coordinates as the caller gave them.
 template <class Device>
-RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArraysView& staged,
+RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArraysView& staged, const Bounds& b,
   const BuildOptions& options)
 {
-  const Bounds b = PositionBounds(d, staged);
   if (b.firstBad != kNoIndex)
   {
     throw Error(NonFinitePointMessage(b.firstBad, ReadPosition(d, staged, b.firstBad)));
@@ -777,11 +801,13 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
   auto phase = std::chrono::steady_clock::now();
-  StagedPositions<Device> staged = StagePositions(d, points.xyzFloat, points.xyzDouble, n, "point positions");
+  Bounds bounds;
+  StagedPositions<Device> staged =
+    StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds);
   double uploadSeconds = SecondsSince(phase);
   phase = std::chrono::steady_clock::now();
-  const RootCube cube = CheckedCube(d, scratch, staged.View(n), options);
-  const double boundsSeconds = SecondsSince(phase);
+  const RootCube cube = CheckedCube(d, scratch, staged.View(n), bounds, options);
+  const double cubeSeconds = SecondsSince(phase);
 
   std::unique_ptr<OctreeState<Device>> fresh;
   OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
@@ -804,7 +830,7 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
     uploadSeconds += SecondsSince(phase);
   });
   stats.uploadSeconds = uploadSeconds;
-  stats.keySeconds += boundsSeconds;
+  stats.keySeconds += cubeSeconds;
   if (!s.keepPoints)
   {
     ReleasePoints(d, scratch, s);

@@ -53,22 +53,40 @@ OCTORAY_HD Bounds EmptyBounds()
   return Bounds{ Vec3d{ inf, inf, inf }, Vec3d{ -inf, -inf, -inf }, kNoIndex };
 }
 
-OCTORAY_HD Bounds PointBounds(const PointArraysView& pts, std::size_t i)
-{
-  const Vec3d p = pts.Position(i);
-  if (!IsFinitePoint(p))
-  {
-    Bounds b = EmptyBounds();
-    b.firstBad = i;
-    return b;
-  }
-  return Bounds{ p, p, kNoIndex };
-}
-
 OCTORAY_HD Bounds MergeBounds(const Bounds& x, const Bounds& y)
 {
   return Bounds{ Min(x.lo, y.lo), Max(x.hi, y.hi), x.firstBad < y.firstBad ? x.firstBad : y.firstBad };
 }
+
+// The bounds of element e of an xyz array (point e / 3, axis e % 3), and
+// their union: a reduction over the elements of the array, which a copy
+// can run on each piece as it lands (Device::StageReduced), where a piece
+// may end inside a point.
+struct CoordinateBounds
+{
+  template <typename T>
+  OCTORAY_HD Bounds operator()(std::size_t e, T value) const
+  {
+    Bounds b = EmptyBounds();
+    if (!std::isfinite(value))
+    {
+      b.firstBad = e / 3;
+      return b;
+    }
+    // Selects, not b.lo[axis]: an index into a vector would put it in
+    // local memory on the GPU.
+    const int axis = static_cast<int>(e % 3);
+    const double x = value;
+    b.lo = Vec3d{ axis == 0 ? x : b.lo.x, axis == 1 ? x : b.lo.y, axis == 2 ? x : b.lo.z };
+    b.hi = Vec3d{ axis == 0 ? x : b.hi.x, axis == 1 ? x : b.hi.y, axis == 2 ? x : b.hi.z };
+    return b;
+  }
+};
+
+struct BoundsUnion
+{
+  OCTORAY_HD Bounds operator()(const Bounds& x, const Bounds& y) const { return MergeBounds(x, y); }
+};
 
 // Reads a node's attribute vector (present attributes only).
 OCTORAY_HD void LoadNodeAttributes(const OctreeView& t, std::uint32_t n, float v[kSlotCount])
