@@ -242,11 +242,12 @@ TEST_P(OctreeBuild, EmptyAndNonFiniteInputAreErrors)
 }
 
 // 1.5 M points of double positions, 36 MB: the CUDA backend copies them
-// through its pinned staging, in pieces of a few megabytes that it reduces
-// to bounds as they land (Device::StageReduced). The cube must be the one
+// through its pinned staging, in pieces of about 4 MB that it reduces to
+// bounds as they land (Device::StageReduced). The cube must be the one
 // fitted to every point, wherever an extreme lies: in the first or last
-// point, or in a point whose coordinates a 4 MB boundary splits; and an
-// error must name the first non-finite point however far into the copy.
+// point, or in points next to 4 MB boundaries, where a piece of a plain
+// 4 MB would have cut them; and an error must name the first non-finite
+// point however far into the copy.
 TEST_P(OctreeBuild, BoundsOfAnUploadInPieces)
 {
   const std::size_t n = 1500000;
@@ -257,7 +258,7 @@ TEST_P(OctreeBuild, BoundsOfAnUploadInPieces)
   {
     x = u(rng);
   }
-  const std::size_t split = (std::size_t(4) << 20) / sizeof(double) / 3; // its z after the boundary
+  const std::size_t split = (std::size_t(4) << 20) / sizeof(double) / 3; // its z past 4 MB
   const std::pair<std::size_t, double> extremes[] = { { 3 * 0 + 1, -3.5 }, { 3 * split + 2, 4.25 },
     { 3 * (2 * split) + 0, 6.0 }, { 3 * (5 * split + 1) + 1, 2.5 }, { 3 * (n - 1) + 2, -5.0 },
     { 3 * (n / 2) + 0, -1.75 } };

@@ -107,10 +107,10 @@ public:
     return Staged<T>{ host };
   }
   template <typename T, typename R, typename Map, typename Combine>
-  Staged<T> StageReduced(const T* host, std::size_t n, const char* what, R identity, Map map, Combine combine,
-    R& result)
+  Staged<T> StageReduced(const T* host, std::size_t n, int stride, const char* what, R identity, Map map,
+    Combine combine, R& result)
   {
-    result = Reduce(n, identity, [&](std::size_t e) { return map(e, host[e]); }, combine);
+    result = Reduce(n / stride, identity, [&](std::size_t i) { return map(i, host); }, combine);
     return Stage(host, n, what);
   }
   template <typename T>

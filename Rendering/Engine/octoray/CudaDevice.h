@@ -105,18 +105,18 @@ __global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* co
   }
 }
 
-// A reduction over a few elements is one block; over many, a grid of at
-// most kMaxRangeBlocks that strides through them.
+// A reduction over a few items is one block; over many, a grid of at most
+// kMaxRangeBlocks that strides through them.
 constexpr std::size_t kRangeItemsPerThread = 16;
 constexpr unsigned kMaxRangeBlocks = 1024;
 
-inline unsigned RangeBlocks(std::size_t elements)
+inline unsigned RangeBlocks(std::size_t items)
 {
-  return std::max(1u, std::min(kMaxRangeBlocks, Blocks((elements + kRangeItemsPerThread - 1) / kRangeItemsPerThread)));
+  return std::max(1u, std::min(kMaxRangeBlocks, Blocks((items + kRangeItemsPerThread - 1) / kRangeItemsPerThread)));
 }
 
-// The reduction of elements [begin, end) of `data`: combine over every
-// map(e, data[e]), one result a block in partial[blockIdx.x].
+// The reduction of items [begin, end) of `data`: combine over every
+// map(i, data), one result a block in partial[blockIdx.x].
 template <typename T, typename R, typename Map, typename Combine>
 __global__ void ReduceRangeKernel(const T* data, std::size_t begin, std::size_t end, R identity, Map map,
   Combine combine, R* partial)
@@ -125,9 +125,9 @@ __global__ void ReduceRangeKernel(const T* data, std::size_t begin, std::size_t 
   __shared__ typename BlockReduce::TempStorage temp;
   R sum = identity;
   const std::size_t stride = gridDim.x * std::size_t(blockDim.x);
-  for (std::size_t e = begin + blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; e < end; e += stride)
+  for (std::size_t i = begin + blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; i < end; i += stride)
   {
-    sum = combine(sum, map(e, data[e]));
+    sum = combine(sum, map(i, data));
   }
   sum = BlockReduce(temp).Reduce(sum, combine);
   if (threadIdx.x == 0)
@@ -237,14 +237,20 @@ public:
     }
     return staged;
   }
-  // Stage, with the reduction of the elements: each piece of the copy is
-  // reduced on the stream that copied it as soon as it lands (CudaUpload.h),
+  // Stage, with the reduction of its items of `stride` elements: each piece
+  // of the copy is reduced on the stream that copied it as soon as it lands
+  // (CudaUpload.h: no piece splits an item of three floats or doubles),
   // while the rest of the array is still on its way, and the pieces'
   // results once the copy is complete.
   template <typename T, typename R, typename Map, typename Combine>
-  Staged<T> StageReduced(const T* source, std::size_t n, const char* what, R identity, Map map, Combine combine,
-    R& result)
+  Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
+    Combine combine, R& result)
   {
+    const std::size_t itemBytes = stride * sizeof(T);
+    if (cuda::kStripeAlignment % itemBytes != 0)
+    {
+      throw Error(std::string("octoray: the staged copy's pieces would split items of ") + what);
+    }
     Staged<T> staged;
     result = identity;
     if (!source)
@@ -260,10 +266,10 @@ public:
     std::atomic<std::size_t> used{ 0 };
     Staging.Copy(staged.Get(), source, n * sizeof(T), what, cuda::QueuedLoops::WaitFor,
       [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
-        const unsigned blocks = cuda::RangeBlocks((end - begin) / sizeof(T));
+        const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
         const std::size_t slot = used.fetch_add(blocks);
         LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
-          data, begin / sizeof(T), end / sizeof(T), identity, map, combine, partials + slot);
+          data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
       });
     result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine);
     return staged;

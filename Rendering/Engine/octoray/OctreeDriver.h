@@ -7,8 +7,9 @@
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
 //   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
-//   StageReduced(host, n, what, identity, map, combine, result)   Stage, and combine over every map(e, host[e])
-//                                     into result: on CUDA reduced piece by piece as the copy lands
+//   StageReduced(host, n, stride, what, identity, map, combine, result)   Stage, and combine over map(i, host)
+//                                     for every item i of `stride` elements into result: on CUDA reduced piece by
+//                                     piece as the copy lands
 //   Prepare(host, n, what), Fill(staged, host, n, what)   Stage in two steps; the copy overlaps loops queued between
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
@@ -102,8 +103,8 @@ StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, 
 {
   Bounds fromFloat, fromDouble;
   StagedPositions<Device> staged{
-    d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, what, EmptyBounds(), CoordinateBounds(), BoundsUnion(), fromFloat),
-    d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, what, EmptyBounds(), CoordinateBounds(), BoundsUnion(),
+    d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(), fromFloat),
+    d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(),
       fromDouble)
   };
   bounds = MergeBounds(fromFloat, fromDouble);
@@ -169,9 +170,9 @@ Bounds PositionBounds(Device& d, const PointArraysView& pts)
   const float* xyzFloat = pts.xyzFloat;
   const double* xyzDouble = pts.xyzDouble;
   return d.Reduce(
-    3 * pts.count, EmptyBounds(),
-    OCTORAY_LAMBDA(std::size_t e) {
-      return xyzDouble ? CoordinateBounds()(e, xyzDouble[e]) : CoordinateBounds()(e, xyzFloat[e]);
+    pts.count, EmptyBounds(),
+    OCTORAY_LAMBDA(std::size_t i) {
+      return xyzDouble ? XyzPointBounds()(i, xyzDouble) : XyzPointBounds()(i, xyzFloat);
     },
     BoundsUnion());
 }

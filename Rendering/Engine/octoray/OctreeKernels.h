@@ -58,28 +58,23 @@ OCTORAY_HD Bounds MergeBounds(const Bounds& x, const Bounds& y)
   return Bounds{ Min(x.lo, y.lo), Max(x.hi, y.hi), x.firstBad < y.firstBad ? x.firstBad : y.firstBad };
 }
 
-// The bounds of element e of an xyz array (point e / 3, axis e % 3), and
-// their union: a reduction over the elements of the array, which a copy
-// can run on each piece as it lands (Device::StageReduced), where a piece
-// may end inside a point.
-struct CoordinateBounds
+// The bounds of point i of an xyz array (three coordinates a point), or
+// the point as the first non-finite one, and their union: a reduction over
+// the points of a flat array, which a copy can run on each piece as it
+// lands (Device::StageReduced).
+struct XyzPointBounds
 {
   template <typename T>
-  OCTORAY_HD Bounds operator()(std::size_t e, T value) const
+  OCTORAY_HD Bounds operator()(std::size_t i, const T* xyz) const
   {
-    Bounds b = EmptyBounds();
-    if (!std::isfinite(value))
+    const Vec3d p{ xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2] };
+    if (!IsFinitePoint(p))
     {
-      b.firstBad = e / 3;
+      Bounds b = EmptyBounds();
+      b.firstBad = i;
       return b;
     }
-    // Selects, not b.lo[axis]: an index into a vector would put it in
-    // local memory on the GPU.
-    const int axis = static_cast<int>(e % 3);
-    const double x = value;
-    b.lo = Vec3d{ axis == 0 ? x : b.lo.x, axis == 1 ? x : b.lo.y, axis == 2 ? x : b.lo.z };
-    b.hi = Vec3d{ axis == 0 ? x : b.hi.x, axis == 1 ? x : b.hi.y, axis == 2 ? x : b.hi.z };
-    return b;
+    return Bounds{ p, p, kNoIndex };
   }
 };
 
