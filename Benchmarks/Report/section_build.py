@@ -376,9 +376,20 @@ def _cuda(ctx):
         "",
         "The engine's sort runs at its floor. What separates the whole call from it is the upload of the points "
         "from pageable memory (most of it at 10 M and more); what separates the device phases from it are the "
-        "keys, the bounds before them, the histogram of neighbouring keys and the levels: one kernel for the "
+        "keys, the histogram of neighbouring keys and the levels: one kernel for the "
         "leaves and one CUB select plus one kernel per level above them (Benchmarks/gpu/profile-build.txt lists "
-        "them for 100 M points). Before the records travelled with the keys, the leaf kernel gathered each "
+        "them for 100 M points). The positions' bounds, which the keys need, are reduced on the device piece by "
+        "piece as the staged copy of the positions lands (CudaUpload.h, Device::StageReduced: the "
+        "ReduceRangeKernel launches in the profile, each on the stream that copied its piece), and count in the "
+        "upload; until 064700a a CUB reduction after the upload read them again, 0.46 ms at 100 M points. "
+        "Against the engine before (4621e56), built side by side in one call and run in turn, the keys phase went from "
+        "1.42 to 0.87 ms at 100 M points and from 0.23–0.24 to 0.10–0.12 ms at 10 M, the device phases from "
+        "10.0–10.1 to 9.45–9.48 ms (2.17–2.19 to 2.05 times the floor) and from 1.60 to 1.48–1.50 ms "
+        "(Benchmarks/gpu/variants-bounds.txt, call 4; the level phase moves by up to 0.4 ms from machine to "
+        "machine with the same kernels, which gave 1.93–1.98 times the floor at 100 M in calls 1 to 3). The "
+        "whole call follows the machine's host: 1.48 times the pinned copy at 100 M points in call 3's run of the "
+        "report's benchmark, 1.52–2.36 for this engine and 2.37–2.49 for the one before in call 4, whose host "
+        "copied slowly (its builds' uploads took 43–91 ms; the run this report reads is call 4's). Before the records travelled with the keys, the leaf kernel gathered each "
         "point's record from its place in the input, a random read a point: at 100 M points that kernel took "
         "4.55 ms and moved 8.3 GB, bound by how many random places the memory serves a second (32-byte fills and "
         "a separate gather loop took as long: Benchmarks/gpu/variants-packed-sort.txt). Moving the records with "
@@ -692,8 +703,9 @@ Command:
     {engine_cmd}
 
 One engine rebuilt repeatedly (buffers reused, as when an animation is rebuilt per frame): median of {repeats} after
-1 warm-up. Phases from BuildStats (medians): keys = bounds + Morton keys, sort = radix sort, levels = unique keys per
-level, links and averages.
+1 warm-up. Phases from BuildStats (medians): keys = Morton keys, sort = radix sort, levels = unique keys per
+level, links and averages; the positions' bounds are reduced where the positions are staged and count in none of
+them (the median holds them).
 
 {engine}
 

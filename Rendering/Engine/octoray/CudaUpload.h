@@ -27,12 +27,13 @@ namespace cuda
 // Below this many bytes cudaMemcpy from pageable memory costs less than
 // starting the staging threads.
 constexpr std::size_t kStagingThreshold = std::size_t(16) << 20;
-// Each pinned buffer (about 4 MB): large enough that a DMA's setup is small
-// beside its transfer, small enough that a stripe's first and last pieces
-// (which do not overlap) are a small part of it.
-// Stripes and pieces start at multiples of kStripeAlignment (3 x 256
-// bytes), so that no piece splits a point of three floats or doubles.
+// Stripes and pieces start at multiples of this (3 x 256 bytes), so that no
+// piece splits a point of three floats or doubles.
 constexpr std::size_t kStripeAlignment = 768;
+// Each pinned buffer (about 4 MB, a multiple of kStripeAlignment): large
+// enough that a DMA's setup is small beside its transfer, small enough that
+// a stripe's first and last pieces (which do not overlap) are a small part
+// of it.
 constexpr std::size_t kStagingPiece = (std::size_t(4) << 20) / kStripeAlignment * kStripeAlignment;
 constexpr int kMaxStagingThreads = 8;
 

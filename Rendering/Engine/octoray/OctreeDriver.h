@@ -382,9 +382,10 @@ ScalarRange FiniteScalarRange(Device& d, const float* scalar, std::size_t n)
 }
 
 // The cube a build uses: fitted to the bounds `b` of the staged positions,
-// or the caller's fixed one, which must hold them all. Checked before anything is replaced,
-// so that a refused build leaves the octree as it was; errors name the
-// first offending point with its coordinates as the caller gave them.
+// or the caller's fixed one, which must hold them all. Checked before
+// anything is replaced, so that a refused build leaves the octree as it
+// was; errors name the first offending point with its coordinates as the
+// caller gave them.
 template <class Device>
 RootCube CheckedCube(Device& d, DriverScratch<Device>& scratch, const PointArraysView& staged, const Bounds& b,
   const BuildOptions& options)
