@@ -263,12 +263,13 @@ struct BuildStats
   std::size_t nodes = 0;
   std::size_t bytes = 0;     // MemoryReport::Total() after the build
   double seconds = 0.0;      // whole build, wall clock
-  // The host's time copying the caller's arrays to the device and queueing
-  // the attributes' conversion into point records (colours, normals); the
+  // The host's time copying the caller's arrays to the device, with the
+  // positions' bounds (reduced as the copy lands), and queueing the
+  // attributes' conversion into point records (colours, normals); the
   // attributes are copied while the device computes the keys.
   double uploadSeconds = 0.0;
   // The device's time (the host's on the CPU backend) of each phase:
-  double keySeconds = 0.0;   // bounds (with their copy to the host) and Morton keys
+  double keySeconds = 0.0;   // the cube from the bounds, and Morton keys
   double sortSeconds = 0.0;  // radix sort of the keys with their records or indices, and the neighbour histogram
   double levelSeconds = 0.0; // unique keys per level, links and averages
 };
