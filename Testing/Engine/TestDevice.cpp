@@ -265,6 +265,36 @@ TEST(CpuDevice, RunStartsAndFirstFailedStep)
   }
 }
 
+// Level sizes from a newNode histogram; past the 32-bit node index, an
+// error naming the depth, before any array is reserved. 400 M keys that
+// share 10 levels with their predecessors: 400 M + 1 nodes at each level
+// from 11 on.
+TEST(LevelBegins, FollowTheHistogramAndRefuseMoreNodesThanTheIndexHolds)
+{
+  std::uint64_t newNode[kDepthHistogramBins] = {};
+  newNode[1] = 7;             // bin 0: 7 keys start a node at every level from 1 on
+  newNode[11] = 400000000ull; // bin 10
+  std::uint32_t levelBegin[kMaxLevel + 2];
+  SetLevelBegins(newNode, 20, levelBegin);
+  std::uint64_t expected = 0;
+  for (int l = 0; l <= kMaxLevel + 1; ++l)
+  {
+    EXPECT_EQ(levelBegin[l], expected) << "level " << l;
+    expected += l > 20 ? 0 : l == 0 ? 1 : l <= 10 ? 8 : 400000008ull;
+  }
+  EXPECT_EQ(expected, 4000000161ull); // below 2^32 - 1
+  try
+  {
+    SetLevelBegins(newNode, 21, levelBegin);
+    ADD_FAILURE() << "no error";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_STREQ(e.what(), "octoray: an octree of depth 21 over these points would hold 4400000169 nodes or more, "
+                           "past the 32-bit node index; choose a shallower depth");
+  }
+}
+
 // The attribute list's slots are laid out in its order, every bit its own.
 TEST(Attributes, SlotsAndBitsFollowTheList)
 {

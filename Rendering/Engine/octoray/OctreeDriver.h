@@ -107,7 +107,7 @@ StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, 
     d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(),
       fromDouble)
   };
-  bounds = MergeBounds(fromFloat, fromDouble);
+  bounds = BoundsUnion()(fromFloat, fromDouble);
   return staged;
 }
 
@@ -345,7 +345,7 @@ template <class Device, class Points>
 void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttributes<Device>& staged,
   const ScalarRange& scalarRange, Points& s)
 {
-  const PointRecordLayout layout = s.layout = RecordLayoutOf(points);
+  const PointRecordLayout layout = s.layout; // set by the build before its sort, whose shape depends on it
   d.Reserve(s.records, points.count * layout.stride, "point attributes");
   if (layout.stride == 0)
   {
@@ -677,6 +677,27 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   return sorted;
 }
 
+// levelBegin[l]: the first node of level l, from the newNode histogram;
+// levelBegin[depth + 1] on: the node count. Nodes are numbered in 32 bits
+// (kInvalidIndex the last number, "none"): a deep octree of a sparse cloud,
+// every point a chain of nodes of its own, can pass that, which is an error
+// before anything is reserved.
+inline void SetLevelBegins(const std::uint64_t newNode[kDepthHistogramBins], int depth,
+  std::uint32_t levelBegin[kMaxLevel + 2])
+{
+  std::uint64_t begin = 0;
+  for (int l = 0; l <= kMaxLevel + 1; ++l)
+  {
+    levelBegin[l] = static_cast<std::uint32_t>(begin);
+    begin += l <= depth ? NodesAtLevel(newNode, l) : 0;
+    if (begin > kInvalidIndex)
+    {
+      throw Error("octoray: an octree of depth " + std::to_string(depth) + " over these points would hold " +
+        std::to_string(begin) + " nodes or more, past the 32-bit node index; choose a shallower depth");
+    }
+  }
+}
+
 // The node arrays from the sorted points: leaves, then each level from the
 // one below, its nodes the runs of equal parent keys. The level sizes are
 // known from the histogram, so nothing returns to the host per level.
@@ -687,11 +708,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const int depth = sorted.depth;
   s.depth = depth;
   s.cube = cube;
-  for (int l = 0; l <= kMaxLevel; ++l)
-  {
-    const std::uint64_t nodes = l <= depth ? NodesAtLevel(sorted.histogram, l) : 0;
-    s.levelBegin[l + 1] = s.levelBegin[l] + static_cast<std::uint32_t>(nodes);
-  }
+  SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
     const std::string what = std::string("node ") + a.kLabel;

@@ -53,11 +53,6 @@ OCTORAY_HD Bounds EmptyBounds()
   return Bounds{ Vec3d{ inf, inf, inf }, Vec3d{ -inf, -inf, -inf }, kNoIndex };
 }
 
-OCTORAY_HD Bounds MergeBounds(const Bounds& x, const Bounds& y)
-{
-  return Bounds{ Min(x.lo, y.lo), Max(x.hi, y.hi), x.firstBad < y.firstBad ? x.firstBad : y.firstBad };
-}
-
 // The bounds of point i of an xyz array (three coordinates a point), or
 // the point as the first non-finite one, and their union: a reduction over
 // the points of a flat array, which a copy can run on each piece as it
@@ -80,7 +75,10 @@ struct XyzPointBounds
 
 struct BoundsUnion
 {
-  OCTORAY_HD Bounds operator()(const Bounds& x, const Bounds& y) const { return MergeBounds(x, y); }
+  OCTORAY_HD Bounds operator()(const Bounds& x, const Bounds& y) const
+  {
+    return Bounds{ Min(x.lo, y.lo), Max(x.hi, y.hi), x.firstBad < y.firstBad ? x.firstBad : y.firstBad };
+  }
 };
 
 // Reads a node's attribute vector (present attributes only).
