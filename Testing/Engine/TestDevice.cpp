@@ -1,6 +1,7 @@
 // The shared pieces under the driver and the renderer, against plain
 // references: the CPU device's primitives (whatever the thread count, the
-// same results), the driver's run starts and first-failure search, the
+// same results), the driver's run starts, first-failure search and level
+// sizes, the
 // attribute list's slots, and the vector vocabulary's rounding.
 #include <octoray/CpuDevice.h>
 #include <octoray/OctreeDriver.h>
@@ -266,9 +267,9 @@ TEST(CpuDevice, RunStartsAndFirstFailedStep)
 }
 
 // Level sizes from a newNode histogram; past the 32-bit node index, an
-// error naming the depth, before any array is reserved. 400 M keys that
-// share 10 levels with their predecessors: 400 M + 1 nodes at each level
-// from 11 on.
+// error naming the depth, before any array is reserved. The first key, 7
+// that share only the root with their predecessors and 400 M that share 10
+// levels: 8 nodes at each level from 1 to 10, 400 M + 8 from 11 on.
 TEST(LevelBegins, FollowTheHistogramAndRefuseMoreNodesThanTheIndexHolds)
 {
   std::uint64_t newNode[kDepthHistogramBins] = {};
