@@ -1,8 +1,7 @@
 // The shared pieces under the driver and the renderer, against plain
 // references: the CPU device's primitives (whatever the thread count, the
 // same results), the driver's run starts, first-failure search and level
-// sizes, the
-// attribute list's slots, and the vector vocabulary's rounding.
+// sizes, the attribute list's slots, and the vector vocabulary's rounding.
 #include <octoray/CpuDevice.h>
 #include <octoray/OctreeDriver.h>
 #include <octoray/RenderKernels.h>
