@@ -9,11 +9,14 @@
 #include "BenchUtil.h"
 
 #include <octoray/Engine.h>
+#include <octoray/Octree.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <numeric>
 #include <sstream>
 #include <thread>
 
@@ -48,6 +51,45 @@ struct Run
   std::size_t engineBytes = 0;      // everything the engine holds
   std::size_t nodeBytes = 0;        // the octree's node arrays alone
 };
+
+// How the points spread over the leaves of the engine's octree: the leaf
+// loop gives each leaf a thread that walks its points, so a warp of 32
+// consecutive leaves runs as long as its longest; laneStepsUsed is the share
+// of lane-steps that reach a point (1: every leaf in a warp alike).
+struct LeafLengths
+{
+  std::size_t leaves = 0, median = 0, p99 = 0, most = 0;
+  double mean = 0.0, laneStepsUsed = 0.0;
+};
+
+LeafLengths MeasureLeafLengths(const Engine& engine)
+{
+  HostOctree t;
+  engine.CopyToHost(t);
+  std::vector<std::uint32_t> points(
+    t.pointCount.begin() + t.levelBegin[t.depth], t.pointCount.begin() + t.levelBegin[t.depth + 1]);
+  LeafLengths l;
+  l.leaves = points.size();
+  if (points.empty())
+  {
+    return l;
+  }
+  double used = 0.0, run = 0.0;
+  for (std::size_t w = 0; w < points.size(); w += 32)
+  {
+    const auto warp = points.begin() + static_cast<std::ptrdiff_t>(w);
+    const auto end = points.begin() + static_cast<std::ptrdiff_t>(std::min(points.size(), w + 32));
+    used += std::accumulate(warp, end, 0.0);
+    run += 32.0 * *std::max_element(warp, end);
+  }
+  l.mean = used / points.size();
+  l.laneStepsUsed = used / run;
+  std::sort(points.begin(), points.end());
+  l.median = points[points.size() / 2];
+  l.p99 = points[points.size() * 99 / 100];
+  l.most = points.back();
+  return l;
+}
 
 Run Time(Engine& engine, const std::string& backend, const PointCloudView& cloud, const BuildOptions& options,
   int repeats)
@@ -147,11 +189,13 @@ int main(int argc, char** argv)
         options.depth = depth;
 
         std::vector<Run> runs;
+        LeafLengths leafLengths;
         if (backend != "cuda")
         {
           auto engine = CreateEngine(Backend::CPU);
           engine->SetThreadCount(1);
           runs.push_back(Time(*engine, CpuBackendName(1), cloud, options, repeats));
+          leafLengths = MeasureLeafLengths(*engine);
           if (threads > 1)
           {
             engine->SetThreadCount(threads);
@@ -206,6 +250,13 @@ int main(int argc, char** argv)
             std::printf("%-10s %-9s %-13s speed-up over 1 thread: %.2fx (%s)\n", "", "", run.backend.c_str(),
               single->timing.median / run.timing.median, run.description.c_str());
           }
+        }
+        if (leafLengths.leaves)
+        {
+          std::printf("%-10s %-9s points a leaf: mean %.2f, median %zu, 99th percentile %zu, most %zu; a thread a "
+                      "leaf, warps of 32 leaves use %.0f%% of their lane-steps\n",
+            "", "", leafLengths.mean, leafLengths.median, leafLengths.p99, leafLengths.most,
+            100.0 * leafLengths.laneStepsUsed);
         }
       }
     }
