@@ -81,14 +81,24 @@ struct BoundsUnion
   }
 };
 
-// Reads a node's attribute vector (present attributes only).
-OCTORAY_HD void LoadNodeAttributes(const OctreeView& t, std::uint32_t n, float v[kSlotCount])
+// fn(slot, value) for each slot of each attribute the nodes store, of node
+// n (as ForEachRecordSlot for a point).
+template <typename Fn>
+OCTORAY_HD void ForEachNodeSlot(const OctreeView& t, std::uint32_t n, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
+    using Value = AttributeValue<typename A::Type>;
     if (A::Of(t))
     {
-      AttributeValue<typename A::Type>::ToSlots(A::Of(t)[n], v + A::kSlot);
+      // A copy first: ToSlots's memcpy from the array would read it a byte at a time.
+      const typename A::Type value = A::Of(t)[n];
+      float v[Value::kSlots];
+      Value::ToSlots(value, v);
+      for (int k = 0; k < Value::kSlots; ++k)
+      {
+        fn(A::kSlot + k, v[k]);
+      }
     }
   });
 }
@@ -135,17 +145,10 @@ struct SortedKeys
   {
     return (narrowKey ? std::uint64_t(narrowKey[s]) : wideKey[s]) >> keyShift;
   }
-  // The attribute vector of the s-th point in sorted order.
-  OCTORAY_HD void Attributes(const PointArraysView& pts, std::size_t s, float v[kSlotCount]) const
+  // The record of the s-th point in sorted order.
+  OCTORAY_HD const std::uint32_t* Record(const PointArraysView& pts, std::size_t s) const
   {
-    if (records)
-    {
-      RecordAttributes(records + s * pts.layout.stride, pts.layout, v);
-    }
-    else
-    {
-      pts.Attributes(index[s], v);
-    }
+    return records ? records + s * pts.layout.stride : pts.Record(index[s]);
   }
 };
 
@@ -167,14 +170,9 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
     return;
   }
   double sum[kSlotCount] = {};
-  float v[kSlotCount] = {};
   for (std::uint32_t s = begin; s < end; ++s)
   {
-    sorted.Attributes(pts, s, v);
-    for (int k = 0; k < kSlotCount; ++k)
-    {
-      sum[k] += v[k];
-    }
+    ForEachRecordSlot(sorted.Record(pts, s), pts.layout, [&](int k, float x) { sum[k] += x; });
   }
   StoreNodeMeans(t, node, sum, static_cast<double>(end - begin));
 }
@@ -193,20 +191,12 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   unsigned mask = 0;
   std::uint32_t count = 0;
   double sum[kSlotCount] = {};
-  float v[kSlotCount] = {};
   for (std::uint32_t c = c0; c < c1; ++c)
   {
     mask |= 1u << OctantOf(t.key[c]);
     const std::uint32_t n = t.pointCount[c];
     count += n;
-    if (t.attributes)
-    {
-      LoadNodeAttributes(t, c, v);
-      for (int k = 0; k < kSlotCount; ++k)
-      {
-        sum[k] += static_cast<double>(v[k]) * n;
-      }
-    }
+    ForEachNodeSlot(t, c, [&](int k, float x) { sum[k] += static_cast<double>(x) * n; });
   }
   t.SetChildMask(node, mask);
   t.pointCount[node] = count;
@@ -278,22 +268,14 @@ OCTORAY_HD void ApplyRecords(const OctreeView& t, const PointArraysView& pts, co
   if (t.attributes)
   {
     double sum[kSlotCount] = {};
-    float v[kSlotCount] = {};
     for (std::uint32_t j = begin; j < end; ++j)
     {
       const bool joins = recordPoint[j] & 1u;
-      pts.Attributes(recordPoint[j] >> 1, v);
-      for (int s = 0; s < kSlotCount; ++s)
-      {
-        sum[s] += joins ? v[s] : -v[s];
-      }
+      ForEachRecordSlot(pts.Record(recordPoint[j] >> 1), pts.layout,
+        [&](int k, float x) { sum[k] += joins ? x : -x; });
     }
-    float mean[kSlotCount] = {};
-    LoadNodeAttributes(t, n, mean);
-    for (int s = 0; s < kSlotCount; ++s)
-    {
-      sum[s] = static_cast<double>(mean[s]) * t.pointCount[n] + sum[s];
-    }
+    const std::uint32_t before = t.pointCount[n];
+    ForEachNodeSlot(t, n, [&](int k, float mean) { sum[k] = static_cast<double>(mean) * before + sum[k]; });
     StoreNodeMeans(t, n, sum, static_cast<double>(count));
   }
   t.pointCount[n] = static_cast<std::uint32_t>(count);

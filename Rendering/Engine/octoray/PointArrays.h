@@ -54,20 +54,35 @@ OCTORAY_HD void StoreInRecord(std::uint32_t* records, const PointRecordLayout& l
   memcpy(records + i * layout.stride + layout.offset[attribute], words, sizeof words);
 }
 
-// The attribute vector of one record (slots of absent attributes are left
-// alone).
-OCTORAY_HD void RecordAttributes(const std::uint32_t* record, const PointRecordLayout& layout, float v[kSlotCount])
+// fn(slot, value) for each slot of each attribute the record holds. The
+// build's loops add up only these: summing every slot, absent attributes'
+// zeros included, spent most of an H100's leaf loop converting zeros to
+// double (Benchmarks/gpu/variants-slots.txt).
+template <typename Fn>
+OCTORAY_HD void ForEachRecordSlot(const std::uint32_t* record, const PointRecordLayout& layout, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
+    using Value = AttributeValue<typename A::Type>;
     const int offset = layout.offset[A::kIndex];
     if (offset < 0)
     {
       return;
     }
+    // Whole words: a memcpy straight from the record reads it a byte at a time.
+    std::uint32_t words[kWordsOf<typename A::Type>];
+    for (int w = 0; w < kWordsOf<typename A::Type>; ++w)
+    {
+      words[w] = record[offset + w];
+    }
     typename A::Type value;
-    memcpy(&value, record + offset, sizeof value);
-    AttributeValue<typename A::Type>::ToSlots(value, v + A::kSlot);
+    memcpy(&value, words, sizeof value);
+    float v[Value::kSlots];
+    Value::ToSlots(value, v);
+    for (int k = 0; k < Value::kSlots; ++k)
+    {
+      fn(A::kSlot + k, v[k]);
+    }
   });
 }
 
@@ -98,11 +113,7 @@ struct PointArraysView
                      : Vec3d{ xyzFloat[3 * i], xyzFloat[3 * i + 1], xyzFloat[3 * i + 2] };
   }
 
-  // The point's attribute vector (slots of absent attributes are left alone).
-  OCTORAY_HD void Attributes(std::size_t i, float v[kSlotCount]) const
-  {
-    RecordAttributes(records + i * layout.stride, layout, v);
-  }
+  OCTORAY_HD const std::uint32_t* Record(std::size_t i) const { return records + i * layout.stride; }
 };
 
 // True when all three coordinates are finite.
