@@ -287,6 +287,21 @@ OCTORAY_HD void ForEachAttribute(Fn&& fn)
 #undef OCTORAY_CALL
 }
 
+// fn(slot, float) for each slot of a value of attribute a (a descriptor).
+// `value` is a copy of the stored one: ToSlots's memcpy straight from an
+// array reads it a byte at a time.
+template <class A, typename Fn>
+OCTORAY_HD void ForEachSlotOf(A, const typename A::Type& value, Fn&& fn)
+{
+  using Value = AttributeValue<typename A::Type>;
+  float v[Value::kSlots];
+  Value::ToSlots(value, v);
+  for (int k = 0; k < Value::kSlots; ++k)
+  {
+    fn(A::kSlot + k, v[k]);
+  }
+}
+
 // fn(descriptor) for every node array: the topology, then the attributes.
 template <typename Fn>
 void ForEachNodeArray(Fn&& fn)

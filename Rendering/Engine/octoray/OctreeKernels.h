@@ -88,17 +88,10 @@ OCTORAY_HD void ForEachNodeSlot(const OctreeView& t, std::uint32_t n, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
-    using Value = AttributeValue<typename A::Type>;
     if (A::Of(t))
     {
-      // A copy first: ToSlots's memcpy from the array would read it a byte at a time.
       const typename A::Type value = A::Of(t)[n];
-      float v[Value::kSlots];
-      Value::ToSlots(value, v);
-      for (int k = 0; k < Value::kSlots; ++k)
-      {
-        fn(A::kSlot + k, v[k]);
-      }
+      ForEachSlotOf(a, value, fn);
     }
   });
 }
