@@ -26,11 +26,14 @@
 // The body of a loop that a backend runs per element (Device::ForEach and
 // the other primitives of OctreeDriver.h), as pbrt-v4's PBRT_CPU_GPU_LAMBDA:
 // it captures by value, because under nvcc it is copied to the GPU (an
-// extended lambda: the CUDA build passes --extended-lambda).
+// extended lambda: the CUDA build passes --extended-lambda). On the host
+// it is inlined into the backend's loop: once the level loops' bodies grew,
+// GCC called them once per node, which cost the CPU build a fifth of its
+// level phase (Benchmarks/gpu/variants-small-levels.txt, call 9's note).
 #if defined(__CUDACC__)
 #define OCTORAY_LAMBDA(...) [=] __host__ __device__(__VA_ARGS__)
 #else
-#define OCTORAY_LAMBDA(...) [=](__VA_ARGS__)
+#define OCTORAY_LAMBDA(...) [=](__VA_ARGS__) __attribute__((always_inline))
 #endif
 
 namespace octoray

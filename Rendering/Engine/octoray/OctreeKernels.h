@@ -189,7 +189,10 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
     mask |= 1u << OctantOf(t.key[c]);
     const std::uint32_t n = t.pointCount[c];
     count += n;
-    ForEachNodeSlot(t, c, [&](int k, float x) { sum[k] += static_cast<double>(x) * n; });
+    if (t.attributes) // one test the compiler can take out of the loop, not one an attribute
+    {
+      ForEachNodeSlot(t, c, [&](int k, float x) { sum[k] += static_cast<double>(x) * n; });
+    }
   }
   t.SetChildMask(node, mask);
   t.pointCount[node] = count;
