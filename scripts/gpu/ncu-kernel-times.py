@@ -7,7 +7,10 @@ runs, longest first, with the launch count and, where the CSV has the DRAM
 bytes, the DRAM traffic and its rate. Used by gpu-check.sh's profile-build
 part on `octoray_bench_cuda --profile-build N` (two builds).
 
-    ncu-kernel-times.py PROFILE.csv [BUILDS]
+    ncu-kernel-times.py PROFILE.csv [BUILDS] [--launches]
+
+With --launches, every launch of that last run in order instead, in
+microseconds (the level phase's selects and loops, level by level).
 """
 import re
 import sys
@@ -53,11 +56,17 @@ def short_names(full_names):
 
 
 def main():
-    path = sys.argv[1]
-    builds = int(sys.argv[2]) if len(sys.argv) > 2 else 2
+    args = [a for a in sys.argv[1:] if a != "--launches"]
+    path = args[0]
+    builds = int(args[1]) if len(args) > 1 else 2
     everything = list(launches(path))
     last = everything[len(everything) - len(everything) // builds:]
     names = short_names(dict.fromkeys(full for full, _, _ in everything))
+    if "--launches" in sys.argv:
+        print(f"{path}: the last of {builds} builds, every launch in order")
+        for full, ms, _ in last:
+            print(f"  {1000 * ms:9.1f} us  {names[full]}")
+        return
     per = {}
     for full, ms, gb in last:
         total, count, traffic = per.get(names[full], (0.0, 0, 0.0))

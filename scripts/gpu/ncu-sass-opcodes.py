@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""What a kernel's instructions are: from Nsight Compute's source page of
+its SASS (ncu --section SourceCounters --page source --print-source sass),
+for the K-th table of the file (ncu 2025.3 writes two tables a profiled
+kernel, alike: the first kernel's is 0, the second's 2), the warp
+instructions executed and the stall samples per opcode, most executed
+first, and the most sampled instructions. Used on the build's leaf and inner
+loops (Benchmarks/gpu/variants-leaf-loop.txt).
+
+    ncu-sass-opcodes.py SOURCE.txt [K]
+"""
+import collections
+import sys
+
+
+def tables(lines):
+    """(first line, last line) of each table: its header starts with "Address"."""
+    starts = [i for i, line in enumerate(lines) if line.startswith("Address ")]
+    return list(zip(starts, starts[1:] + [len(lines)]))
+
+
+def instructions(lines, first, last):
+    """(SASS text, stall samples, warp instructions executed) per row."""
+    numbers_at = lines[first].index("Warp S")  # the first counter column
+    for line in lines[first + 1:last]:
+        if not line.startswith("0x"):
+            continue
+        fields = line[numbers_at:].split()
+        try:
+            samples, executed = int(fields[0]), int(fields[3])
+        except (IndexError, ValueError):
+            continue
+        yield line[19:numbers_at].strip(), samples, executed
+
+
+def opcode(sass):
+    words = sass.split()
+    word = words[1] if words[0].startswith("@") else words[0]
+    return word.split(".")[0]
+
+
+def main():
+    lines = open(sys.argv[1]).read().split("\n")
+    k = int(sys.argv[2]) if len(sys.argv) > 2 else 0
+    rows = list(instructions(lines, *tables(lines)[k]))
+    executed = collections.Counter()
+    sampled = collections.Counter()
+    for sass, samples, count in rows:
+        executed[opcode(sass)] += count
+        sampled[opcode(sass)] += samples
+    print(f"{len(rows)} instructions, {sum(sampled.values())} stall samples, "
+          f"{sum(executed.values())} warp instructions executed")
+    print("by opcode: warp instructions executed, stall samples")
+    for name, count in executed.most_common(25):
+        print(f"  {name:10s} {count:12d} {sampled[name]:8d}")
+    print("most sampled: samples, executed, instruction")
+    for sass, samples, count in sorted(rows, key=lambda r: -r[1])[:16]:
+        print(f"  {samples:7d} {count:10d}  {sass[:70]}")
+
+
+if __name__ == "__main__":
+    main()
