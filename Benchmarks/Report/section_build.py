@@ -306,6 +306,9 @@ def _cuda(ctx):
     # And since the pinned staging: the upload's own time beside the plain
     # and registered copies, and the memory with and without kept points.
     staging = all("pageable_upload_seconds" in r for r in builds)
+    # And since the staging's threads were kept: the host's half of the
+    # staging alone, the caller's arrays copied into page-locked memory.
+    host_copy = all(r.get("host_staging_copy_seconds") for r in builds)
     # And since the records travel with the keys: CUB's sort of what the
     # build sorts at depth 10 and less, 32-bit keys with 8-byte records (0
     # deeper, where it sorts the floor's pairs).
@@ -316,10 +319,11 @@ def _cuda(ctx):
             m = mem_records.get((r["n"], r["depth"]), {})
             staging_rows.append([count(r["n"]), r["depth"], seconds(r["upload_seconds"]),
                                  seconds(r["pageable_upload_seconds"]), seconds(r["registered_upload_seconds"]),
-                                 seconds(r["pinned_upload_seconds"]),
-                                 "%.2f" % (r["upload_seconds"] / r["pinned_upload_seconds"]),
-                                 "%.1f" % m.get("array_bytes_per_point", 0), "%.1f" % m.get("seconds", 0),
-                                 seconds(r["lean_seconds"]), "%.1f" % m.get("lean_bytes_per_point", 0)])
+                                 seconds(r["pinned_upload_seconds"])]
+                                + ([seconds(r["host_staging_copy_seconds"])] if host_copy else [])
+                                + ["%.2f" % (r["upload_seconds"] / r["pinned_upload_seconds"]),
+                                   "%.1f" % m.get("array_bytes_per_point", 0), "%.1f" % m.get("seconds", 0),
+                                   seconds(r["lean_seconds"]), "%.1f" % m.get("lean_bytes_per_point", 0)])
         row = [count(r["n"]), r["depth"], seconds(r["seconds"])]
         if phases:
             device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
@@ -445,19 +449,27 @@ def _cuda(ctx):
     if staging:
         text += [
             "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
-            "16 MB and more through page-locked buffers on up to 8 host threads (Rendering/Engine/octoray/"
+            + ("1 MB and more through page-locked buffers on up to 16 host threads, started once and kept, in "
+               "pieces that grow from 0.5 to 4 MB at the start of a thread's stripe and shrink toward its end "
+               if host_copy else "16 MB and more through page-locked buffers on up to 8 host threads ")
+            + "(Rendering/Engine/octoray/"
             "CudaUpload.h), the positions first and the attributes while the device computes the keys; *upload* is the "
             "host's "
             "time in those copies; *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
-            "arrays in place for the copy, *pinned* is the floor above. GPU bytes per point: the arrays alone; "
+            "arrays in place for the copy, *pinned* is the floor above%s. GPU bytes per point: the arrays alone; "
             "with the memory that the engine's allocator keeps for the next build (with the points kept, a "
             "rebuild fills a new octree beside the old one and then reuses the old one's memory instead of "
             "mapping new memory); and built without the points (`BuildOptions::keepPoints` off: node arrays "
-            "only, the allocator's cache given back), with that build's whole call.",
+            "only, the allocator's cache given back), with that build's whole call." % (
+                "; *host copy* is the host's half of the staging alone: the caller's arrays copied into "
+                "page-locked memory by as many threads, no DMA (octoray_bench_cuda's PinnedCopy::HostSeconds). "
+                "No upload through page-locked buffers takes less than the longer of the host copy and the pinned "
+                "copy" if host_copy else ""),
             "",
-            ctx.table(["points", "depth", "upload", "plain cudaMemcpy", "cudaHostRegister + copy", "pinned copy",
-                       "upload / pinned", "B/point, arrays", "B/point, with cache", "whole call, points not kept",
-                       "B/point, points not kept"], staging_rows),
+            ctx.table(["points", "depth", "upload", "plain cudaMemcpy", "cudaHostRegister + copy", "pinned copy"]
+                      + (["host copy"] if host_copy else [])
+                      + ["upload / pinned", "B/point, arrays", "B/point, with cache", "whole call, points not kept",
+                         "B/point, points not kept"], staging_rows),
             "",
         ]
     every = [r for r in records if r["name"] == "gpu bytes per point, every attribute"]

@@ -1,7 +1,8 @@
 // The shared pieces under the driver and the renderer, against plain
 // references: the CPU device's primitives (whatever the thread count, the
 // same results), the driver's run starts, first-failure search and level
-// sizes, the attribute list's slots, and the vector vocabulary's rounding.
+// sizes, the attribute list's slots, the kept threads of ChunkWorkers, and
+// the vector vocabulary's rounding.
 #include <octoray/CpuDevice.h>
 #include <octoray/OctreeDriver.h>
 #include <octoray/RenderKernels.h>
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <numeric>
 #include <random>
+#include <thread>
 
 using namespace octoray;
 
@@ -86,6 +88,59 @@ TEST(CpuDevice, ForEachReduceAndHistogramCoverEveryItemOnce)
       EXPECT_EQ(counts[b], reference[b]) << "bin " << b;
     }
   });
+}
+
+// The kept threads split each pass as ParallelChunks does, call every
+// chunk (empty ones too) on as many threads, over many passes, and pass on
+// the first chunk's exception once all have run.
+TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
+{
+  for (int chunks : { 1, 2, 3, 5 })
+  {
+    ChunkWorkers workers(chunks);
+    ASSERT_EQ(workers.Chunks(), chunks);
+    for (std::size_t n : { 0, 1, 4, 1000, 1001 })
+    {
+      SCOPED_TRACE("chunks " + std::to_string(chunks) + ", n " + std::to_string(n));
+      std::vector<int> seen(n, 0);
+      std::vector<std::pair<std::size_t, std::size_t>> ranges(chunks, { 1, 0 });
+      std::vector<std::thread::id> ids(chunks);
+      workers.Run(n, [&](std::size_t begin, std::size_t end, int c) {
+        ranges[c] = { begin, end };
+        ids[c] = std::this_thread::get_id();
+        for (std::size_t i = begin; i < end; ++i)
+        {
+          seen[i] += 1;
+        }
+      });
+      EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+      for (int c = 0; c < chunks; ++c)
+      {
+        EXPECT_EQ(ranges[c].first, n * c / chunks) << "chunk " << c;
+        EXPECT_EQ(ranges[c].second, n * (c + 1) / chunks) << "chunk " << c;
+      }
+      EXPECT_EQ(ids[0], std::this_thread::get_id());
+      std::sort(ids.begin(), ids.end());
+      EXPECT_EQ(std::unique(ids.begin(), ids.end()) - ids.begin(), chunks);
+    }
+    std::vector<int> ran(chunks, 0);
+    try
+    {
+      workers.Run(std::size_t(100), [&](std::size_t, std::size_t, int c) {
+        ran[c] = 1;
+        if (c > 0)
+        {
+          throw Error("chunk " + std::to_string(c));
+        }
+      });
+      EXPECT_EQ(chunks, 1) << "no chunk threw";
+    }
+    catch (const Error& e)
+    {
+      EXPECT_STREQ(e.what(), "chunk 1");
+    }
+    EXPECT_EQ(std::count(ran.begin(), ran.end(), 1), chunks);
+  }
 }
 
 TEST(CpuDevice, SelectKeepsOrderAndCounts)

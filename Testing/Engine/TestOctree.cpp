@@ -242,7 +242,7 @@ TEST_P(OctreeBuild, EmptyAndNonFiniteInputAreErrors)
 }
 
 // 1.5 M points of double positions, 36 MB: the CUDA backend copies them
-// through its pinned staging, in pieces of about 4 MB that it reduces to
+// through its pinned staging, in pieces of 0.5 to 4 MB that it reduces to
 // bounds as they land (Device::StageReduced). The cube must be the one
 // fitted to every point, wherever an extreme lies: in the first or last
 // point, or in points next to 4 MB boundaries, where a piece of a plain

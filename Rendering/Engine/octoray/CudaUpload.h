@@ -6,7 +6,8 @@
 // one per host thread; each thread copies its stripe through two pinned
 // buffers of its own, filling one while the copy engine reads the other,
 // so the host copies and the DMA overlap and several host threads keep
-// the bus busy. Arrays already in device memory (a CUDA simulation's) and
+// the bus busy; the threads and buffers are made at the first such copy
+// and kept. Arrays already in device memory (a CUDA simulation's) and
 // page-locked host arrays are copied directly. A caller may queue work on
 // each piece as it lands (Landed), which then runs while the rest of the
 // array is still on its way. Only compiled by nvcc.
@@ -18,33 +19,63 @@
 #include <algorithm>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace octoray
 {
 namespace cuda
 {
-// Below this many bytes cudaMemcpy from pageable memory costs less than
-// starting the staging threads.
-constexpr std::size_t kStagingThreshold = std::size_t(16) << 20;
+// Below this many bytes cudaMemcpy from pageable memory (through the
+// driver's own bounce buffer, a fraction of the bus's speed) takes about as
+// long as waking the staging threads and queueing their pieces.
+constexpr std::size_t kStagingThreshold = std::size_t(1) << 20;
 // Stripes and pieces start at multiples of this (3 x 256 bytes), so that no
 // piece splits a point of three floats or doubles.
 constexpr std::size_t kStripeAlignment = 768;
 // Each pinned buffer (about 4 MB, a multiple of kStripeAlignment): large
-// enough that a DMA's setup is small beside its transfer, small enough that
-// a stripe's first and last pieces (which do not overlap) are a small part
-// of it.
+// enough that a DMA's setup and the calls that queue it are small beside
+// its transfer.
 constexpr std::size_t kStagingPiece = (std::size_t(4) << 20) / kStripeAlignment * kStripeAlignment;
-constexpr int kMaxStagingThreads = 8;
+// A stripe's first and last pieces (about 512 kB): see PieceBytes.
+constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kStripeAlignment * kStripeAlignment;
+// How many pieces smaller than kStagingPiece PieceBytes cuts at each end of
+// a stripe, at most: the sizes double from kEdgePiece (twice: once at it),
+// and halve toward the end.
+constexpr std::size_t kEdgePieces = 6;
+static_assert(kStagingPiece / kEdgePiece <= 16, "kEdgePieces counts at most four doublings");
+// One host thread copies from pageable memory at a fraction of the bus's
+// speed, and several share the host's memory bandwidth: on the 16-core
+// host of an H100 the host's half of the staging took 3.0-3.9 ms for
+// 190 MB on 16 threads against 3.9-6.1 on 8 (octoray_bench_cuda,
+// Benchmarks/gpu/variants-staging.txt). Each thread keeps 2 x 4 MB of
+// page-locked memory: 128 MB at most.
+constexpr int kMaxStagingThreads = 16;
 
 // Work queued on a piece of a copy, bytes [begin, end) of the destination,
 // once it has landed: on `stream`, in whose order the piece's copy ran.
 using Landed = std::function<void(std::size_t begin, std::size_t end, cudaStream_t stream)>;
 
-// The most pieces a copy of `bytes` lands in (each stripe's last one may be short).
+// The bytes of a stripe's piece at `offset`, of the stripe [begin, end):
+// a multiple of kStripeAlignment but the stripe's last. The staging
+// threads start together and end together: while they fill their first
+// buffers the copy engine has nothing to do, and while it copies their last
+// ones the host waits. Pieces that grow from kEdgePiece at a stripe's start
+// and shrink toward its end keep both short.
+inline std::size_t PieceBytes(std::size_t offset, std::size_t begin, std::size_t end)
+{
+  const std::size_t left = end - offset;
+  const std::size_t grown = std::max(offset - begin, kEdgePiece);
+  const std::size_t shrunk = std::max(left / 2, kEdgePiece);
+  const std::size_t n = std::min({ kStagingPiece, grown, shrunk }) / kStripeAlignment * kStripeAlignment;
+  return std::min(n, left);
+}
+
+// The most pieces a copy of `bytes` lands in: in each stripe, its full
+// pieces and those PieceBytes cuts smaller at either end.
 inline std::size_t MaxPieces(std::size_t bytes)
 {
-  return bytes / kStagingPiece + kMaxStagingThreads + 1;
+  return bytes / kStagingPiece + kMaxStagingThreads * (2 * kEdgePieces + 1);
 }
 
 // Whether CUDA can copy from `p` without staging: device, managed or
@@ -100,9 +131,8 @@ public:
     {
       CudaCheck(cudaStreamSynchronize(0), what);
     }
-    const int stripes = static_cast<int>(Lanes.size());
     const std::size_t units = (bytes + kStripeAlignment - 1) / kStripeAlignment;
-    ParallelChunks(units, stripes, [&](std::size_t first, std::size_t last, int stripe) {
+    Workers->Run(units, [&](std::size_t first, std::size_t last, int stripe) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
       const std::size_t begin = first * kStripeAlignment;
       const std::size_t end = std::min(last * kStripeAlignment, bytes);
@@ -131,10 +161,10 @@ private:
       cudaStream_t stream;
       ~Drain() { cudaStreamSynchronize(stream); }
     } drain{ lane.stream };
-    for (std::size_t offset = begin, piece = 0; offset < end; offset += kStagingPiece, ++piece)
+    for (std::size_t offset = begin, piece = 0, n = 0; offset < end; offset += n, ++piece)
     {
       const int b = static_cast<int>(piece & 1);
-      const std::size_t n = std::min(kStagingPiece, end - offset);
+      n = PieceBytes(offset, begin, end);
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
       std::memcpy(lane.pinned[b], source + offset, n);
       CudaCheck(cudaMemcpyAsync(device + offset, lane.pinned[b], n, cudaMemcpyHostToDevice, lane.stream), what);
@@ -147,8 +177,8 @@ private:
     CudaCheck(cudaStreamSynchronize(lane.stream), what);
   }
 
-  // The lanes, made at the first large copy and kept; false (and the plain
-  // copy taken) where page-locked memory cannot be had.
+  // The lanes and their threads, made at the first large copy and kept;
+  // false (and the plain copy taken) where page-locked memory cannot be had.
   bool Allocate()
   {
     if (!Lanes.empty())
@@ -173,11 +203,13 @@ private:
         return false;
       }
     }
+    Workers = std::make_unique<ChunkWorkers>(threads);
     return true;
   }
 
   void Free()
   {
+    Workers.reset();
     for (Lane& lane : Lanes)
     {
       for (int b = 0; b < 2; ++b)
@@ -200,6 +232,7 @@ private:
   }
 
   std::vector<Lane> Lanes;
+  std::unique_ptr<ChunkWorkers> Workers; // one stripe each
 };
 }
 }
