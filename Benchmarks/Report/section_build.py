@@ -461,8 +461,9 @@ def _cuda(ctx):
             "rebuild fills a new octree beside the old one and then reuses the old one's memory instead of "
             "mapping new memory); and built without the points (`BuildOptions::keepPoints` off: node arrays "
             "only, the allocator's cache given back), with that build's whole call." % (
-                "; *host copy* is the host's half of the staging alone: the caller's arrays copied into "
-                "page-locked memory by as many threads, no DMA (octoray_bench_cuda's PinnedCopy::HostSeconds). "
+                "; *host copy* is the host's half of the staging alone: the caller's arrays copied piece by "
+                "piece into the same threads' page-locked buffers, no DMA (octoray_bench_cuda's "
+                "HostHalfOfStaging). "
                 "No upload through page-locked buffers takes less than the longer of the host copy and the pinned "
                 "copy" if host_copy else ""),
             "",
@@ -472,6 +473,24 @@ def _cuda(ctx):
                          "B/point, points not kept"], staging_rows),
             "",
         ]
+        if host_copy:
+            text += [
+                "The staging's threads start together and end together: with 4 MB pieces the copy engine waited "
+                "while they filled their first buffers and the host while it copied their last ones, once for "
+                "each array (three a build here), and the threads were started for each copy. With fb4365a's "
+                "staging built beside it and run in turn, two rounds (%s), the whole call went from 2.88–2.96 to "
+                "2.48–2.56 times the pinned copy at 10 M points with the ramped pieces and kept threads (the "
+                "ramp alone: 2.76–2.81), and from 2.35–2.55 to 2.22–2.25 with 16 threads instead of 8; staging "
+                "arrays from 1 MB instead of 16 took the 1 M-point call from 5.87–6.44 to 4.32–4.39 times. At 100 M "
+                "points the host's spread hides any difference: 1.45–2.38 across the variants and rounds, and "
+                "1.50 and 1.85 for one code. The host's half of the staging alone, the caller's arrays copied "
+                "into the threads' page-locked buffers without the DMA, takes less than the pinned copy on 16 "
+                "threads (the table's *host copy*); the upload at 10 M points still takes about 1.7 times the "
+                "longer of the two, which these runs do not explain (not measured: the CUDA calls of the "
+                "threads' pieces, about 17 a thread a build, contending for the driver)." % (
+                    "Benchmarks/gpu/variants-staging.txt"),
+                "",
+            ]
     every = [r for r in records if r["name"] == "gpu bytes per point, every attribute"]
     if every:
         r = every[0]
