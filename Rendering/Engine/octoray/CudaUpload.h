@@ -46,9 +46,9 @@ constexpr std::size_t kEdgePieces = 6;
 static_assert(kStagingPiece / kEdgePiece <= 16, "kEdgePieces counts at most four doublings");
 // One host thread copies from pageable memory at a fraction of the bus's
 // speed, and several share the host's memory bandwidth: on the 16-core
-// host of an H100 the host's half of the staging took 3.0-3.9 ms for
-// 190 MB on 16 threads against 3.9-6.1 on 8 (octoray_bench_cuda,
-// Benchmarks/gpu/variants-staging.txt). Each thread keeps 2 x 4 MB of
+// host of an H100 the host's half of the staging took 3.0-3.1 ms for
+// 190 MB on 16 threads against 3.9-6.1 on 8, in one run (octoray_bench_cuda,
+// Benchmarks/gpu/variants-staging.txt, call 3). Each thread keeps 2 x 4 MB of
 // page-locked memory: 128 MB at most.
 constexpr int kMaxStagingThreads = 16;
 
