@@ -30,6 +30,7 @@
 #include <cub/device/device_radix_sort.cuh>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -175,14 +176,36 @@ double BuildSortSeconds(std::size_t n, int depth)
   return SortedKeys::Narrow(depth) ? SortSeconds<std::uint32_t, std::uint64_t>(n, 3 * depth) : 0.0;
 }
 
+// A caller's host array the build reads.
+struct HostArray
+{
+  void* data;
+  std::size_t bytes;
+};
+
+// The cloud's arrays as the build reads them, in the order it copies them.
+std::array<HostArray, 3> InputArrays(Cloud& c)
+{
+  return { HostArray{ c.xyz.data(), c.xyz.size() * sizeof(float) }, HostArray{ c.rgb.data(), c.rgb.size() },
+    HostArray{ c.reflectivity.data(), c.reflectivity.size() * sizeof(float) } };
+}
+
+std::size_t InputBytes(Cloud& c)
+{
+  std::size_t total = 0;
+  for (const HostArray& a : InputArrays(c))
+    total += a.bytes;
+  return total;
+}
+
 // The copy a whole build call from host arrays cannot beat: every input
 // array the build reads, as one block of pinned host memory copied to the
 // device. Seconds() times one copy; 0 where the memory cannot be had.
 class PinnedCopy
 {
 public:
-  explicit PinnedCopy(const Cloud& c)
-    : Bytes(sizeof(float) * (c.xyz.size() + c.reflectivity.size()) + c.rgb.size())
+  explicit PinnedCopy(Cloud& c)
+    : Bytes(InputBytes(c))
   {
     if (cudaMallocHost(&Host, Bytes) != cudaSuccess || cudaMalloc(&Device, Bytes) != cudaSuccess)
     {
@@ -218,9 +241,9 @@ private:
 };
 
 // The host's half of the engine's staging alone (CudaUpload.h): the
-// caller's arrays, each cut into a stripe a staging thread, copied piece by
-// piece (cuda::PieceBytes) into that thread's two page-locked buffers in
-// turn, as the staging fills them; no DMA. No upload through such buffers
+// caller's arrays, each cut as the staging cuts them (StagingPieces.h),
+// copied piece by piece into each thread's two page-locked buffers in
+// turn; no DMA. No upload through such buffers
 // takes less than the longer of this and the pinned copy.
 class HostHalfOfStaging
 {
@@ -249,27 +272,19 @@ public:
   HostHalfOfStaging& operator=(const HostHalfOfStaging&) = delete;
 
   int ThreadCount() const { return Threads.Chunks(); }
-  double Seconds(const Cloud& c)
+  double Seconds(Cloud& c)
   {
     if (std::count(Buffers.begin(), Buffers.end(), nullptr))
     {
       return 0.0;
     }
-    const std::pair<const void*, std::size_t> arrays[3] = { { c.xyz.data(), c.xyz.size() * sizeof(float) },
-      { c.rgb.data(), c.rgb.size() }, { c.reflectivity.data(), c.reflectivity.size() * sizeof(float) } };
     const auto t0 = std::chrono::steady_clock::now();
-    for (const auto& a : arrays)
+    for (const HostArray& a : InputArrays(c))
     {
-      const char* source = static_cast<const char*>(a.first);
-      const std::size_t units = (a.second + octoray::cuda::kStripeAlignment - 1) / octoray::cuda::kStripeAlignment;
-      Threads.Run(units, [&](std::size_t first, std::size_t last, int stripe) {
-        const std::size_t begin = first * octoray::cuda::kStripeAlignment;
-        const std::size_t end = std::min(last * octoray::cuda::kStripeAlignment, a.second);
-        for (std::size_t offset = begin, piece = 0, n = 0; offset < end; offset += n, ++piece)
-        {
-          n = octoray::cuda::PieceBytes(offset, begin, end);
-          std::memcpy(Buffers[2 * stripe + (piece & 1)], source + offset, n);
-        }
+      const char* source = static_cast<const char*>(a.data);
+      Threads.Run(octoray::cuda::StripeUnits(a.bytes), [&](std::size_t first, std::size_t last, int stripe) {
+        octoray::cuda::ForEachPiece(octoray::cuda::StripeBytes(first, last, a.bytes),
+          [&](std::size_t offset, std::size_t n, int b) { std::memcpy(Buffers[2 * stripe + b], source + offset, n); });
       });
     }
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -321,24 +336,14 @@ struct UploadPeers
 
 UploadPeers MeasureUploadPeers(Cloud& c)
 {
-  struct Array
-  {
-    void* data;
-    std::size_t bytes;
-  };
-  const Array arrays[3] = { { c.xyz.data(), c.xyz.size() * sizeof(float) }, { c.rgb.data(), c.rgb.size() },
-    { c.reflectivity.data(), c.reflectivity.size() * sizeof(float) } };
-  std::size_t total = 0;
-  for (const Array& a : arrays)
-    total += a.bytes;
   void* device = nullptr;
   UploadPeers peers;
-  if (cudaMalloc(&device, total) != cudaSuccess)
+  if (cudaMalloc(&device, InputBytes(c)) != cudaSuccess)
     return peers;
   auto copyAll = [&](bool registerFirst) {
     char* to = static_cast<char*>(device);
     bool ok = true;
-    for (const Array& a : arrays)
+    for (const HostArray& a : InputArrays(c))
     {
       if (registerFirst)
         ok = ok && cudaHostRegister(a.data, a.bytes, cudaHostRegisterDefault) == cudaSuccess;

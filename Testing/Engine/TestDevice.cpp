@@ -1,11 +1,12 @@
 // The shared pieces under the driver and the renderer, against plain
 // references: the CPU device's primitives (whatever the thread count, the
 // same results), the driver's run starts, first-failure search and level
-// sizes, the attribute list's slots, the kept threads of ChunkWorkers, and
-// the vector vocabulary's rounding.
+// sizes, the attribute list's slots, the kept threads of ChunkWorkers, the
+// CUDA backend's staged pieces, and the vector vocabulary's rounding.
 #include <octoray/CpuDevice.h>
 #include <octoray/OctreeDriver.h>
 #include <octoray/RenderKernels.h>
+#include <octoray/StagingPieces.h>
 
 #include <gtest/gtest.h>
 
@@ -140,6 +141,50 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
       EXPECT_STREQ(e.what(), "chunk 1");
     }
     EXPECT_EQ(std::count(ran.begin(), ran.end(), 1), chunks);
+  }
+}
+
+// The CUDA backend's staged copy cuts each array into a stripe a thread
+// and each stripe into pieces (StagingPieces.h). For copies of many sizes on
+// 1 to kMaxStagingThreads threads, split as ChunkWorkers splits them: the
+// pieces cover each stripe in order; none is empty or larger than a
+// page-locked buffer; all but a stripe's last are whole multiples of
+// kStripeAlignment, so that no piece splits a point; and a copy has no more
+// pieces than MaxPieces, which sizes the partial bounds of the pieces.
+TEST(StagingPieces, CoverEachStripeWithinTheBuffersAndMaxPieces)
+{
+  using namespace octoray::cuda;
+  std::mt19937_64 rng(7);
+  std::vector<std::size_t> sizes = { 1, kStripeAlignment, kEdgePiece + 1, kStagingPiece, 3 * kStagingPiece + 5 };
+  for (int i = 0; i < 300; ++i)
+  {
+    sizes.push_back(std::size_t(1) + rng() % (std::size_t(3) << 30));
+  }
+  for (int threads = 1; threads <= kMaxStagingThreads; threads += 3)
+  {
+    ChunkWorkers workers(threads);
+    for (std::size_t bytes : sizes)
+    {
+      SCOPED_TRACE("bytes " + std::to_string(bytes) + ", threads " + std::to_string(threads));
+      std::vector<std::size_t> pieces(threads, 0), covered(threads, 0);
+      std::vector<int> bad(threads, 0);
+      workers.Run(StripeUnits(bytes), [&](std::size_t first, std::size_t last, int t) {
+        const Stripe stripe = StripeBytes(first, last, bytes);
+        std::size_t next = stripe.begin;
+        ForEachPiece(stripe, [&](std::size_t offset, std::size_t n, int buffer) {
+          const bool last = offset + n == stripe.end;
+          bad[t] += offset != next || n == 0 || n > kStagingPiece || (!last && n % kStripeAlignment != 0) ||
+            buffer != static_cast<int>(pieces[t] % 2);
+          next = offset + n;
+          ++pieces[t];
+        });
+        covered[t] = next - stripe.begin;
+        bad[t] += next != stripe.end;
+      });
+      EXPECT_EQ(std::accumulate(bad.begin(), bad.end(), 0), 0);
+      EXPECT_EQ(std::accumulate(covered.begin(), covered.end(), std::size_t(0)), bytes);
+      EXPECT_LE(std::accumulate(pieces.begin(), pieces.end(), std::size_t(0)), MaxPieces(bytes));
+    }
   }
 }
 

@@ -15,6 +15,7 @@
 
 #include "CudaSupport.h"
 #include "Parallel.h"
+#include "StagingPieces.h"
 
 #include <algorithm>
 #include <cstring>
@@ -30,53 +31,9 @@ namespace cuda
 // driver's own bounce buffer, a fraction of the bus's speed) takes about as
 // long as waking the staging threads and queueing their pieces.
 constexpr std::size_t kStagingThreshold = std::size_t(1) << 20;
-// Stripes and pieces start at multiples of this (3 x 256 bytes), so that no
-// piece splits a point of three floats or doubles.
-constexpr std::size_t kStripeAlignment = 768;
-// Each pinned buffer (about 4 MB, a multiple of kStripeAlignment): large
-// enough that a DMA's setup and the calls that queue it are small beside
-// its transfer.
-constexpr std::size_t kStagingPiece = (std::size_t(4) << 20) / kStripeAlignment * kStripeAlignment;
-// A stripe's first and last pieces (about 512 kB): see PieceBytes.
-constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kStripeAlignment * kStripeAlignment;
-// How many pieces smaller than kStagingPiece PieceBytes cuts at each end of
-// a stripe, at most: the sizes double from kEdgePiece (twice: once at it),
-// and halve toward the end.
-constexpr std::size_t kEdgePieces = 6;
-static_assert(kStagingPiece / kEdgePiece <= 16, "kEdgePieces counts at most four doublings");
-// One host thread copies from pageable memory at a fraction of the bus's
-// speed, and several share the host's memory bandwidth: on the 16-core
-// host of an H100 the host's half of the staging took 3.0-3.1 ms for
-// 190 MB on 16 threads against 3.9-6.1 on 8, in one run (octoray_bench_cuda,
-// Benchmarks/gpu/variants-staging.txt, call 3). Each thread keeps 2 x 4 MB of
-// page-locked memory: 128 MB at most.
-constexpr int kMaxStagingThreads = 16;
-
 // Work queued on a piece of a copy, bytes [begin, end) of the destination,
 // once it has landed: on `stream`, in whose order the piece's copy ran.
 using Landed = std::function<void(std::size_t begin, std::size_t end, cudaStream_t stream)>;
-
-// The bytes of a stripe's piece at `offset`, of the stripe [begin, end):
-// a multiple of kStripeAlignment but the stripe's last. The staging
-// threads start together and end together: while they fill their first
-// buffers the copy engine has nothing to do, and while it copies their last
-// ones the host waits. Pieces that grow from kEdgePiece at a stripe's start
-// and shrink toward its end keep both short.
-inline std::size_t PieceBytes(std::size_t offset, std::size_t begin, std::size_t end)
-{
-  const std::size_t left = end - offset;
-  const std::size_t grown = std::max(offset - begin, kEdgePiece);
-  const std::size_t shrunk = std::max(left / 2, kEdgePiece);
-  const std::size_t n = std::min({ kStagingPiece, grown, shrunk }) / kStripeAlignment * kStripeAlignment;
-  return std::min(n, left);
-}
-
-// The most pieces a copy of `bytes` lands in: in each stripe, its full
-// pieces and those PieceBytes cuts smaller at either end.
-inline std::size_t MaxPieces(std::size_t bytes)
-{
-  return bytes / kStagingPiece + kMaxStagingThreads * (2 * kEdgePieces + 1);
-}
 
 // Whether CUDA can copy from `p` without staging: device, managed or
 // page-locked host memory.
@@ -131,13 +88,10 @@ public:
     {
       CudaCheck(cudaStreamSynchronize(0), what);
     }
-    const std::size_t units = (bytes + kStripeAlignment - 1) / kStripeAlignment;
-    Workers->Run(units, [&](std::size_t first, std::size_t last, int stripe) {
+    Workers->Run(StripeUnits(bytes), [&](std::size_t first, std::size_t last, int stripe) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
-      const std::size_t begin = first * kStripeAlignment;
-      const std::size_t end = std::min(last * kStripeAlignment, bytes);
-      CopyStripe(Lanes[stripe], static_cast<char*>(device), static_cast<const char*>(source), begin, end, what,
-        landed);
+      CopyStripe(Lanes[stripe], static_cast<char*>(device), static_cast<const char*>(source),
+        StripeBytes(first, last, bytes), what, landed);
     });
   }
 
@@ -150,21 +104,18 @@ private:
     cudaEvent_t copied[2] = { nullptr, nullptr };
   };
 
-  // Bytes [begin, end) of the copy, through the lane's two pinned buffers.
+  // A stripe of the copy, through the lane's two pinned buffers in turn.
   // Returns, or throws, once the lane has finished what it queued: the
   // destination may be freed right after.
-  static void CopyStripe(Lane& lane, char* device, const char* source, std::size_t begin, std::size_t end,
-    const char* what, const Landed& landed)
+  static void CopyStripe(Lane& lane, char* device, const char* source, Stripe stripe, const char* what,
+    const Landed& landed)
   {
     struct Drain
     {
       cudaStream_t stream;
       ~Drain() { cudaStreamSynchronize(stream); }
     } drain{ lane.stream };
-    for (std::size_t offset = begin, piece = 0, n = 0; offset < end; offset += n, ++piece)
-    {
-      const int b = static_cast<int>(piece & 1);
-      n = PieceBytes(offset, begin, end);
+    ForEachPiece(stripe, [&](std::size_t offset, std::size_t n, int b) {
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
       std::memcpy(lane.pinned[b], source + offset, n);
       CudaCheck(cudaMemcpyAsync(device + offset, lane.pinned[b], n, cudaMemcpyHostToDevice, lane.stream), what);
@@ -173,7 +124,7 @@ private:
       {
         landed(offset, offset + n, lane.stream);
       }
-    }
+    });
     CudaCheck(cudaStreamSynchronize(lane.stream), what);
   }
 
