@@ -487,7 +487,8 @@ def _cuda(ctx):
                 "into the threads' page-locked buffers without the DMA, takes less than the pinned copy on 16 "
                 "threads (the table's *host copy*); the upload at 10 M points still takes about 1.7 times the "
                 "longer of the two, which these runs do not explain (not measured: the CUDA calls of the "
-                "threads' pieces, about 17 a thread a build, contending for the driver)." % (
+                "threads' pieces contending for the driver: at 10 M points a thread's stripes of the three arrays are "
+                "8, 4 and 5 pieces, StagingPieces.h's PieceBytes, each an event wait, a copy and an event)." % (
                     "Benchmarks/gpu/variants-staging.txt"),
                 "",
             ]
