@@ -10,8 +10,9 @@
 //    updates and without them (the node arrays alone), and per array for
 //    100 M points with every attribute;
 //  - the upload of the caller's pageable arrays beside plain cudaMemcpy and
-//    cudaHostRegister of the same arrays, and beside the host's half of the
-//    engine's staging alone (--only build skips the rest);
+//    cudaHostRegister of the same arrays, beside the host's half of the
+//    engine's staging alone and at once with the pinned copy, and beside
+//    the engine's staged copy alone (--only build skips the rest);
 //  - with --billion N: N points generated on the device, built without
 //    their points, and traced at 1920x1080 (build time, bytes per point,
 //    frame time);
@@ -40,6 +41,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -295,6 +297,55 @@ private:
   std::vector<void*> Buffers; // two a thread
 };
 
+// The host's half of the staging and the pinned copy run at once, the
+// longer of the two timed: both read the host's memory (the first also
+// writes it), so each slows the other. A staged upload takes at least this.
+double HostHalfBesidePinnedCopy(HostHalfOfStaging& half, PinnedCopy& copy, Cloud& c)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  std::thread dma([&] { copy.Seconds(); });
+  half.Seconds(c);
+  dma.join();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The engine's staged copy alone (CudaUpload.h's HostStaging), nothing
+// queued on its pieces: the input arrays one Copy each, as a build copies
+// them, and all their bytes as one pageable block in a single Copy. Medians
+// of 5 after a warm-up copy (TimeMedian); 0 where the device memory cannot be had.
+struct StagedCopies
+{
+  double byArray = 0.0;
+  double oneBlock = 0.0;
+};
+
+StagedCopies MeasureStagedCopies(Cloud& c)
+{
+  StagedCopies result;
+  const std::size_t bytes = InputBytes(c);
+  void* device = nullptr;
+  if (cudaMalloc(&device, bytes) != cudaSuccess)
+  {
+    cudaGetLastError();
+    return result;
+  }
+  std::vector<char> block(bytes, 1);
+  octoray::cuda::HostStaging staging;
+  auto byArray = [&] {
+    char* to = static_cast<char*>(device);
+    for (const HostArray& a : InputArrays(c))
+    {
+      staging.Copy(to, a.data, a.bytes, "staged copy peer");
+      to += a.bytes;
+    }
+  };
+  auto oneBlock = [&] { staging.Copy(device, block.data(), bytes, "staged copy peer"); };
+  result.byArray = TimeMedian(5, byArray);
+  result.oneBlock = TimeMedian(5, oneBlock);
+  cudaFree(device);
+  return result;
+}
+
 // A build's whole call against the pinned copy, measured pair by pair
 // (build, then copy, `repeats` times after a warm-up build): the medians of
 // each and the median of the pairs' ratios, which a drift of the host's
@@ -332,6 +383,8 @@ struct UploadPeers
   double pageable = 0.0;
   double registered = 0.0;
   double hostStaging = 0.0; // HostHalfOfStaging, median of 5
+  double hostBesideCopy = 0.0; // HostHalfBesidePinnedCopy, median of 5
+  StagedCopies staged;
 };
 
 UploadPeers MeasureUploadPeers(Cloud& c)
@@ -624,10 +677,20 @@ int Run(int argc, char** argv)
       hostTimes.push_back(hostHalf.Seconds(c));
     }
     peers.hostStaging = Median(hostTimes);
+    std::vector<double> besideTimes;
+    for (int r = 0; r < 5; ++r)
+    {
+      besideTimes.push_back(HostHalfBesidePinnedCopy(hostHalf, pinned, c));
+    }
+    peers.hostBesideCopy = Median(besideTimes);
+    peers.staged = MeasureStagedCopies(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
-                "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms\n",
+                "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "
+                "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms (one block %.3f "
+                "ms)\n",
       n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
-      hostHalf.ThreadCount(), peers.hostStaging * 1e3);
+      hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged.byArray * 1e3,
+      peers.staged.oneBlock * 1e3);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
@@ -668,6 +731,8 @@ int Run(int argc, char** argv)
           { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
           { "host_staging_copy_seconds", peers.hostStaging },
+          { "host_staging_beside_copy_seconds", peers.hostBesideCopy },
+          { "staged_copy_seconds", peers.staged.byArray }, { "staged_block_seconds", peers.staged.oneBlock },
           { "lean_seconds", leanSeconds } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
         { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });
