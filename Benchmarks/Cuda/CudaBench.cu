@@ -243,8 +243,8 @@ private:
 };
 
 // The host's half of the engine's staging alone (CudaUpload.h): the
-// caller's arrays, each cut as the staging cuts them (StagingPieces.h),
-// copied piece by piece into each thread's two page-locked buffers in
+// caller's arrays, laid end to end and cut as the staging cuts them
+// (StagingPieces.h), copied piece by piece into each thread's two page-locked buffers in
 // turn; no DMA. No upload through such buffers
 // takes less than the longer of this and the pinned copy.
 class HostHalfOfStaging
@@ -280,15 +280,15 @@ public:
     {
       return 0.0;
     }
+    const std::array<HostArray, 3> arrays = InputArrays(c);
+    const octoray::cuda::StagingRun run({ arrays[0].bytes, arrays[1].bytes, arrays[2].bytes });
     const auto t0 = std::chrono::steady_clock::now();
-    for (const HostArray& a : InputArrays(c))
-    {
-      const char* source = static_cast<const char*>(a.data);
-      Threads.Run(octoray::cuda::StripeUnits(a.bytes), [&](std::size_t first, std::size_t last, int stripe) {
-        octoray::cuda::ForEachPiece(octoray::cuda::StripeBytes(first, last, a.bytes),
-          [&](std::size_t offset, std::size_t n, int b) { std::memcpy(Buffers[2 * stripe + b], source + offset, n); });
-      });
-    }
+    Threads.Run(octoray::cuda::StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int stripe) {
+      octoray::cuda::ForEachPiece(run, octoray::cuda::StripeBytes(first, last, run.Length()),
+        [&](std::size_t array, std::size_t offset, std::size_t n, int b) {
+          std::memcpy(Buffers[2 * stripe + b], static_cast<const char*>(arrays[array].data) + offset, n);
+        });
+    });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
@@ -309,41 +309,29 @@ double HostHalfBesidePinnedCopy(HostHalfOfStaging& half, PinnedCopy& copy, Cloud
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The engine's staged copy alone (CudaUpload.h's HostStaging), nothing
-// queued on its pieces: the input arrays one Copy each, as a build copies
-// them, and all their bytes as one pageable block in a single Copy. Medians
-// of 5 after a warm-up copy (TimeMedian); 0 where the device memory cannot be had.
-struct StagedCopies
+// The engine's staged copy alone (CudaUpload.h's HostStaging) of the input
+// arrays in one pass, as a build copies them, nothing queued on its pieces:
+// the median of 5 after a warm-up copy (TimeMedian); 0 where the device
+// memory cannot be had.
+double StagedCopySeconds(Cloud& c)
 {
-  double byArray = 0.0;
-  double oneBlock = 0.0;
-};
-
-StagedCopies MeasureStagedCopies(Cloud& c)
-{
-  StagedCopies result;
-  const std::size_t bytes = InputBytes(c);
   void* device = nullptr;
-  if (cudaMalloc(&device, bytes) != cudaSuccess)
+  if (cudaMalloc(&device, InputBytes(c)) != cudaSuccess)
   {
     cudaGetLastError();
-    return result;
+    return 0.0;
   }
-  std::vector<char> block(bytes, 1);
+  std::vector<octoray::cuda::CopyPart> parts;
+  char* to = static_cast<char*>(device);
+  for (const HostArray& a : InputArrays(c))
+  {
+    parts.push_back(octoray::cuda::CopyPart{ to, a.data, a.bytes, "staged copy peer", nullptr });
+    to += a.bytes;
+  }
   octoray::cuda::HostStaging staging;
-  auto byArray = [&] {
-    char* to = static_cast<char*>(device);
-    for (const HostArray& a : InputArrays(c))
-    {
-      staging.Copy(to, a.data, a.bytes, "staged copy peer");
-      to += a.bytes;
-    }
-  };
-  auto oneBlock = [&] { staging.Copy(device, block.data(), bytes, "staged copy peer"); };
-  result.byArray = TimeMedian(5, byArray);
-  result.oneBlock = TimeMedian(5, oneBlock);
+  const double seconds = TimeMedian(5, [&] { staging.Copy(parts); });
   cudaFree(device);
-  return result;
+  return seconds;
 }
 
 // A build's whole call against the pinned copy, measured pair by pair
@@ -384,7 +372,7 @@ struct UploadPeers
   double registered = 0.0;
   double hostStaging = 0.0; // HostHalfOfStaging, median of 5
   double hostBesideCopy = 0.0; // HostHalfBesidePinnedCopy, median of 5
-  StagedCopies staged;
+  double staged = 0.0;         // StagedCopySeconds
 };
 
 UploadPeers MeasureUploadPeers(Cloud& c)
@@ -683,14 +671,12 @@ int Run(int argc, char** argv)
       besideTimes.push_back(HostHalfBesidePinnedCopy(hostHalf, pinned, c));
     }
     peers.hostBesideCopy = Median(besideTimes);
-    peers.staged = MeasureStagedCopies(c);
+    peers.staged = StagedCopySeconds(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "
-                "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms (one block %.3f "
-                "ms)\n",
+                "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms\n",
       n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
-      hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged.byArray * 1e3,
-      peers.staged.oneBlock * 1e3);
+      hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged * 1e3);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
@@ -732,7 +718,7 @@ int Run(int argc, char** argv)
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
           { "host_staging_copy_seconds", peers.hostStaging },
           { "host_staging_beside_copy_seconds", peers.hostBesideCopy },
-          { "staged_copy_seconds", peers.staged.byArray }, { "staged_block_seconds", peers.staged.oneBlock },
+          { "staged_copy_seconds", peers.staged },
           { "lean_seconds", leanSeconds } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
         { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });

@@ -144,46 +144,68 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
   }
 }
 
-// The CUDA backend's staged copy cuts each array into a stripe a thread
-// and each stripe into pieces (StagingPieces.h). For copies of many sizes on
-// 1 to kMaxStagingThreads threads, split as ChunkWorkers splits them: the
-// pieces cover each stripe in order; none is empty or larger than a
-// page-locked buffer; all but a stripe's last are whole multiples of
-// kStripeAlignment, so that no piece splits a point; and a copy has no more
-// pieces than MaxPieces, which sizes the partial bounds of the pieces.
-TEST(StagingPieces, CoverEachStripeWithinTheBuffersAndMaxPieces)
+// The CUDA backend's staged copy lays a copy's arrays end to end and cuts
+// the run into a stripe a thread and each stripe into pieces
+// (StagingPieces.h). For runs of one to four arrays of many sizes (empty
+// ones among them) on 1 to kMaxStagingThreads threads, split as
+// ChunkWorkers splits them: the pieces cover every array once, each
+// stripe's in order; none is empty, larger than a page-locked buffer, or
+// past its array; each starts at a whole multiple of kStripeAlignment into
+// its array, so that no piece splits a point; the buffers alternate; and no
+// array gets more pieces than MaxPieces, which sizes the partial bounds of
+// its pieces.
+TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
 {
   using namespace octoray::cuda;
   std::mt19937_64 rng(7);
-  std::vector<std::size_t> sizes = { 1, kStripeAlignment, kEdgePiece + 1, kStagingPiece, 3 * kStagingPiece + 5 };
+  std::vector<std::vector<std::size_t>> runs = { { 1 }, { kStripeAlignment }, { kEdgePiece + 1 }, { kStagingPiece },
+    { 3 * kStagingPiece + 5 }, { 0, 5 }, { 120000000, 30000000, 40000000 } };
   for (int i = 0; i < 300; ++i)
   {
-    sizes.push_back(std::size_t(1) + rng() % (std::size_t(3) << 30));
+    std::vector<std::size_t> run(1 + rng() % 4);
+    for (std::size_t& bytes : run)
+    {
+      bytes = rng() % 8 == 0 ? rng() % 3 : std::size_t(1) + rng() % (std::size_t(1) << (10 + rng() % 21));
+    }
+    runs.push_back(run);
   }
   for (int threads = 1; threads <= kMaxStagingThreads; threads += 3)
   {
     ChunkWorkers workers(threads);
-    for (std::size_t bytes : sizes)
+    for (const std::vector<std::size_t>& arrays : runs)
     {
-      SCOPED_TRACE("bytes " + std::to_string(bytes) + ", threads " + std::to_string(threads));
-      std::vector<std::size_t> pieces(threads, 0), covered(threads, 0);
+      const StagingRun run(arrays);
+      SCOPED_TRACE("first array " + std::to_string(arrays[0]) + " bytes of " + std::to_string(arrays.size()) +
+        ", threads " + std::to_string(threads));
+      std::vector<std::vector<std::size_t>> pieces(threads, std::vector<std::size_t>(arrays.size(), 0));
+      std::vector<std::vector<std::size_t>> covered = pieces;
       std::vector<int> bad(threads, 0);
-      workers.Run(StripeUnits(bytes), [&](std::size_t first, std::size_t last, int t) {
-        const Stripe stripe = StripeBytes(first, last, bytes);
-        std::size_t next = stripe.begin;
-        ForEachPiece(stripe, [&](std::size_t offset, std::size_t n, int buffer) {
-          const bool last = offset + n == stripe.end;
-          bad[t] += offset != next || n == 0 || n > kStagingPiece || (!last && n % kStripeAlignment != 0) ||
-            buffer != static_cast<int>(pieces[t] % 2);
-          next = offset + n;
-          ++pieces[t];
+      workers.Run(StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int t) {
+        const Stripe stripe = StripeBytes(first, last, run.Length());
+        std::size_t next = stripe.begin; // in the run
+        int count = 0;
+        ForEachPiece(run, stripe, [&](std::size_t array, std::size_t offset, std::size_t n, int buffer) {
+          const std::size_t at = run.start[array] + offset;
+          bad[t] += at < next || n == 0 || n > kStagingPiece || offset + n > arrays[array] ||
+            offset % kStripeAlignment != 0 || buffer != count++ % 2;
+          next = at + n;
+          ++pieces[t][array];
+          covered[t][array] += n;
         });
-        covered[t] = next - stripe.begin;
-        bad[t] += next != stripe.end;
+        bad[t] += next > stripe.end;
       });
       EXPECT_EQ(std::accumulate(bad.begin(), bad.end(), 0), 0);
-      EXPECT_EQ(std::accumulate(covered.begin(), covered.end(), std::size_t(0)), bytes);
-      EXPECT_LE(std::accumulate(pieces.begin(), pieces.end(), std::size_t(0)), MaxPieces(bytes));
+      for (std::size_t a = 0; a < arrays.size(); ++a)
+      {
+        std::size_t bytes = 0, count = 0;
+        for (int t = 0; t < threads; ++t)
+        {
+          bytes += covered[t][a];
+          count += pieces[t][a];
+        }
+        EXPECT_EQ(bytes, arrays[a]) << "array " << a;
+        EXPECT_LE(count, MaxPieces(arrays[a])) << "array " << a;
+      }
     }
   }
 }

@@ -4,7 +4,9 @@
 # replaces Rendering/Engine/octoray/FILE.h (Traversal.h, CudaUpload.h, ...)
 # in a copy of the tree with a build folder of its own; "main" names the
 # tree itself; a .gpu-vtk/variants/FILE.NAME.cpp replaces FILE.cpp there
-# alike (CpuEngine.cpp, which the render headers' callers live in). All are
+# alike (CpuEngine.cpp, which the render headers' callers live in), and a
+# .gpu-vtk/variants/CudaBench.NAME.cu the benchmark (for a variant whose
+# engine the tree's benchmark no longer compiles against). All are
 # built first (in parallel), then `octoray_bench_cuda
 # --only SECTION` (default render) runs ROUNDS times (default 1) over all of
 # them in turn, so that a drift of the card's clocks reaches every variant
@@ -41,9 +43,13 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
   # Tracked files and new ones not yet in the index the copy arrived with.
   git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$src"
   cp -r .gpu-vtk "$src/"
-  for ext in h cpp; do
+  for ext in h cpp cu; do
     for f in .gpu-vtk/variants/*."$v".$ext; do
-      [ -e "$f" ] && cp "$f" "$src/Rendering/Engine/octoray/$(basename "$f" ."$v".$ext).$ext"
+      [ -e "$f" ] || continue
+      # The tracked file of that name (one of the engine's or the benchmark's).
+      target=$(git ls-files Rendering/Engine Benchmarks/Cuda | grep -E "(^|/)$(basename "$f" ."$v".$ext)\.$ext\$")
+      [ "$(echo "$target" | wc -l)" = 1 ] && [ -n "$target" ] || { echo "== $v: no one file for $f" >&2; exit 1; }
+      cp "$f" "$src/$target"
     done
   done
   # The tests belong to the tree's own headers: built in "main" alone.

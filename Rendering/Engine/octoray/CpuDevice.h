@@ -106,21 +106,21 @@ public:
   {
     return Staged<T>{ host };
   }
+  // Loops read a caller's arrays where they are: nothing to copy.
+  struct Fills
+  {
+  };
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* host, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result)
+    Combine combine, R& result, Fills = {})
   {
     result = Reduce(n / stride, identity, [&](std::size_t i) { return map(i, host); }, combine);
     return Stage(host, n, what);
   }
   template <typename T>
-  Staged<T> Prepare(const T* host, std::size_t n, const char* what)
+  Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&)
   {
     return Stage(host, n, what);
-  }
-  template <typename T>
-  void Fill(Staged<T>&, const T*, std::size_t, const char*)
-  {
   }
   template <typename T>
   void Adopt(const Staged<T>& staged, Buffer<T>& buffer, std::size_t n)

@@ -237,14 +237,17 @@ public:
     }
     return staged;
   }
+  // Copies that a Prepare left for the next StageReduced, which makes them
+  // in the same pass of the staging threads as its own.
+  using Fills = std::vector<cuda::CopyPart>;
   // Stage, with the reduction of its items of `stride` elements: each piece
   // of the copy is reduced on the stream that copied it as soon as it lands
   // (CudaUpload.h: no piece splits an item of three floats or doubles),
   // while the rest of the array is still on its way, and the pieces'
-  // results once the copy is complete.
+  // results once the copy is complete. The copies `along` go with it.
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result)
+    Combine combine, R& result, Fills along = {})
   {
     const std::size_t itemBytes = stride * sizeof(T);
     if (cuda::kStripeAlignment % itemBytes != 0)
@@ -253,48 +256,43 @@ public:
     }
     Staged<T> staged;
     result = identity;
-    if (!source)
-    {
-      return staged;
-    }
-    Reserve(staged, n, what);
     Buffer<R> partial;
-    Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
-      "partial reductions");
-    const T* data = staged.Get();
-    R* partials = partial.Get();
     std::atomic<std::size_t> used{ 0 };
-    Staging.Copy(staged.Get(), source, n * sizeof(T), what, cuda::QueuedLoops::WaitFor,
-      [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
-        const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
-        const std::size_t slot = used.fetch_add(blocks);
-        LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
-          data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
-      });
-    result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine);
+    if (source)
+    {
+      Reserve(staged, n, what);
+      Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
+        "partial reductions");
+      const T* data = staged.Get();
+      R* partials = partial.Get();
+      along.insert(along.begin(), cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what,
+        [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
+          const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
+          const std::size_t slot = used.fetch_add(blocks);
+          LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
+            data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
+        } });
+    }
+    Staging.Copy(along);
+    if (source)
+    {
+      result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partial.Get() }, combine);
+    }
     return staged;
   }
-  // Stage in two steps, for a copy that overlaps loops: Prepare takes the
-  // device memory before those loops are queued (memory taken after them
-  // is, in the stream's order, only free once they have run), and Fill
-  // copies into it without waiting for them.
+  // Room for a caller's array where loops read it, filled by the next
+  // StageReduced given `fills` (on the CPU, the array itself): arrays
+  // staged together share the staging's ramps (StagingPieces.h).
   template <typename T>
-  Staged<T> Prepare(const T* source, std::size_t n, const char* what)
+  Staged<T> Prepare(const T* source, std::size_t n, const char* what, Fills& fills)
   {
     Staged<T> staged;
     if (source)
     {
       Reserve(staged, n, what);
+      fills.push_back(cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what, nullptr });
     }
     return staged;
-  }
-  template <typename T>
-  void Fill(Staged<T>& staged, const T* source, std::size_t n, const char* what)
-  {
-    if (source)
-    {
-      Staging.Copy(staged.Get(), source, n * sizeof(T), what, cuda::QueuedLoops::MayRun);
-    }
   }
   template <typename T>
   void Adopt(Staged<T>&& staged, Buffer<T>& buffer, std::size_t)

@@ -2,11 +2,12 @@
 // memory. A VTK array lives in ordinary (pageable) host memory, from which
 // cudaMemcpy goes through the driver's own small bounce buffer at a
 // fraction of what the bus carries (octoray_bench_cuda measures both
-// beside the engine's own upload). Large arrays are cut into stripes,
-// one per host thread; each thread copies its stripe through two pinned
-// buffers of its own, filling one while the copy engine reads the other,
-// so the host copies and the DMA overlap and several host threads keep
-// the bus busy; the threads and buffers are made at the first such copy
+// beside the engine's own upload). The arrays of one copy are laid end
+// to end (StagingPieces.h) and cut into stripes, one per host thread, so
+// that one pass of the threads serves them all; each thread copies its
+// stripe through two pinned buffers of its own, filling one while the
+// copy engine reads the other, so the host copies and the DMA overlap and
+// several host threads keep the bus busy; the threads and buffers are made at the first such copy
 // and kept. Arrays already in device memory (a CUDA simulation's) and
 // page-locked host arrays are copied directly. A caller may queue work on
 // each piece as it lands (Landed), which then runs while the rest of the
@@ -21,15 +22,17 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace octoray
 {
 namespace cuda
 {
-// Below this many bytes cudaMemcpy from pageable memory (through the
-// driver's own bounce buffer, a fraction of the bus's speed) takes about as
-// long as waking the staging threads and queueing their pieces.
+// Below this many bytes (a copy's pageable arrays together) cudaMemcpy
+// from pageable memory (through the driver's own bounce buffer, a fraction
+// of the bus's speed) takes about as long as waking the staging threads
+// and queueing their pieces.
 constexpr std::size_t kStagingThreshold = std::size_t(1) << 20;
 // Work queued on a piece of a copy, bytes [begin, end) of the destination,
 // once it has landed: on `stream`, in whose order the piece's copy ran.
@@ -48,13 +51,15 @@ inline bool DirectlyCopyable(const void* p)
   return attributes.type != cudaMemoryTypeUnregistered;
 }
 
-// Whether a copy must first wait for the loops queued on the default
-// stream: it must where its destination may be memory that one of them
-// still reads (freed and taken again in the stream's order).
-enum class QueuedLoops
+// One array of a copy: `bytes` from `source` (host or device memory) to
+// `device`, and the work to queue on each of its pieces as it lands.
+struct CopyPart
 {
-  WaitFor,
-  MayRun
+  void* device;
+  const void* source;
+  std::size_t bytes;
+  std::string what; // names the array in an error
+  Landed landed;
 };
 
 class HostStaging
@@ -68,30 +73,43 @@ public:
   // Copies `bytes` from `source` (host or device memory) to `device` on the
   // current device; returns once the copy, and the work `landed` queued on
   // its pieces, is complete.
-  void Copy(void* device, const void* source, std::size_t bytes, const char* what,
-    QueuedLoops queued = QueuedLoops::WaitFor, const Landed& landed = nullptr)
+  void Copy(void* device, const void* source, std::size_t bytes, const char* what, const Landed& landed = nullptr)
   {
-    if (bytes < kStagingThreshold || DirectlyCopyable(source) || !Allocate())
+    Copy({ CopyPart{ device, source, bytes, what, landed } });
+  }
+
+  // Copies every part, after the loops queued on the default stream (the
+  // staging streams do not wait for them by themselves); returns once the
+  // copies and the work queued on their pieces are complete. Parts CUDA
+  // copies directly go so; the others are staged in one pass.
+  void Copy(const std::vector<CopyPart>& parts)
+  {
+    std::vector<CopyPart> staged;
+    std::vector<std::size_t> stagedBytes;
+    for (const CopyPart& part : parts)
     {
-      CudaCheck(cudaMemcpy(device, source, bytes, cudaMemcpyDefault), what);
-      if (landed)
+      if (DirectlyCopyable(part.source))
       {
-        landed(0, bytes, 0);
-        CudaCheck(cudaStreamSynchronize(0), what);
+        CopyDirectly(part);
       }
+      else
+      {
+        staged.push_back(part);
+        stagedBytes.push_back(part.bytes);
+      }
+    }
+    const StagingRun run(stagedBytes);
+    if (run.Length() < kStagingThreshold || !Allocate())
+    {
+      std::for_each(staged.begin(), staged.end(), CopyDirectly);
       return;
     }
     int current = 0;
     CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
-    // The staging streams do not wait for the default stream by themselves.
-    if (queued == QueuedLoops::WaitFor)
-    {
-      CudaCheck(cudaStreamSynchronize(0), what);
-    }
-    Workers->Run(StripeUnits(bytes), [&](std::size_t first, std::size_t last, int stripe) {
+    CudaCheck(cudaStreamSynchronize(0), staged.front().what.c_str());
+    Workers->Run(StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int stripe) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
-      CopyStripe(Lanes[stripe], static_cast<char*>(device), static_cast<const char*>(source),
-        StripeBytes(first, last, bytes), what, landed);
+      CopyStripe(Lanes[stripe], staged, run, StripeBytes(first, last, run.Length()));
     });
   }
 
@@ -104,25 +122,41 @@ private:
     cudaEvent_t copied[2] = { nullptr, nullptr };
   };
 
-  // A stripe of the copy, through the lane's two pinned buffers in turn.
+  // cudaMemcpy, which goes from pageable memory through the driver's own
+  // bounce buffer, and the part's landed work on the default stream.
+  static void CopyDirectly(const CopyPart& part)
+  {
+    CudaCheck(cudaMemcpy(part.device, part.source, part.bytes, cudaMemcpyDefault), part.what.c_str());
+    if (part.landed)
+    {
+      part.landed(0, part.bytes, 0);
+      CudaCheck(cudaStreamSynchronize(0), part.what.c_str());
+    }
+  }
+
+  // A stripe of the run, through the lane's two pinned buffers in turn.
   // Returns, or throws, once the lane has finished what it queued: the
-  // destination may be freed right after.
-  static void CopyStripe(Lane& lane, char* device, const char* source, Stripe stripe, const char* what,
-    const Landed& landed)
+  // destinations may be freed right after.
+  static void CopyStripe(Lane& lane, const std::vector<CopyPart>& parts, const StagingRun& run, Stripe stripe)
   {
     struct Drain
     {
       cudaStream_t stream;
       ~Drain() { cudaStreamSynchronize(stream); }
     } drain{ lane.stream };
-    ForEachPiece(stripe, [&](std::size_t offset, std::size_t n, int b) {
+    const char* what = parts.front().what.c_str();
+    ForEachPiece(run, stripe, [&](std::size_t array, std::size_t offset, std::size_t n, int b) {
+      const CopyPart& part = parts[array];
+      what = part.what.c_str();
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
-      std::memcpy(lane.pinned[b], source + offset, n);
-      CudaCheck(cudaMemcpyAsync(device + offset, lane.pinned[b], n, cudaMemcpyHostToDevice, lane.stream), what);
+      std::memcpy(lane.pinned[b], static_cast<const char*>(part.source) + offset, n);
+      CudaCheck(cudaMemcpyAsync(static_cast<char*>(part.device) + offset, lane.pinned[b], n,
+                  cudaMemcpyHostToDevice, lane.stream),
+        what);
       CudaCheck(cudaEventRecord(lane.copied[b], lane.stream), what);
-      if (landed)
+      if (part.landed)
       {
-        landed(offset, offset + n, lane.stream);
+        part.landed(offset, offset + n, lane.stream);
       }
     });
     CudaCheck(cudaStreamSynchronize(lane.stream), what);

@@ -265,8 +265,8 @@ struct BuildStats
   double seconds = 0.0;      // whole build, wall clock
   // The host's time copying the caller's arrays to the device, with the
   // positions' bounds (reduced as the copy lands), and queueing the
-  // attributes' conversion into point records (colours, normals); the
-  // attributes are copied while the device computes the keys.
+  // attributes' conversion into point records (colours, normals); on CUDA
+  // the attributes are copied in the positions' pass of the staging.
   double uploadSeconds = 0.0;
   // The device's time (the host's on the CPU backend) of each phase:
   double keySeconds = 0.0;   // the cube from the bounds, and Morton keys

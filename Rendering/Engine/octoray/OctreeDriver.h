@@ -7,10 +7,10 @@
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
 //   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
-//   StageReduced(host, n, stride, what, identity, map, combine, result)   Stage, and combine over map(i, host)
-//                                     for every item i of `stride` elements into result: on CUDA reduced piece by
-//                                     piece as the copy lands
-//   Prepare(host, n, what), Fill(staged, host, n, what)   Stage in two steps; the copy overlaps loops queued between
+//   StageReduced(host, n, stride, what, identity, map, combine, result, along)   Stage, and combine over
+//                                     map(i, host) for every item i of `stride` elements into result: on CUDA
+//                                     reduced piece by piece as the copy lands; the Fills `along` copied with it
+//   Prepare(host, n, what, fills)     room for a Stage whose copy (added to fills) a StageReduced makes
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
@@ -97,15 +97,18 @@ StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const d
 
 // StagePositions, with the positions' bounds (PositionBounds) reduced as
 // the copy lands: on CUDA they cost the build nothing beyond its upload.
+// The copies `along` (Device::Prepare's) go in the positions' pass.
 template <class Device>
 StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
-  std::size_t n, const char* what, Bounds& bounds)
+  std::size_t n, const char* what, Bounds& bounds, typename Device::Fills along = {})
 {
   Bounds fromFloat, fromDouble;
+  typename Device::Fills none;
   StagedPositions<Device> staged{
-    d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(), fromFloat),
+    d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(), fromFloat,
+      xyzFloat ? std::move(along) : none),
     d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(),
-      fromDouble)
+      fromDouble, xyzFloat ? none : std::move(along))
   };
   bounds = BoundsUnion()(fromFloat, fromDouble);
   return staged;
@@ -248,25 +251,16 @@ void ForEachStagedInput(const PointCloudView& points, StagedAttributes<Device>& 
   });
 }
 
-// The attributes' staged arrays in two steps (Device::Prepare, Fill): a
-// build takes their memory before it queues the sort and copies them while
-// the device sorts, which needs only the positions.
+// Room for the attributes' staged arrays, whose copies (added to `fills`)
+// go with the positions': one pass of the CUDA staging for all the arrays.
 template <class Device>
-StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points)
+StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points, typename Device::Fills& fills)
 {
   StagedAttributes<Device> staged;
   ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
-    array = d.Prepare(data, count, label.c_str());
+    array = d.Prepare(data, count, label.c_str(), fills);
   });
   return staged;
-}
-
-template <class Device>
-void FillAttributes(Device& d, const PointCloudView& points, StagedAttributes<Device>& staged)
-{
-  ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
-    d.Fill(array, data, count, label.c_str());
-  });
 }
 
 // The record layout of a cloud's attributes: those it has, in the list's
@@ -820,9 +814,11 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
   auto phase = std::chrono::steady_clock::now();
+  typename Device::Fills fills;
+  StagedAttributes<Device> attributes = PrepareAttributes(d, points, fills);
   Bounds bounds;
   StagedPositions<Device> staged =
-    StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds);
+    StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds, std::move(fills));
   double uploadSeconds = SecondsSince(phase);
   phase = std::chrono::steady_clock::now();
   const RootCube cube = CheckedCube(d, scratch, staged.View(n), bounds, options);
@@ -836,12 +832,9 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.points.layout = RecordLayoutOf(points); // the sort's shape depends on it
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
-  StagedAttributes<Device> attributes = PrepareAttributes(d, points);
   BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true, [&] {
-    // The keys need the positions alone: the attributes are copied while
-    // the device computes them, and become records that the sort moves.
+    // The attributes become records that the sort moves.
     phase = std::chrono::steady_clock::now();
-    FillAttributes(d, points, attributes);
     const float* scalar = attributes.values[kAttributeScalar].Get();
     s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
     IngestAttributes(d, points, attributes, s.scalarRange, s.points);

@@ -1,12 +1,15 @@
-// How the CUDA backend's staged copy (CudaUpload.h) cuts a caller's array:
-// into one stripe a staging thread, and each stripe into pieces that pass
-// through the thread's two page-locked buffers in turn. Plain C++, so that
+// How the CUDA backend's staged copy (CudaUpload.h) cuts a caller's arrays:
+// laid end to end in one run, into one stripe a staging thread, and each
+// stripe into pieces that pass through the thread's two page-locked buffers
+// in turn. Plain C++, so that
 // the CPU's tests check the cuts and octoray_bench_cuda's host-side peer
 // makes the same ones.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <utility>
+#include <vector>
 
 namespace octoray
 {
@@ -51,11 +54,11 @@ inline std::size_t PieceBytes(std::size_t offset, std::size_t begin, std::size_t
   return std::min(n, left);
 }
 
-// The most pieces a copy of `bytes` lands in: in each stripe, its full
-// pieces and those PieceBytes cuts smaller at either end.
-inline std::size_t MaxPieces(std::size_t bytes)
+// A copy of `bytes` in units of kStripeAlignment: the staging threads split
+// these (ChunkWorkers), so that stripes start on whole points.
+inline std::size_t StripeUnits(std::size_t bytes)
 {
-  return bytes / kStagingPiece + kMaxStagingThreads * (2 * kEdgePieces + 1);
+  return (bytes + kStripeAlignment - 1) / kStripeAlignment;
 }
 
 // A stripe's bytes [begin, end) of a copy.
@@ -65,29 +68,71 @@ struct Stripe
   std::size_t end;
 };
 
-// A copy of `bytes` in units of kStripeAlignment: the staging threads split
-// these (ChunkWorkers), so that stripes start on whole points.
-inline std::size_t StripeUnits(std::size_t bytes)
-{
-  return (bytes + kStripeAlignment - 1) / kStripeAlignment;
-}
-
 // The stripe of units [first, last) of a copy of `bytes`.
 inline Stripe StripeBytes(std::size_t first, std::size_t last, std::size_t bytes)
 {
   return Stripe{ std::min(first * kStripeAlignment, bytes), std::min(last * kStripeAlignment, bytes) };
 }
 
-// fn(offset, bytes, buffer) for each piece of the stripe, in order;
-// `buffer` (0 or 1) is the page-locked buffer it passes through.
+// The arrays of one staged copy laid end to end in a run, each from a
+// multiple of kStripeAlignment (so that the pieces of every array start on
+// whole points), which the threads cut into stripes and pieces in one pass:
+// each pass pays the ramps at its stripes' ends once, whatever the number of
+// arrays (Benchmarks/gpu/variants-one-pass.txt).
+struct StagingRun
+{
+  std::vector<std::size_t> start; // each array's first byte in the run
+  std::vector<std::size_t> bytes; // each array's length
+
+  explicit StagingRun(std::vector<std::size_t> arrayBytes)
+    : bytes(std::move(arrayBytes))
+  {
+    std::size_t at = 0;
+    for (std::size_t b : bytes)
+    {
+      start.push_back(at);
+      at += StripeUnits(b) * kStripeAlignment;
+    }
+  }
+  std::size_t Length() const { return bytes.empty() ? 0 : start.back() + bytes.back(); }
+  std::size_t End(std::size_t array) const { return start[array] + bytes[array]; }
+};
+
+// The most pieces of a run that fall in one of its arrays, of `bytes`: its
+// full pieces, and in each stripe those PieceBytes cuts smaller at either
+// end, the stripe's last and the one the array's end cuts.
+inline std::size_t MaxPieces(std::size_t bytes)
+{
+  return bytes / kStagingPiece + kMaxStagingThreads * (2 * kEdgePieces + 2);
+}
+
+// fn(array, offset, bytes, buffer) for each piece of the run's stripe, in
+// order: bytes [offset, offset + bytes) of that array; `buffer` (0 or 1) is
+// the page-locked buffer it passes through. A piece ends where its array
+// does; the gaps between arrays are nobody's.
 template <typename Fn>
-void ForEachPiece(Stripe stripe, Fn&& fn)
+void ForEachPiece(const StagingRun& run, Stripe stripe, Fn&& fn)
 {
   int piece = 0;
-  for (std::size_t offset = stripe.begin, n = 0; offset < stripe.end; offset += n, ++piece)
+  std::size_t array = 0;
+  for (std::size_t offset = stripe.begin; offset < stripe.end;)
   {
-    n = PieceBytes(offset, stripe.begin, stripe.end);
-    fn(offset, n, piece & 1);
+    while (array < run.bytes.size() && offset >= run.End(array))
+    {
+      ++array;
+    }
+    if (array == run.bytes.size())
+    {
+      return;
+    }
+    if (offset < run.start[array])
+    {
+      offset = run.start[array]; // past a gap
+      continue;
+    }
+    const std::size_t n = std::min(PieceBytes(offset, stripe.begin, stripe.end), run.End(array) - offset);
+    fn(array, offset - run.start[array], n, piece++ & 1);
+    offset += n;
   }
 }
 }
