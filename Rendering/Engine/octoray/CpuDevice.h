@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <numeric>
 #include <tuple>
@@ -112,8 +113,13 @@ public:
   };
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* host, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result, Fills = {})
+    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr)
   {
+    if (prepareAlong)
+    {
+      Fills none;
+      prepareAlong(none);
+    }
     result = Reduce(n / stride, identity, [&](std::size_t i) { return map(i, host); }, combine);
     return Stage(host, n, what);
   }

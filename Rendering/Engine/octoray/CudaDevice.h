@@ -237,18 +237,24 @@ public:
     }
     return staged;
   }
-  // Copies that a Prepare left for the next StageReduced, which makes them
-  // in the same pass of the staging threads as its own.
+  // Copies that Prepare adds for a StageReduced to make in the same pass of
+  // the staging threads as its own.
   using Fills = std::vector<cuda::CopyPart>;
   // Stage, with the reduction of its items of `stride` elements: each piece
   // of the copy is reduced on the stream that copied it as soon as it lands
   // (CudaUpload.h: no piece splits an item of three floats or doubles),
   // while the rest of the array is still on its way, and the pieces'
-  // results once the copy is complete. The copies `along` go with it.
+  // results once the copy is complete. prepareAlong adds copies that go in
+  // the same pass. It runs once this array's memory is taken, so theirs
+  // comes after it in the pool, as before the one pass: taken first, it
+  // left the build's level phase at 10 M points 0.15 ms slower in two calls,
+  // though not with other piece sizes (Benchmarks/gpu/variants-one-pass.txt;
+  // the pool's layout, not explained).
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result, Fills along = {})
+    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr)
   {
+    Fills along;
     const std::size_t itemBytes = stride * sizeof(T);
     if (cuda::kStripeAlignment % itemBytes != 0)
     {
@@ -261,6 +267,13 @@ public:
     if (source)
     {
       Reserve(staged, n, what);
+    }
+    if (prepareAlong)
+    {
+      prepareAlong(along);
+    }
+    if (source)
+    {
       Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
         "partial reductions");
       const T* data = staged.Get();
@@ -280,8 +293,8 @@ public:
     }
     return staged;
   }
-  // Room for a caller's array where loops read it, filled by the next
-  // StageReduced given `fills` (on the CPU, the array itself): arrays
+  // Room for a caller's array where loops read it, whose copy a
+  // StageReduced makes from `fills` (on the CPU, the array itself): arrays
   // staged together share the staging's ramps (StagingPieces.h).
   template <typename T>
   Staged<T> Prepare(const T* source, std::size_t n, const char* what, Fills& fills)

@@ -7,10 +7,11 @@
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
 //   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
-//   StageReduced(host, n, stride, what, identity, map, combine, result, along)   Stage, and combine over
+//   StageReduced(host, n, stride, what, identity, map, combine, result, prepareAlong)   Stage, and combine over
 //                                     map(i, host) for every item i of `stride` elements into result: on CUDA
-//                                     reduced piece by piece as the copy lands; the Fills `along` copied with it
-//   Prepare(host, n, what, fills)     room for a Stage whose copy (added to fills) a StageReduced makes
+//                                     reduced piece by piece as the copy lands; prepareAlong(fills), called once
+//                                     its memory is taken, adds copies (Prepare's) that go in the same pass
+//   Prepare(host, n, what, fills)     room for a Stage, whose copy it adds to fills (CUDA)
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
@@ -97,18 +98,19 @@ StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const d
 
 // StagePositions, with the positions' bounds (PositionBounds) reduced as
 // the copy lands: on CUDA they cost the build nothing beyond its upload.
-// The copies `along` (Device::Prepare's) go in the positions' pass.
+// prepareAlong adds copies (Device::Prepare's) to make in the positions'
+// pass, once their memory is taken.
 template <class Device>
 StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
-  std::size_t n, const char* what, Bounds& bounds, typename Device::Fills along = {})
+  std::size_t n, const char* what, Bounds& bounds,
+  const std::function<void(typename Device::Fills&)>& prepareAlong = nullptr)
 {
   Bounds fromFloat, fromDouble;
-  typename Device::Fills none;
   StagedPositions<Device> staged{
     d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(), fromFloat,
-      xyzFloat ? std::move(along) : none),
+      xyzFloat ? prepareAlong : nullptr),
     d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(),
-      fromDouble, xyzFloat ? none : std::move(along))
+      fromDouble, xyzFloat ? nullptr : prepareAlong)
   };
   bounds = BoundsUnion()(fromFloat, fromDouble);
   return staged;
@@ -814,11 +816,10 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
   auto phase = std::chrono::steady_clock::now();
-  typename Device::Fills fills;
-  StagedAttributes<Device> attributes = PrepareAttributes(d, points, fills);
+  StagedAttributes<Device> attributes;
   Bounds bounds;
-  StagedPositions<Device> staged =
-    StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds, std::move(fills));
+  StagedPositions<Device> staged = StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions",
+    bounds, [&](typename Device::Fills& fills) { attributes = PrepareAttributes(d, points, fills); });
   double uploadSeconds = SecondsSince(phase);
   phase = std::chrono::steady_clock::now();
   const RootCube cube = CheckedCube(d, scratch, staged.View(n), bounds, options);
