@@ -367,7 +367,7 @@ def _cuda(ctx):
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
         "events in the same run. Medians of 7. The device phases are the device's own time (CUDA events between "
-        "them); the attributes' upload runs while the device computes the keys. GPU bytes per point include "
+        "them); the attributes' upload goes with the positions'. GPU bytes per point include "
         "the sort buffers the engine keeps for rebuilds and the memory its allocator keeps for the next build (split "
         "in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
         "to the device (cudaMemcpy), what a whole call from host arrays cannot beat, timed after each of the 7 "

@@ -7,11 +7,12 @@
 // that one pass of the threads serves them all; each thread copies its
 // stripe through two pinned buffers of its own, filling one while the
 // copy engine reads the other, so the host copies and the DMA overlap and
-// several host threads keep the bus busy; the threads and buffers are made at the first such copy
-// and kept. Arrays already in device memory (a CUDA simulation's) and
-// page-locked host arrays are copied directly. A caller may queue work on
-// each piece as it lands (Landed), which then runs while the rest of the
-// array is still on its way. Only compiled by nvcc.
+// several host threads keep the bus busy; the threads and buffers are
+// made at the first such copy and kept. Arrays already in device memory (a
+// CUDA simulation's) and page-locked host arrays are copied directly. A
+// caller may queue work on each piece as it lands (Landed), which then
+// runs while the rest of the array is still on its way. Only compiled by
+// nvcc.
 #pragma once
 
 #include "CudaSupport.h"

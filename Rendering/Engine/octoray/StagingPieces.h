@@ -1,9 +1,8 @@
 // How the CUDA backend's staged copy (CudaUpload.h) cuts a caller's arrays:
 // laid end to end in one run, into one stripe a staging thread, and each
 // stripe into pieces that pass through the thread's two page-locked buffers
-// in turn. Plain C++, so that
-// the CPU's tests check the cuts and octoray_bench_cuda's host-side peer
-// makes the same ones.
+// in turn. Plain C++, so that the CPU's tests check the cuts and
+// octoray_bench_cuda's host-side peer makes the same ones.
 #pragma once
 
 #include <algorithm>
