@@ -338,28 +338,43 @@ double StagedCopySeconds(Cloud& c)
 // (build, then copy, `repeats` times after a warm-up build): the medians of
 // each and the median of the pairs' ratios, which a drift of the host's
 // copy speed moves less than it moves either median (both halves of a pair
-// copy through the same host at nearly the same time).
+// copy through the same host at nearly the same time). `phases` holds the
+// medians of the builds' own upload and phase times (one build's may be a
+// stray), and the last build's node count.
 struct PairedBuild
 {
   double seconds = 0.0;
   double copySeconds = 0.0;
   double ratio = 0.0;
+  BuildStats phases;
 };
 
-PairedBuild TimeBuildAgainstCopy(int repeats, PinnedCopy& copy, const std::function<void()>& build)
+PairedBuild TimeBuildAgainstCopy(int repeats, PinnedCopy& copy, const std::function<BuildStats()>& build)
 {
   build();
   std::vector<double> builds, copies, ratios;
+  std::vector<BuildStats> stats;
   for (int r = 0; r < repeats; ++r)
   {
     const auto start = std::chrono::steady_clock::now();
-    build();
+    stats.push_back(build());
     cudaDeviceSynchronize();
     builds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     copies.push_back(copy.Seconds());
     ratios.push_back(copies.back() > 0 ? builds.back() / copies.back() : 0.0);
   }
-  return PairedBuild{ Median(builds), Median(copies), Median(ratios) };
+  PairedBuild paired{ Median(builds), Median(copies), Median(ratios), stats.back() };
+  for (double BuildStats::*phase :
+    { &BuildStats::uploadSeconds, &BuildStats::keySeconds, &BuildStats::sortSeconds, &BuildStats::levelSeconds })
+  {
+    std::vector<double> times;
+    for (const BuildStats& s : stats)
+    {
+      times.push_back(s.*phase);
+    }
+    paired.phases.*phase = Median(times);
+  }
+  return paired;
 }
 
 // The same input arrays copied as a caller's pageable arrays go without the
@@ -687,9 +702,9 @@ int Run(int argc, char** argv)
       }
       BuildOptions o;
       o.depth = depth;
-      BuildStats last;
       const int repeats = 7;
-      const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { last = engine->Build(c.View(), o); });
+      const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { return engine->Build(c.View(), o); });
+      const BuildStats& phases = paired.phases; // medians
       const double t = paired.seconds;
       const double floor = SortFloorSeconds(n, 3 * depth);
       const double buildSort = BuildSortSeconds(n, depth);
@@ -705,15 +720,15 @@ int Run(int argc, char** argv)
                   "bytes/point (%.1f in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input "
                   "%.3f ms beside it, "
                   "whole call %.2fx that (median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
-        n, depth, t * 1e3, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
-        last.levelSeconds * 1e3, floor * 1e3, buildSort * 1e3, t / floor, last.nodes, bytesPerPoint,
+        n, depth, t * 1e3, phases.uploadSeconds * 1e3, phases.keySeconds * 1e3, phases.sortSeconds * 1e3,
+        phases.levelSeconds * 1e3, floor * 1e3, buildSort * 1e3, t / floor, phases.nodes, bytesPerPoint,
         arrayBytesPerPoint, uploadMegabytes, paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3,
         leanBytesPerPoint);
       records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
-        { { "upload_seconds", last.uploadSeconds }, { "key_seconds", last.keySeconds },
-          { "sort_seconds", last.sortSeconds }, { "level_seconds", last.levelSeconds },
+        { { "upload_seconds", phases.uploadSeconds }, { "key_seconds", phases.keySeconds },
+          { "sort_seconds", phases.sortSeconds }, { "level_seconds", phases.levelSeconds },
           { "build_sort_seconds", buildSort },
-          { "nodes", double(last.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
+          { "nodes", double(phases.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
           { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
           { "host_staging_copy_seconds", peers.hostStaging },
