@@ -511,8 +511,9 @@ def _cuda(ctx):
                 "half of the staging and the pinned copy at once take about 1.1 times the pinned copy at 10 M "
                 "points (3.67–3.86 ms against 3.44–3.47 in that call), since both read the host's memory, and "
                 "the staged copy alone stays 0.5–0.7 ms above that. An upload at that floor would still leave "
-                "1.50–1.54 times at 10 M points, with the keys, the sort and the levels after it (about 1.5 ms), "
-                "which need all the positions. In this report's run the host was slower: the host's half alone took %s at 10 M points "
+                "about 1.5 times at 10 M points (1.49–1.56 in that call), with the keys, the sort and the levels "
+                "after it (about 1.5 ms), which need all the positions. In this report's run the host was "
+                "slower: the host's half alone took %s at 10 M points "
                 "(2.2–3.6 ms in the three calls before it)." % (
                     next((seconds(r["host_staging_copy_seconds"]) for r in builds
                           if r["n"] == 10000000 and r["depth"] == 10), "?")),
