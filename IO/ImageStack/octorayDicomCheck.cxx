@@ -68,18 +68,42 @@ public:
         std::to_string(this->LengthAt) + " says the group ends at byte " +
         std::to_string(this->End) + ", but its elements end at byte " + std::to_string(pos));
     }
-    return true;
+    return this->DataSetFollows(pos);
   }
 
 private:
+  // GDCM 3.0 reads the tag after the group without looking whether the
+  // file has one, and asserts (aborts) where it has not.
+  bool DataSetFollows(uint64_t pos)
+  {
+    const uint64_t left = this->E.Size() - pos;
+    if (this->ElementsRead == 0 || left >= 4)
+    {
+      return true;
+    }
+    if (left == 0)
+    {
+      return this->E.Fail("the DICOM file ends at byte " + std::to_string(pos) +
+        " with its file meta group: no data set follows it");
+    }
+    return this->E.Fail("the DICOM file ends " + std::to_string(left) + " bytes after its file meta group (at byte " +
+      std::to_string(pos) + "): no data set element fits there");
+  }
+
   // The group length and the transfer syntax; the other elements are
-  // skipped.
+  // skipped. GDCM 3.0 asserts on a sequence or an undefined length here.
   bool Element(const Header& h, std::string& syntax)
   {
+    ++this->ElementsRead;
     if (h.Length == UndefinedLength)
     {
       return this->E.Fail("DICOM file meta element " + h.Name() + " at byte " +
         std::to_string(h.Start) + " has an undefined length");
+    }
+    if (IsVR(h.VR, "SQ"))
+    {
+      return this->E.Fail("DICOM file meta element " + h.Name() + " at byte " + std::to_string(h.Start) +
+        " is a sequence (SQ), which the file meta group cannot hold");
     }
     if (h.Element == 0x0000)
     {
@@ -140,6 +164,7 @@ private:
   }
 
   Elements& E;
+  int ElementsRead = 0;
   bool HasLength = false;
   uint64_t LengthAt = 0; // where the group length (0002,0000) is
   uint64_t End = 0;      // where it says the group ends

@@ -367,7 +367,8 @@ void TestEnclosing()
 
 // The file meta group: its length past the end of the file, a length
 // that does not end where its elements end, a group length that is not a
-// 4-byte UL, a transfer syntax UID longer than a UID can be.
+// 4-byte UL, a transfer syntax UID longer than a UID can be, no data set
+// after it, a sequence in it.
 void TestFileMeta()
 {
   Dicom d = Part10(ExplicitLE);
@@ -401,6 +402,23 @@ void TestFileMeta()
   Dicom u = Part10(std::string(70, '1'));
   CHECK_EQ_STR(u.Check().substr(0, 52), "the DICOM transfer syntax UID (0002,0010) at byte 15");
   CHECK_CONTAINS(u.Check(), "is 70 bytes long; a UID has at most 64");
+  // GDCM 3.0 asserts where the file ends with the group or too soon after
+  // it, and on a sequence in the group (a fuzzer's find:
+  // Testing/Fuzz/regressions/slice_stack/dicom_meta_end_assert).
+  Dicom e = Part10(ExplicitLE);
+  const std::string metaEnds = std::to_string(e.Size());
+  CHECK_EQ_STR(e.Check(), "the DICOM file ends at byte " + metaEnds + " with its file meta group: no data set follows it");
+  e.Raw(std::string("\x08\0", 2));
+  CHECK_EQ_STR(e.Check(),
+    "the DICOM file ends 2 bytes after its file meta group (at byte " + metaEnds + "): no data set element fits there");
+  Dicom q;
+  q.Bytes.assign(128, 0);
+  q.Raw("DICM");
+  q.Element(0x0002, 0x0001, "OB", std::string("\0\1", 2));
+  q.Element(0x0002, 0x0002, "SQ", "");
+  Image(q);
+  CHECK_EQ_STR(q.Check(),
+    "DICOM file meta element (0002,0002) at byte 146 is a sequence (SQ), which the file meta group cannot hold");
 }
 
 // Sound structure on which GDCM 3.0 still stops the process (seen with

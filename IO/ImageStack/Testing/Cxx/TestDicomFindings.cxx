@@ -89,6 +89,7 @@ int TestDicomFindings(int argc, char* argv[])
     { "dicom_huge_length_oom",
       "DICOM element (0803,0000) at byte 530 has no valid VR: found '\\x00\\x00' where explicit "
       "VR little endian expects one" },
+    { "dicom_meta_end_assert", "the DICOM file ends at byte 146 with its file meta group: no data set follows it" },
     { "dicom_attribute_vr_assert",
       "DICOM element (0028,0011) at byte 1838 has VR IS where the standard gives US, which GDCM 3.0 "
       "cannot read" },
