@@ -55,6 +55,17 @@ double Median(std::vector<double> v)
   return v[v.size() / 2];
 }
 
+// The median of `runs` calls of a measure that times itself.
+double MedianOfRuns(int runs, const std::function<double()>& seconds)
+{
+  std::vector<double> t;
+  for (int r = 0; r < runs; ++r)
+  {
+    t.push_back(seconds());
+  }
+  return Median(t);
+}
+
 double TimeMedian(int repeats, const std::function<void()>& work)
 {
   work(); // warm-up: allocations, module load
@@ -666,26 +677,11 @@ int Run(int argc, char** argv)
     Cloud c = MakeCloud(n, 1);
     PinnedCopy pinned(c);
     const double uploadMegabytes = pinned.Megabytes();
-    std::vector<double> pinnedTimes;
-    for (int r = 0; r < 5; ++r)
-    {
-      pinnedTimes.push_back(pinned.Seconds());
-    }
-    const double pinnedUpload = Median(pinnedTimes);
+    const double pinnedUpload = MedianOfRuns(5, [&] { return pinned.Seconds(); });
     UploadPeers peers = MeasureUploadPeers(c);
     HostHalfOfStaging hostHalf;
-    std::vector<double> hostTimes;
-    for (int r = 0; r < 5; ++r)
-    {
-      hostTimes.push_back(hostHalf.Seconds(c));
-    }
-    peers.hostStaging = Median(hostTimes);
-    std::vector<double> besideTimes;
-    for (int r = 0; r < 5; ++r)
-    {
-      besideTimes.push_back(HostHalfBesidePinnedCopy(hostHalf, pinned, c));
-    }
-    peers.hostBesideCopy = Median(besideTimes);
+    peers.hostStaging = MedianOfRuns(5, [&] { return hostHalf.Seconds(c); });
+    peers.hostBesideCopy = MedianOfRuns(5, [&] { return HostHalfBesidePinnedCopy(hostHalf, pinned, c); });
     peers.staged = StagedCopySeconds(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "

@@ -41,6 +41,7 @@ public:
   bool Read(uint64_t& pos, std::string& syntax)
   {
     const uint64_t size = this->E.Size();
+    const uint64_t start = pos;
     while (size - pos >= 2)
     {
       unsigned char g[2];
@@ -68,16 +69,16 @@ public:
         std::to_string(this->LengthAt) + " says the group ends at byte " +
         std::to_string(this->End) + ", but its elements end at byte " + std::to_string(pos));
     }
-    return this->DataSetFollows(pos);
+    return pos == start || this->DataSetFollows(pos);
   }
 
 private:
-  // GDCM 3.0 reads the tag after the group without looking whether the
-  // file has one, and asserts (aborts) where it has not.
+  // GDCM 3.0 reads the tag after a group without looking whether the file
+  // has one, and asserts (aborts) where it has not.
   bool DataSetFollows(uint64_t pos)
   {
     const uint64_t left = this->E.Size() - pos;
-    if (this->ElementsRead == 0 || left >= 4)
+    if (left >= 4)
     {
       return true;
     }
@@ -94,7 +95,6 @@ private:
   // skipped. GDCM 3.0 asserts on a sequence or an undefined length here.
   bool Element(const Header& h, std::string& syntax)
   {
-    ++this->ElementsRead;
     if (h.Length == UndefinedLength)
     {
       return this->E.Fail("DICOM file meta element " + h.Name() + " at byte " +
@@ -164,7 +164,6 @@ private:
   }
 
   Elements& E;
-  int ElementsRead = 0;
   bool HasLength = false;
   uint64_t LengthAt = 0; // where the group length (0002,0000) is
   uint64_t End = 0;      // where it says the group ends
