@@ -52,6 +52,7 @@ test: build data
 # interpreter leaks by design).
 ASAN_BUILD ?= build-asan
 FUZZ_SECONDS ?= 30
+FUZZ_SEED ?= 1
 ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 # Coverage for libFuzzer in the project's code (the readers the fuzz targets
 # call), not only in the targets themselves.
@@ -63,7 +64,7 @@ ASAN_TARGETS = octoray_engine_tests octorayIOParticlesCxxTests octorayIOImageSta
   octorayRenderingVolumePython
 test-asan: deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DOCTORAY_ENABLE_CUDA=OFF -DOCTORAY_FUZZ_SECONDS=$(FUZZ_SECONDS) \
+	  -DOCTORAY_ENABLE_CUDA=OFF -DOCTORAY_FUZZ_SECONDS=$(FUZZ_SECONDS) -DOCTORAY_FUZZ_SEED=$(FUZZ_SEED) \
 	  -DOCTORAY_PYTHON_ASAN_PRELOAD=$$(clang++-14 -print-file-name=libclang_rt.asan-x86_64.so) \
 	  -DCMAKE_C_FLAGS="$(ASAN_FLAGS)" -DCMAKE_CXX_FLAGS="$(ASAN_CXX_FLAGS)" \
 	  -DCMAKE_EXE_LINKER_FLAGS="$(ASAN_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(ASAN_FLAGS)" $(CMAKE_FLAGS)
