@@ -140,6 +140,51 @@ def repeated_call_ratios(ctx, n):
         return [float(m.group(1)) for m in map(pattern.search, f) if m]
 
 
+STEPS_FILE = "profile-build-10m.txt"
+
+
+def build_steps(path):
+    """(step, microseconds) per line of ncu-kernel-times.py --steps."""
+    pattern = re.compile(r"^\s+([0-9.]+) us\s+(?:\d+x(?:\s+[0-9.]+ GB\s+[0-9.]+ TB/s)?)?\s+(.*)$")
+    with open(path) as f:
+        return [(m.group(2), float(m.group(1))) for m in map(pattern.match, f) if m]
+
+
+def _steps_at_10m(ctx):
+    """Where the device phases go at 10 M points, from ncu: the table and
+    what it says of the goal (the phases within twice the sort)."""
+    path = ctx.gpu_file(STEPS_FILE)
+    if not path:
+        return []
+    steps = build_steps(path)
+    with open(path) as f:
+        table = f.read().rstrip("\n").split("\n", 1)[1]
+    us = dict(steps)
+    levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level "))]
+    big, small = levels[:3], levels[3:]
+    level_us = sum(t for _, t in levels)
+    return [
+        "At 10 M points, where the device phases are furthest from the sort, Nsight Compute times each kernel of "
+        "the second of two builds, summed here by step (gpu-check.sh's profile-build part, "
+        "`ncu-kernel-times.py --steps`; %s). ncu runs the kernels one at a time with the caches flushed before "
+        "each, so the small ones take longer than in a build, and the bounds' kernels, which run beside the "
+        "copies, do not add up:" % gpu_source(ctx, STEPS_FILE),
+        "",
+        "```",
+        table,
+        "```",
+        "",
+        "The levels take %.0f µs of the phases' %.0f, more than the sort's %.0f: the leaves and the two levels "
+        "above them %.0f µs, the %d levels nearer the root %.0f µs, three launches each (a CUB select, its "
+        "init, and the loop). Within twice the sort, the keys, the histogram and the levels together would "
+        "have to take no longer than the sort (here %.0f µs)." % (
+            level_us, us.get("device phases (keys, sort, histogram, levels)", float("nan")),
+            us.get("sort (CUB)", float("nan")), sum(t for _, t in big), len(small), sum(t for _, t in small),
+            us.get("keys", 0) + us.get("histogram of neighbouring keys", 0) + level_us),
+        "",
+    ]
+
+
 def gpu_records(ctx, name):
     path = ctx.gpu_file(name)
     return load_records(path) if path else None
@@ -435,6 +480,7 @@ def _cuda(ctx):
         "device-resident points would not pay the upload.",
         "",
     ]
+    text += _steps_at_10m(ctx)
     repeats = {n: repeated_call_ratios(ctx, n) for n in (10000000, 100000000)}
     if all(repeats.values()):
         both = [r["call_over_pinned_copy"] for r in builds if r["depth"] == 10 and r["n"] == 100000000

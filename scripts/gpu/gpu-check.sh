@@ -28,7 +28,8 @@
 # 8x16, beside the main build's 16x8), report (the
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
 # ORBIT_ARGS adds arguments), profile-build (ncu's time of every kernel of a
-# build of PROFILE_BUILD points, default 1e8), sass (the primary-ray render
+# build of PROFILE_BUILD points, default 1e8, and by step of a build of 10 M
+# points), sass (the primary-ray render
 # kernel's machine code, from cuobjdump).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Benchmarks/gpu/).
@@ -122,12 +123,19 @@ if want profile; then
     > "$out/profile.txt" 2>&1
 fi
 if want profile-build; then
-  # Every kernel of two 100 M-point builds at depth 10, timed by ncu with
-  # its DRAM traffic; the table is the second build's time per kernel.
-  step profile-build ncu --clock-control none \
-    --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum --csv --page raw \
-    --log-file "$out/profile-build.csv" $build/bin/octoray_bench_cuda --profile-build "${PROFILE_BUILD:-1e8}"
+  # Every kernel of two builds at depth 10, timed by ncu with its DRAM
+  # traffic: of 100 M points, the second build's time per kernel
+  # (profile-build.txt), and of 10 M points, where the device phases are
+  # furthest from the sort's floor, the second build's time per step and
+  # level (profile-build-10m.txt).
+  for tag in "" -10m; do
+    step profile-build$tag ncu --clock-control none \
+      --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum --csv --page raw \
+      --log-file "$out/profile-build$tag.csv" $build/bin/octoray_bench_cuda \
+      --profile-build "$([ -z "$tag" ] && echo "${PROFILE_BUILD:-1e8}" || echo 1e7)"
+  done
   python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build.csv" 2 > "$out/profile-build.txt" 2>&1
+  python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build-10m.csv" 2 --steps > "$out/profile-build-10m.txt" 2>&1
 fi
 if want sass; then
   # The render kernel's machine code (primary rays), to count what one
@@ -175,6 +183,7 @@ done
 [ -f "$out/bench.log" ] && grep -E "^(device|upload|build|every attribute|update|render)" "$out/bench.log"
 [ -f "$out/profile.txt" ] && cat "$out/profile.txt"
 [ -f "$out/profile-build.txt" ] && head -25 "$out/profile-build.txt"
+[ -f "$out/profile-build-10m.txt" ] && cat "$out/profile-build-10m.txt"
 [ -f "$out/sass-primary.txt" ] && echo "sass-primary.txt: $(grep -c '/\*[0-9a-f]*\*/' "$out/sass-primary.txt") instructions"
 for log in "$out"/variant-*.log; do
   [ -f "$log" ] && grep -E "^render" "$log" | sed "s/^/$(basename "$log" .log): /"
@@ -187,7 +196,7 @@ printf '%s\n' "${status[@]}"
 files=()
 for f in summary.txt gpu.txt engine-tests.xml mapper-tests.xml bench-results-cuda.json quality-cuda.json \
   bench-render-cuda.json bench-thesis-cuda.json bench-quantisation-cuda.json orbit.json profile.txt \
-  profile-primary.csv profile-full.csv profile-primary16.csv profile-build.txt; do
+  profile-primary.csv profile-full.csv profile-primary16.csv profile-build.txt profile-build-10m.txt; do
   [ -e "$out/$f" ] && files+=("$f")
 done
 (cd "$out" && tar czf report-files.tgz "${files[@]}")

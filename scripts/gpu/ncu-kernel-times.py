@@ -7,10 +7,16 @@ runs, longest first, with the launch count and, where the CSV has the DRAM
 bytes, the DRAM traffic and its rate. Used by gpu-check.sh's profile-build
 part on `octoray_bench_cuda --profile-build N` (two builds).
 
-    ncu-kernel-times.py PROFILE.csv [BUILDS] [--launches]
+    ncu-kernel-times.py PROFILE.csv [BUILDS] [--launches | --steps]
 
 With --launches, every launch of that last run in order instead, in
-microseconds (the level phase's selects and loops, level by level).
+microseconds (the level phase's selects and loops, level by level). With
+--steps, the last run's launches summed by the build's steps, in the order
+the build queues them: the positions' bounds (during the upload), the keys,
+the records, the sort, the histogram of neighbouring keys, then each level
+from the leaves up (a CUB select and a loop each; a level's select begins
+with its DeviceCompactInitKernel), and the device phases' sum (keys, sort,
+histogram, levels: what the benchmark's phases time, but the records).
 """
 import re
 import sys
@@ -55,8 +61,53 @@ def short_names(full_names):
 
 
 
+# The build's steps before its levels, by a piece of each kernel's name.
+# The first that matches names the step (the histogram's kernel is a
+# lambda of QueueSort, as the keys' is).
+STEPS = (("positions' bounds (in the upload)", ("ReduceRangeKernel", "reduce::DeviceReduce")),
+         ("histogram of neighbouring keys", ("cuda::HistogramKernel",)),
+         ("records", ("IngestAttributes",)),
+         ("sort (CUB)", ("DeviceRadixSort",)),
+         ("keys", ("QueueSort",)))
+PHASES = ("keys", "sort (CUB)", "histogram of neighbouring keys")
+
+
+def steps(last):
+    """(step, launches, ms, GB or None) for the run's launches, in order;
+    the levels from the leaves (the depth) up to the root (level 0), each
+    from its select's init kernel."""
+    table, selects = {}, 0
+    for full, ms, gb in last:
+        if "DeviceCompactInitKernel" in full:
+            selects += 1
+        step = next((name for name, keys in STEPS if any(k in full for k in keys)), None)
+        if step is None or selects:
+            step = -selects # a level, counted from the leaves; named below
+        count, total, traffic = table.get(step, (0, 0.0, 0.0))
+        table[step] = (count + 1, total + ms, None if gb is None or traffic is None else traffic + gb)
+    depth = selects - 1
+
+    def name(step):
+        if not isinstance(step, int):
+            return step
+        level = depth + 1 + step
+        return "other" if step == 0 else f"leaves (level {level})" if level == depth else f"level {level}"
+    return [(name(step),) + values for step, values in table.items()]
+
+
+def print_steps(path, builds, last):
+    print(f"{path}: the last of {builds} builds by step")
+    phases = 0.0
+    for step, count, ms, gb in steps(last):
+        if step in PHASES or step.startswith(("leaves", "level ")):
+            phases += ms
+        dram = f"  {gb:6.3f} GB {gb / ms:5.2f} TB/s" if gb is not None and ms > 0 else ""
+        print(f"  {1000 * ms:8.1f} us  {count:3d}x{dram}  {step}")
+    print(f"  {1000 * phases:8.1f} us        device phases (keys, sort, histogram, levels)")
+
+
 def main():
-    args = [a for a in sys.argv[1:] if a != "--launches"]
+    args = [a for a in sys.argv[1:] if a not in ("--launches", "--steps")]
     path = args[0]
     builds = int(args[1]) if len(args) > 1 else 2
     everything = list(launches(path))
@@ -66,6 +117,9 @@ def main():
         print(f"{path}: the last of {builds} builds, every launch in order")
         for full, ms, _ in last:
             print(f"  {1000 * ms:9.1f} us  {names[full]}")
+        return
+    if "--steps" in sys.argv:
+        print_steps(path, builds, last)
         return
     per = {}
     for full, ms, gb in last:
