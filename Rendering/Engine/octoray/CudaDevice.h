@@ -3,7 +3,7 @@
 // engine's memory pool (DeviceMemoryPool). Everything runs in order on the
 // default stream; a loop returns before the GPU has run it, and the host
 // waits only where it reads a result (ToHost, Reduce) or Synchronize. The
-// copies of a caller's arrays (Stage, Upload: CudaUpload.h) return
+// copies of a caller's arrays (StageReduced, Upload: CudaUpload.h) return
 // complete. Only compiled by nvcc.
 #pragma once
 
@@ -225,26 +225,15 @@ public:
   {
     buffer.Release();
   }
-  // `source`: host memory, or device memory (a caller's CUDA arrays),
-  // copied on the device.
-  template <typename T>
-  Staged<T> Stage(const T* source, std::size_t n, const char* what)
-  {
-    Staged<T> staged;
-    if (source)
-    {
-      Upload(staged, source, n, what);
-    }
-    return staged;
-  }
   // Copies that Prepare adds for a StageReduced to make in the same pass of
   // the staging threads as its own.
   using Fills = std::vector<cuda::CopyPart>;
-  // Stage, with the reduction of its items of `stride` elements: each piece
-  // of the copy is reduced on the stream that copied it as soon as it lands
-  // (CudaUpload.h: no piece splits an item of three floats or doubles),
-  // while the rest of the array is still on its way, and the pieces'
-  // results once the copy is complete. prepareAlong adds copies that go in
+  // A copy of `source` (host memory, or device memory: a caller's CUDA
+  // arrays, copied on the device) with the reduction of its items of
+  // `stride` elements: each piece of the copy is reduced on the stream that
+  // copied it as soon as it lands (CudaUpload.h: no piece splits an item of
+  // three floats or doubles), while the rest of the array is still on its
+  // way, and the pieces' results once the copy is complete. prepareAlong adds copies that go in
   // the same pass. It runs once this array's memory is taken, so theirs
   // comes after it in the pool, as before the one pass: taken first, it
   // left the build's level phase at 10 M points 0.15 ms slower in two calls,

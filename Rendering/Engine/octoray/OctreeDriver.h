@@ -6,12 +6,12 @@
 //   Buffer<T>                         an owning array: Get(), Count(), Bytes(), Empty()
 //   Reserve(buffer, n, what)          room for n, kept while it fits; `what` names it in an out-of-memory error
 //   Release(buffer)
-//   Stage(host, n, what)              a caller's array where loops read it: the array itself (CPU), a copy (CUDA)
-//   StageReduced(host, n, stride, what, identity, map, combine, result, prepareAlong)   Stage, and combine over
-//                                     map(i, host) for every item i of `stride` elements into result: on CUDA
-//                                     reduced piece by piece as the copy lands; prepareAlong(fills), called once
-//                                     its memory is taken, adds copies (Prepare's) that go in the same pass
-//   Prepare(host, n, what, fills)     room for a Stage, whose copy it adds to fills (CUDA)
+//   StageReduced(host, n, stride, what, identity, map, combine, result, prepareAlong)   a caller's array where
+//                                     loops read it (the array itself on the CPU, a copy on CUDA), and combine
+//                                     over map(i, host) for every item i of `stride` elements into result: on
+//                                     CUDA reduced piece by piece as the copy lands; prepareAlong(fills), called
+//                                     once its memory is taken, adds copies (Prepare's) that go in the same pass
+//   Prepare(host, n, what, fills)     room for another caller's array, whose copy it adds to fills (CUDA)
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
@@ -88,18 +88,10 @@ struct StagedPositions
   }
 };
 
-template <class Device>
-StagedPositions<Device> StagePositions(Device& d, const float* xyzFloat, const double* xyzDouble, std::size_t n,
-  const char* what)
-{
-  return StagedPositions<Device>{ d.Stage(xyzFloat, xyzFloat ? 3 * n : 0, what),
-    d.Stage(xyzDouble, xyzDouble ? 3 * n : 0, what) };
-}
-
-// StagePositions, with the positions' bounds (PositionBounds) reduced as
-// the copy lands: on CUDA they cost the build nothing beyond its upload.
-// prepareAlong adds copies (Device::Prepare's) to make in the positions'
-// pass, once their memory is taken.
+// A caller's positions staged, with their bounds (PositionBounds, and the
+// first non-finite point) reduced as the copy lands: on CUDA they cost
+// nothing beyond the upload. prepareAlong adds copies (Device::Prepare's)
+// to make in the positions' pass, once their memory is taken.
 template <class Device>
 StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
   std::size_t n, const char* what, Bounds& bounds,
@@ -933,14 +925,18 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   UpdateStats stats;
   stats.moved = moved;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
-  const auto staged = d.Stage(positions.indices, positions.indices ? moved : 0, "update indices");
-  const StagedPositions<Device> xyz =
-    StagePositions(d, positions.xyzFloat, positions.xyzDouble, moved, "update positions");
+  // The indices go in the positions' pass; of the positions' bounds only the
+  // first non-finite point counts, checked before the first write, so that a
+  // bad position changes nothing.
+  typename Device::template Staged<std::uint32_t> staged;
+  Bounds bounds;
+  const StagedPositions<Device> xyz = StageBoundedPositions(d, positions.xyzFloat, positions.xyzDouble, moved,
+    "update positions", bounds, [&](typename Device::Fills& fills) {
+      staged = d.Prepare(positions.indices, positions.indices ? moved : 0, "update indices", fills);
+    });
   const PointArraysView to = xyz.View(moved);
   const std::uint32_t* indices = staged.Get();
-  // Checked before the first write, so that a bad position changes nothing.
-  const std::uint64_t bad = FirstFailedStep(d, scratch, "FirstNonFiniteKernel", moved,
-    OCTORAY_LAMBDA(std::size_t k) { return IsFinitePoint(to.Position(k)); });
+  const std::uint64_t bad = bounds.firstBad;
   if (bad != kNoIndex)
   {
     throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, positions.Position(bad)));
