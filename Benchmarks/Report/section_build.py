@@ -522,8 +522,8 @@ def _cuda(ctx):
                                  if one_pass else
                                  "the positions first and the attributes while the device computes the keys; ")
             + "*upload* is the host's "
-            "time in those copies (in runs of the benchmark before 25da958, this one's among them, the last of the "
-            "7 builds' own, as are the device phases above; since, their medians); *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
+            "time in those copies, the median of the 7 builds as are the device phases above (in runs of the "
+            "benchmark before 25da958, the last build's own); *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
             "arrays in place for the copy, *pinned* is the floor above%s. GPU bytes per point: the arrays alone; "
             "with the memory that the engine's allocator keeps for the next build (with the points kept, a "
             "rebuild fills a new octree beside the old one and then reuses the old one's memory instead of "
