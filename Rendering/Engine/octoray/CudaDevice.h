@@ -233,12 +233,13 @@ public:
   // `stride` elements: each piece of the copy is reduced on the stream that
   // copied it as soon as it lands (CudaUpload.h: no piece splits an item of
   // three floats or doubles), while the rest of the array is still on its
-  // way, and the pieces' results once the copy is complete. prepareAlong adds copies that go in
-  // the same pass. It runs once this array's memory is taken, so theirs
-  // comes after it in the pool, as before the one pass: taken first, it
-  // left the build's level phase at 10 M points 0.15 ms slower in two calls,
-  // though not with other piece sizes (Benchmarks/gpu/variants-one-pass.txt;
-  // the pool's layout, not explained).
+  // way, and the pieces' results once the copy is complete. prepareAlong
+  // adds copies that go in the same pass. It runs once this array's memory
+  // is taken, so theirs comes after it in the pool, as before the one pass:
+  // taken first, it left the build's level phase at 10 M points 0.15 ms
+  // slower in two calls, though not with other piece sizes
+  // (Benchmarks/gpu/variants-one-pass.txt; the pool's layout, not
+  // explained).
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
     Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr)
