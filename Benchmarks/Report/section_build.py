@@ -574,6 +574,15 @@ def _cuda(ctx):
                 "about 1.5 times at 10 M points (1.49–1.56 in that call), with the keys, the sort and the levels "
                 "after it (about 1.5 ms), which need all the positions.%s" % _host_floor_at_10m(builds),
                 "",
+                "What a build's upload adds to the staging threads' pass, timed on the host part by part "
+                "(Benchmarks/gpu/variants-upload-parts.txt, call 4): at 100 M points the memory's reservations, "
+                "up to 2.8 ms where the pool maps new memory, and the records' reservation and ingest, 0.3–1.2 ms; "
+                "the rest is the pass itself, 42.8–47.5 ms in the depth-10 builds of that run where the staged copy "
+                "alone took 39.8. The bounds' kernels on the pieces are not what the pass loses: with them reduced "
+                "in one launch after the copy, or every four pieces, the whole call at 100 M points took 1.57–1.59 "
+                "and 1.50–1.56 times the pinned copy against 1.56–1.60 (call 5), within the host's spread (the "
+                "staged copy alone moved between 38.7 and 49.2 ms from run to run).",
+                "",
             ]
     every = [r for r in records if r["name"] == "gpu bytes per point, every attribute"]
     if every:
