@@ -82,7 +82,7 @@ def steps(last):
             selects += 1
         step = next((name for name, keys in STEPS if any(k in full for k in keys)), None)
         if step is None or selects:
-            step = -selects # a level, counted from the leaves; named below
+            step = -selects  # a level, counted from the leaves; named below
         count, total, traffic = table.get(step, (0, 0.0, 0.0))
         table[step] = (count + 1, total + ms, None if gb is None or traffic is None else traffic + gb)
     depth = selects - 1
