@@ -208,7 +208,7 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
   for (std::uint32_t node = begin; node < end; ++node)
   {
     std::uint32_t x, y, z;
-    octoray::DecodeMorton(tree.key[node], x, y, z);
+    octoray::DecodeMorton(tree.Key(node), x, y, z);
     const double p[3] = { tree.cube.origin[0] + (x + 0.5) * leaf, tree.cube.origin[1] + (y + 0.5) * leaf,
       tree.cube.origin[2] + (z + 0.5) * leaf };
     const vtkIdType id = node - begin;

@@ -309,18 +309,31 @@ TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
   const BuildStats stats = engine->Build(c.View(), options);
   const MemoryReport m = engine->Memory();
   EXPECT_EQ(stats.bytes, m.Total());
-  std::size_t keyBytes = 0;
-  for (const auto& a : m.arrays)
-  {
-    if (a.first == "node keys")
+  const auto bytesOf = [](const MemoryReport& report, const std::string& label) {
+    std::size_t bytes = 0;
+    for (const auto& a : report.arrays)
     {
-      keyBytes = a.second;
+      bytes += a.first == label ? a.second : 0;
     }
-  }
-  EXPECT_GE(keyBytes, stats.nodes * sizeof(std::uint64_t));
-  EXPECT_LE(keyBytes, 2 * stats.nodes * sizeof(std::uint64_t));
+    return bytes;
+  };
+  // At depth 10 every key fits its low word (Attributes.h): 4 bytes a node.
+  EXPECT_GE(bytesOf(m, "node keys"), stats.nodes * sizeof(std::uint32_t));
+  EXPECT_LE(bytesOf(m, "node keys"), 2 * stats.nodes * sizeof(std::uint32_t));
+  EXPECT_EQ(bytesOf(m, "node keys' high words"), 0u);
   // Far below a dense skeleton of depth 10: (8^11 - 1) / 7 pointers.
   EXPECT_LT(m.Total(), ((1ull << 33) - 1) / 7 * 8 / 100);
+
+  // Deeper, each key has its high word too.
+  options.depth = 12;
+  const BuildStats deep = engine->Build(c.View(), options);
+  const MemoryReport d = engine->Memory();
+  for (const char* label : { "node keys", "node keys' high words" })
+  {
+    SCOPED_TRACE(label);
+    EXPECT_GE(bytesOf(d, label), deep.nodes * sizeof(std::uint32_t));
+    EXPECT_LE(bytesOf(d, label), 2 * deep.nodes * sizeof(std::uint32_t));
+  }
 }
 
 // With a fixed root cube, a point outside it is refused before anything is

@@ -104,7 +104,7 @@ struct TestRays
     const float cells = std::ldexp(1.0f, depth);
     const std::uint32_t leaf = view.levelBegin[depth] + static_cast<std::uint32_t>(rng() % view.LevelSize(depth));
     std::uint32_t cell[3];
-    DecodeMorton(t.key[leaf], cell[0], cell[1], cell[2]);
+    DecodeMorton(t.Key(leaf), cell[0], cell[1], cell[2]);
     const Vec3f corner{ cell[0] / cells, cell[1] / cells, cell[2] / cells };
     ray.origin = Vec3f{ around(rng), around(rng), around(rng) };
     Vec3f d = corner + Vec3f{ share(rng), share(rng), share(rng) } * (1.0f / cells) - ray.origin;

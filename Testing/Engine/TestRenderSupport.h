@@ -124,7 +124,7 @@ inline bool Slab(const WorldRay& r, const double lo[3], const double hi[3], doub
 inline void NodeBox(const HostOctree& t, std::uint32_t n, int level, double lo[3], double hi[3])
 {
   std::uint32_t c[3];
-  DecodeMorton(t.key[n], c[0], c[1], c[2]);
+  DecodeMorton(t.Key(n), c[0], c[1], c[2]);
   const double voxel = t.cube.size / double(1u << level);
   for (int a = 0; a < 3; ++a)
   {

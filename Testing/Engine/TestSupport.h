@@ -270,7 +270,7 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
     for (const auto& [key, ref] : levels[l])
     {
       SCOPED_TRACE("level " + std::to_string(l) + " node " + std::to_string(n));
-      ASSERT_EQ(t.key[n], key);
+      ASSERT_EQ(t.Key(n), key);
       ASSERT_EQ(t.pointCount[n], ref.count);
       ASSERT_EQ(ChildMaskOf(t, n), ref.childMask);
       if (l == t.depth)
@@ -282,8 +282,8 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
         const std::uint32_t f = FirstChildOf(t, n);
         ASSERT_GE(f, t.levelBegin[l + 1]);
         ASSERT_LT(f, t.levelBegin[l + 2]);
-        EXPECT_EQ(t.key[f] >> 3, key);
-        EXPECT_TRUE(f == t.levelBegin[l + 1] || (t.key[f - 1] >> 3) != key) << "first child is not the first";
+        EXPECT_EQ(t.Key(f) >> 3, key);
+        EXPECT_TRUE(f == t.levelBegin[l + 1] || (t.Key(f - 1) >> 3) != key) << "first child is not the first";
       }
       const double inv = 1.0 / ref.count;
       // Means of float data summed in double: relative error ~1e-7.

@@ -18,8 +18,15 @@
 namespace octoray
 {
 // Arrays every node has, whatever the input: X(member, Name, Type,
-// nodesPerEntry, label).
-//   key         the node's level-local Morton key (3 * level bits)
+// nodesPerEntry, fromDepth, label), in octrees of fromDepth levels and more.
+//   key         the node's level-local Morton key (3 * level bits), its low
+//               32 bits
+//   keyHigh     its high 32 bits, in octrees deeper than 10 levels alone:
+//               above, keys of 64 bits took 8 bytes a node where the keys of
+//               every level fit 4, and the level phase, which writes each
+//               node's key once and reads it twice (a select, the parent's
+//               loop), took 20 % longer at 100 M points
+//               (Benchmarks/gpu/variants-node-keys.txt)
 //   childMasks  each node's child mask (bit o set: the child in octant o
 //               exists), eight nodes' to a word: node n's is byte n % 8 of
 //               word n / 8 (the last word's spare bytes zero)
@@ -34,10 +41,28 @@ namespace octoray
 // one level up whose key is this node's shifted by one octant
 // (OctreeView::Find).
 #define OCTORAY_NODE_TOPOLOGY(X)                                                                                      \
-  X(key, Key, std::uint64_t, 1, "keys")                                                                              \
-  X(childMasks, ChildMasks, std::uint64_t, 8, "child masks")                                                         \
-  X(childBase, ChildBase, std::uint32_t, 8, "first children")                                                        \
-  X(pointCount, PointCount, std::uint32_t, 1, "point counts")
+  X(key, Key, std::uint32_t, 1, 0, "keys")                                                                           \
+  X(keyHigh, KeyHigh, std::uint32_t, 1, kWideKeyDepth, "keys' high words")                                         \
+  X(childMasks, ChildMasks, std::uint64_t, 8, 0, "child masks")                                                      \
+  X(childBase, ChildBase, std::uint32_t, 8, 0, "first children")                                                     \
+  X(pointCount, PointCount, std::uint32_t, 1, 0, "point counts")
+
+// The shallowest octree whose deepest keys (3 bits a level) pass 32 bits.
+constexpr int kWideKeyDepth = 11;
+
+// Node n's level-local key from its low and (where stored) high words.
+OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* high, std::size_t n)
+{
+  return (high ? std::uint64_t{ high[n] } << 32 : 0u) | low[n];
+}
+
+// Nodes' keys of both words, read as one array (keys[i]).
+struct NodeKeys
+{
+  const std::uint32_t* low;
+  const std::uint32_t* high;
+  OCTORAY_HD std::uint64_t operator[](std::size_t i) const { return NodeKey(low, high, i); }
+};
 
 // Optional per-point attributes, each stored per node as the plain mean over
 // the points beneath it, and only where the input had it:
@@ -220,7 +245,8 @@ constexpr unsigned kRoundedAttributes = OCTORAY_ATTRIBUTES(OCTORAY_ROUNDED_BIT) 
 #undef OCTORAY_ROUNDED_BIT
 
 // Descriptors that loops receive: the array's value type, index in its
-// list (attributes), presence bit (0: always present), first slot, label,
+// list (attributes), presence bit (0: always present), the depth from which
+// octrees have it, first slot, label,
 // and Of(arrays), the array of that name in any of the structures declared
 // from these lists.
 template <int I>
@@ -243,12 +269,13 @@ enum TopologyIndex : int
     return arrays.member;                                                                                            \
   }
 
-#define OCTORAY_DESCRIBE_TOPOLOGY(member, Name, Type_, nodesPerEntry, label)                                         \
+#define OCTORAY_DESCRIBE_TOPOLOGY(member, Name, Type_, nodesPerEntry, fromDepth, label)                              \
   template <>                                                                                                        \
   struct TopologyArray<kTopology##Name>                                                                              \
   {                                                                                                                  \
     using Type = Type_;                                                                                              \
     static constexpr unsigned kBit = 0;                                                                              \
+    static constexpr int kFromDepth = fromDepth;                                                                     \
     static constexpr std::size_t kNodesPerEntry = nodesPerEntry;                                                     \
     static constexpr const char* kLabel = label;                                                                     \
     OCTORAY_ARRAY_OF(member)                                                                                         \
@@ -264,6 +291,7 @@ OCTORAY_NODE_TOPOLOGY(OCTORAY_DESCRIBE_TOPOLOGY)
     using Input = Input_;                                                                                            \
     static constexpr int kIndex = kAttribute##Name;                                                                  \
     static constexpr unsigned kBit = kHas##Name;                                                                     \
+    static constexpr int kFromDepth = 0;                                                                             \
     static constexpr int kSlot = kSlot##Name;                                                                        \
     static constexpr std::size_t kNodesPerEntry = 1;                                                                 \
     static constexpr const char* kLabel = label;                                                                     \
@@ -319,11 +347,11 @@ constexpr std::size_t EntriesFor(Descriptor, std::size_t nodes)
   return (nodes + Descriptor::kNodesPerEntry - 1) / Descriptor::kNodesPerEntry;
 }
 
-// Whether an octree of `attributes` (AttributeBits) has the array.
+// Whether an octree of `attributes` (AttributeBits) and `depth` has the array.
 template <typename Descriptor>
-constexpr bool Present(Descriptor, unsigned attributes)
+constexpr bool Present(Descriptor, unsigned attributes, int depth)
 {
-  return Descriptor::kBit == 0 || (attributes & Descriptor::kBit) != 0;
+  return (Descriptor::kBit == 0 || (attributes & Descriptor::kBit) != 0) && depth >= Descriptor::kFromDepth;
 }
 
 // One member per node array, each a Buffer<its type>: HostOctree's vectors,

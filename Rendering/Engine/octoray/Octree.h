@@ -104,6 +104,17 @@ struct OctreeView
     return levelBegin[level + 1] - levelBegin[level];
   }
 
+  // Node n's level-local key, from its words (Attributes.h).
+  OCTORAY_HD std::uint64_t Key(std::uint32_t n) const { return NodeKey(key, keyHigh, n); }
+  OCTORAY_HD void SetKey(std::uint32_t n, std::uint64_t levelKey) const
+  {
+    key[n] = static_cast<std::uint32_t>(levelKey);
+    if (keyHigh)
+    {
+      keyHigh[n] = static_cast<std::uint32_t>(levelKey >> 32);
+    }
+  }
+
   // Binary search for a node of `level` by its level-local key.
   OCTORAY_HD std::uint32_t Find(int level, std::uint64_t levelKey) const
   {
@@ -112,7 +123,7 @@ struct OctreeView
     while (lo < hi)
     {
       const std::uint32_t mid = lo + (hi - lo) / 2;
-      if (key[mid] < levelKey)
+      if (Key(mid) < levelKey)
       {
         lo = mid + 1;
       }
@@ -121,7 +132,7 @@ struct OctreeView
         hi = mid;
       }
     }
-    return (lo < levelBegin[level + 1] && key[lo] == levelKey) ? lo : kInvalidIndex;
+    return (lo < levelBegin[level + 1] && Key(lo) == levelKey) ? lo : kInvalidIndex;
   }
 };
 
@@ -195,6 +206,7 @@ struct HostOctree : NodeArrays<HostVector>
   ScalarRange scalarRange; // the scalars' codes are relative to it (Scalar16.h)
 
   std::size_t NodeCount() const { return key.size(); }
+  std::uint64_t Key(std::size_t n) const { return NodeKey(key.data(), DataOrNull(keyHigh), n); }
   // Node n's scalar, decoded.
   float Scalar(std::size_t n) const { return DecodeScalar(scalarRange, scalar[n]); }
   OctreeView View();

@@ -147,10 +147,11 @@ std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const c
 // starts[r] = where the r-th run of equal (key >> shift) among n sorted
 // keys starts, with n after the last run: the nodes one level up (shift 3),
 // the leaves (the sorted words' keyShift) or the records of one node
-// (shift 0). `starts` has room for n + 1; the count goes to
-// kCounterSelected, which the host reads only where it does not know it.
-template <class Device, typename Key>
-void RunStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int shift,
+// (shift 0). `keys`: an array, or what reads as one (NodeKeys). `starts`
+// has room for n + 1; the count goes to kCounterSelected, which the host
+// reads only where it does not know it.
+template <class Device, typename Keys>
+void RunStarts(Device& d, DriverScratch<Device>& scratch, Keys keys, std::size_t n, int shift,
   std::uint32_t* starts)
 {
   d.Select(
@@ -700,7 +701,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
     const std::string what = std::string("node ") + a.kLabel;
-    if (Present(a, s.attributes))
+    if (Present(a, s.attributes, depth))
     {
       d.Reserve(a.Of(s.nodes), EntriesFor(a, nodes), what.c_str());
     }
@@ -736,10 +737,18 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   {
     const std::uint32_t begin = view.levelBegin[l];
     const std::uint32_t childBegin = view.levelBegin[l + 1];
-    RunStarts(d, scratch, view.key + childBegin, view.LevelSize(l + 1), 3, starts);
+    if (view.keyHigh)
+    {
+      RunStarts(d, scratch, NodeKeys{ view.key + childBegin, view.keyHigh + childBegin }, view.LevelSize(l + 1), 3,
+        starts);
+    }
+    else
+    {
+      RunStarts(d, scratch, view.key + childBegin, view.LevelSize(l + 1), 3, starts);
+    }
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
       const std::uint32_t c0 = childBegin + starts[j];
-      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), view.key[c0] >> 3, c0, childBegin + starts[j + 1]);
+      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), view.Key(c0) >> 3, c0, childBegin + starts[j + 1]);
     });
   }
 }

@@ -149,7 +149,7 @@ struct SortedKeys
 OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, const SortedKeys& sorted,
   std::uint32_t node, std::uint32_t begin, std::uint32_t end)
 {
-  t.key[node] = sorted.LeafKey(begin);
+  t.SetKey(node, sorted.LeafKey(begin));
   t.SetChildMask(node, 0);
   if ((node & 7u) == 0)
   {
@@ -176,7 +176,7 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
 OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint64_t levelKey, std::uint32_t c0,
   std::uint32_t c1)
 {
-  t.key[node] = levelKey;
+  t.SetKey(node, levelKey);
   if ((node & 7u) == 0)
   {
     t.childBase[node >> 3] = c0;
@@ -186,7 +186,7 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   double sum[kSlotCount] = {};
   for (std::uint32_t c = c0; c < c1; ++c)
   {
-    mask |= 1u << OctantOf(t.key[c]);
+    mask |= 1u << OctantOf(t.key[c]); // a key's low word holds its octant
     const std::uint32_t n = t.pointCount[c];
     count += n;
     if (t.attributes) // one test the compiler can take out of the loop, not one an attribute

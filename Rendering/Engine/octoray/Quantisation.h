@@ -88,7 +88,7 @@ std::uint32_t WalkToLeaf(const HostOctree& tree, const PointCloudView& points, s
     node = ChildIndex(mask, FirstChildOf(tree, node), octant);
     visit(node);
   }
-  if (tree.key[node] != AncestorKey(full, tree.depth))
+  if (tree.Key(node) != AncestorKey(full, tree.depth))
   {
     throw std::runtime_error("point " + std::to_string(i) + ": the leaf reached has another key");
   }
@@ -105,7 +105,7 @@ inline QuantisationError MeasureQuantisation(const HostOctree& tree, const Point
   for (std::size_t i = 0; i < points.count; ++i)
   {
     const std::uint32_t leaf = WalkToLeaf(tree, points, i, [](std::uint32_t) {});
-    const double d = Length(points.Position(i) - VoxelCentre(tree.cube, tree.depth, tree.key[leaf]));
+    const double d = Length(points.Position(i) - VoxelCentre(tree.cube, tree.depth, tree.Key(leaf)));
     q.max = std::max(q.max, d);
     sum += d;
   }

@@ -48,7 +48,7 @@ void ReferenceTraverse(const OctreeView& tree, const Ray& ray, const LevelOfDeta
     hit.level = e.level;
     hit.size = PowerOfTwo(-e.level);
     std::uint32_t cell[3];
-    DecodeMorton(tree.key[e.node], cell[0], cell[1], cell[2]);
+    DecodeMorton(tree.Key(e.node), cell[0], cell[1], cell[2]);
     hit.lo = Vec3f{ static_cast<float>(cell[0]), static_cast<float>(cell[1]), static_cast<float>(cell[2]) } * hit.size;
     if (e.level == tree.depth || lod.StopAt(hit.size, e.tEnter))
     {
