@@ -42,7 +42,7 @@ namespace octoray
 // (OctreeView::Find).
 #define OCTORAY_NODE_TOPOLOGY(X)                                                                                      \
   X(key, Key, std::uint32_t, 1, 0, "keys")                                                                           \
-  X(keyHigh, KeyHigh, std::uint32_t, 1, kWideKeyDepth, "keys' high words")                                         \
+  X(keyHigh, KeyHigh, std::uint32_t, 1, kWideKeyDepth, "keys' high words")                                           \
   X(childMasks, ChildMasks, std::uint64_t, 8, 0, "child masks")                                                      \
   X(childBase, ChildBase, std::uint32_t, 8, 0, "first children")                                                     \
   X(pointCount, PointCount, std::uint32_t, 1, 0, "point counts")
