@@ -143,11 +143,10 @@ def repeated_call_ratios(ctx, n):
 STEPS_FILE = "profile-build-10m.txt"
 
 
-def build_steps(path):
+def build_steps(lines):
     """(step, microseconds) per line of ncu-kernel-times.py --steps."""
     pattern = re.compile(r"^\s+([0-9.]+) us\s+(?:\d+x(?:\s+[0-9.]+ GB\s+[0-9.]+ TB/s)?)?\s+(.*)$")
-    with open(path) as f:
-        return [(m.group(2), float(m.group(1))) for m in map(pattern.match, f) if m]
+    return [(m.group(2), float(m.group(1))) for m in map(pattern.match, lines) if m]
 
 
 def _host_floor_at_10m(builds):
@@ -170,9 +169,10 @@ def _steps_at_10m(ctx):
     path = ctx.gpu_file(STEPS_FILE)
     if not path:
         return []
-    steps = build_steps(path)
     with open(path) as f:
-        table = f.read().rstrip("\n").split("\n", 1)[1]
+        lines = f.read().rstrip("\n").split("\n")
+    steps = build_steps(lines[1:])  # under the title line
+    table = "\n".join(lines[1:])
     us = dict(steps)
     levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level "))]
     big, small = levels[:3], levels[3:]
@@ -584,8 +584,8 @@ def _cuda(ctx):
                 "What a build's upload adds to the staging threads' pass, timed on the host part by part "
                 "(Benchmarks/gpu/variants-upload-parts.txt, call 4): at 100 M points the memory's reservations, "
                 "up to 2.8 ms where the pool maps new memory, and the records' reservation and ingest, 0.3–1.2 ms; "
-                "the rest is the pass itself, 42.8–47.5 ms in the depth-10 builds of that run where the staged copy "
-                "alone took 39.8. The bounds' kernels on the pieces are not what the pass loses: with them reduced "
+                "the rest is the pass itself, 42.8–47.5 ms in the first twelve builds of 100 M points in that run, "
+                "where the staged copy alone took 39.8. The bounds' kernels on the pieces are not what the pass loses: with them reduced "
                 "in one launch after the copy, or every four pieces, the whole call at 100 M points took 1.57–1.59 "
                 "and 1.50–1.56 times the pinned copy against 1.56–1.60 (call 5), within the host's spread (the "
                 "staged copy alone moved between 38.7 and 49.2 ms from run to run).",
