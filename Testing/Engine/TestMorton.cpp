@@ -69,11 +69,37 @@ TEST(RootCube, DegenerateBoundsGetAUsableCube)
 
 TEST(DepthChoice, SharedLevelsOfNeighbouringKeys)
 {
-  EXPECT_EQ(SharedLevels(5, 5), 21);
+  EXPECT_EQ(SharedLevels<std::uint64_t>(5, 5), 21);
   // Keys that differ only in the last triple share levels 0..20.
-  EXPECT_EQ(SharedLevels(8, 9), 20);
+  EXPECT_EQ(SharedLevels<std::uint64_t>(8, 9), 20);
   // Keys that differ in the top triple share only the root.
-  EXPECT_EQ(SharedLevels(0, 1ull << 62), 0);
+  EXPECT_EQ(SharedLevels<std::uint64_t>(0, 1ull << 62), 0);
+}
+
+// Leaf keys of a depth (in 32 bits where they fit, as the build sorts
+// them) share the levels their full-depth keys share; equal ones all 21.
+TEST(DepthChoice, SharedLevelsOfLeafKeysAsOfTheirFullDepthKeys)
+{
+  std::mt19937_64 rng(11);
+  for (int depth = 1; depth <= kMaxLevel; ++depth)
+  {
+    const int bits = 3 * depth;
+    const int shift = 3 * kMaxLevel - bits;
+    for (int k = 0; k < 300; ++k)
+    {
+      const std::uint64_t a = rng() >> (64 - bits);
+      // Equal, one bit apart (any level), or unrelated.
+      const std::uint64_t b = k % 3 == 0 ? a : k % 3 == 1 ? a ^ (1ull << (rng() % bits)) : rng() >> (64 - bits);
+      const int full = SharedLevels(a << shift, b << shift);
+      SCOPED_TRACE(testing::Message() << "depth " << depth << ", keys " << a << ", " << b);
+      EXPECT_EQ(SharedLevels(a, b, depth), full);
+      if (bits <= 32)
+      {
+        EXPECT_EQ(SharedLevels(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), depth), full);
+      }
+      EXPECT_EQ(full, a == b ? kMaxLevel : depth - 1 - (63 - __builtin_clzll(a ^ b)) / 3);
+    }
+  }
 }
 
 #include <octoray/RenderKernels.h>

@@ -9,25 +9,22 @@
 // level below what it shares with either neighbour.
 #pragma once
 
-#include "Config.h"
+#include "Morton.h"
 
 namespace octoray
 {
-// Deepest level at which full-depth keys a and b have the same ancestor
-// (0..20), or 21 when a == b.
-OCTORAY_HD int SharedLevels(std::uint64_t a, std::uint64_t b)
+// Deepest level at which keys a and b of `depth` levels (leaf keys at that
+// depth; full-depth keys by default) have the same ancestor (0..depth - 1),
+// or kMaxLevel when a == b: equal keys of a depth short of kMaxLevel count
+// as sharing the levels below it too, which were not told apart. Keys of 32
+// bits take 32-bit arithmetic: the build's histogram of neighbouring keys
+// runs this three times a point and is bound by how many instructions it
+// issues.
+template <typename Key>
+OCTORAY_HD int SharedLevels(Key a, Key b, int depth = kMaxLevel)
 {
-  const std::uint64_t x = a ^ b;
-  if (!x)
-  {
-    return kMaxLevel;
-  }
-#if defined(__CUDA_ARCH__)
-  const int highest = 63 - __clzll(static_cast<long long>(x));
-#else
-  const int highest = 63 - __builtin_clzll(x);
-#endif
-  return kMaxLevel - 1 - highest / 3;
+  const Key x = a ^ b;
+  return x ? depth - 1 - HighestBit(x) / 3 : kMaxLevel;
 }
 
 constexpr int kDepthHistogramBins = kMaxLevel + 2; // levels -1..21
@@ -42,14 +39,14 @@ struct BinPair
 // 0..kDepthHistogramBins-1) and alone (the next kDepthHistogramBins):
 // newNode's bin is the level shared with the previous key (not counted for
 // i == 0), alone's the deeper of the levels shared with either neighbour
-// (-1 when there is none). Bin b is entry b + 1. fullKey(i) is sorted key
-// i at full depth (leaf keys of a fixed depth shifted up).
-template <class FullKey>
-OCTORAY_HD BinPair DepthHistogramEntries(FullKey fullKey, std::size_t n, std::size_t i)
+// (-1 when there is none). Bin b is entry b + 1. `keys` are leaf keys of
+// `depth` levels (32 or 64 bits).
+template <typename Key>
+OCTORAY_HD BinPair DepthHistogramEntries(const Key* keys, std::size_t n, std::size_t i, int depth)
 {
-  const std::uint64_t key = fullKey(i);
-  const int withPrev = i > 0 ? SharedLevels(fullKey(i - 1), key) : -1;
-  const int withNext = i + 1 < n ? SharedLevels(key, fullKey(i + 1)) : -1;
+  const Key key = keys[i];
+  const int withPrev = i > 0 ? SharedLevels(keys[i - 1], key, depth) : -1;
+  const int withNext = i + 1 < n ? SharedLevels(key, keys[i + 1], depth) : -1;
   return BinPair{ i > 0 ? withPrev + 1 : -1, kDepthHistogramBins + (withPrev > withNext ? withPrev : withNext) + 1 };
 }
 

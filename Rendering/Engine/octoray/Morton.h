@@ -5,6 +5,34 @@
 
 namespace octoray
 {
+// The lowest and the highest set bit of bits != 0 (of keys, of child masks).
+OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
+{
+#if defined(__CUDA_ARCH__)
+  return static_cast<unsigned>(__ffs(static_cast<int>(bits)) - 1);
+#else
+  return static_cast<unsigned>(__builtin_ctz(bits));
+#endif
+}
+
+OCTORAY_HD_INLINE int HighestBit(std::uint32_t bits)
+{
+#if defined(__CUDA_ARCH__)
+  return 31 - __clz(static_cast<int>(bits));
+#else
+  return 31 - __builtin_clz(bits);
+#endif
+}
+
+OCTORAY_HD_INLINE int HighestBit(std::uint64_t bits)
+{
+#if defined(__CUDA_ARCH__)
+  return 63 - __clzll(static_cast<long long>(bits));
+#else
+  return 63 - __builtin_clzll(bits);
+#endif
+}
+
 // Spreads the low 21 bits of v so that bit i lands on bit 3i.
 OCTORAY_HD std::uint64_t SpreadBits3(std::uint64_t v)
 {

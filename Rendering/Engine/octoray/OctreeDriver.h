@@ -530,6 +530,15 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
   return sorted;
 }
 
+// Counts the n sorted leaf keys of `depth` levels in DepthChoice's two
+// histograms (DepthHistogramEntries).
+template <class Device, typename Key>
+void QueueNeighbourHistogram(Device& d, const Key* keys, std::size_t n, int depth, std::uint64_t* counts)
+{
+  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
+    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
+}
+
 // Queues the sort of the state's points by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys (computed, or the stored ones), the
 // sort, and the histogram of neighbouring sorted keys. beforeSort(), if
@@ -590,14 +599,16 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   {
     sorted.keys = SortKeysWithIndices(d, scratch, scratch.sortKey, n, bits, sorted.spare);
   }
-  const SortedKeys sortedKeys = sorted.keys;
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
-  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) {
-      return DepthHistogramEntries([&](std::size_t k) { return sortedKeys.LeafKey(k) << leafShift; }, n, i);
-    },
-    counters + kCounterHistogram);
+  if (sorted.keys.narrowKey)
+  {
+    QueueNeighbourHistogram(d, sorted.keys.narrowKey, n, sortDepth, counters + kCounterHistogram);
+  }
+  else
+  {
+    QueueNeighbourHistogram(d, sorted.keys.wideKey, n, sortDepth, counters + kCounterHistogram);
+  }
   marks[2] = clock.Mark();
   return sorted;
 }

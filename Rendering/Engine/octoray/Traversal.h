@@ -374,24 +374,6 @@ OCTORAY_HD_INLINE unsigned MirrorOctants(unsigned mask, unsigned signs)
   return mask;
 }
 
-OCTORAY_HD_INLINE unsigned LowestBit(unsigned bits)
-{
-#if defined(__CUDA_ARCH__)
-  return static_cast<unsigned>(__ffs(static_cast<int>(bits)) - 1);
-#else
-  return static_cast<unsigned>(__builtin_ctz(bits));
-#endif
-}
-
-OCTORAY_HD_INLINE int HighestBit(unsigned bits)
-{
-#if defined(__CUDA_ARCH__)
-  return 31 - __clz(static_cast<int>(bits));
-#else
-  return 31 - __builtin_clz(bits);
-#endif
-}
-
 // The corner, on one axis, of the node of `level` that holds the point x of
 // the unit cube: x cut down to a multiple of the node's side (exact in
 // float, the scalings being powers of two).
