@@ -18,8 +18,9 @@ namespace octoray
 // or kMaxLevel when a == b: equal keys of a depth short of kMaxLevel count
 // as sharing the levels below it too, which were not told apart. Keys of 32
 // bits take 32-bit arithmetic: the build's histogram of neighbouring keys
-// runs this three times a point and is bound by how many instructions it
-// issues.
+// runs this three times a point, and on an H100 it ran a fifth faster so,
+// where more reads in flight had not made it faster
+// (Benchmarks/gpu/variants-histogram-32bit.txt).
 template <typename Key>
 OCTORAY_HD int SharedLevels(Key a, Key b, int depth = kMaxLevel)
 {

@@ -601,6 +601,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   }
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
+  // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
   if (sorted.keys.narrowKey)
   {
     QueueNeighbourHistogram(d, sorted.keys.narrowKey, n, sortDepth, counters + kCounterHistogram);
