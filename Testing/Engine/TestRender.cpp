@@ -446,6 +446,27 @@ TEST_P(RenderTest, DepthBufferInDeviceMemory)
 
 INSTANTIATE_TEST_SUITE_P(Backends, RenderTest, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
 
+// The device's traversal reads mirrored child masks from this table
+// (OctantMirror); the CUDA pictures' tests above check its use.
+TEST(Traversal, MirroredMasksFlipOctantsByTheRaySigns)
+{
+  const MirroredMasks table = EveryMirroredMask();
+  for (unsigned signs = 0; signs < 8; ++signs)
+  {
+    const OctantMirror mirror(signs);
+    for (unsigned mask = 0; mask < 256; ++mask)
+    {
+      unsigned expected = 0;
+      for (unsigned octant = 0; octant < 8; ++octant)
+      {
+        expected |= ((mask >> octant) & 1u) << (octant ^ signs);
+      }
+      ASSERT_EQ(table.bySigns[signs][mask], expected) << "signs " << signs << ", mask " << mask;
+      ASSERT_EQ(mirror(mask), expected) << "signs " << signs << ", mask " << mask;
+    }
+  }
+}
+
 TEST(DepthSignature, ChangesWithAnyPixel)
 {
   std::vector<float> depth(640 * 480);

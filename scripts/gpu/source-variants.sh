@@ -19,12 +19,15 @@
 # Run after gpu-check.sh, it builds against that call's VTK (/tmp/vtk-egl);
 # without it, the engine alone (OCTORAY_ENABLE_VTK=OFF), which is all the
 # benchmark needs. With TESTS=1 the "main" folder also builds and runs the
-# engine's tests (both backends).
+# engine's tests (both backends); TESTS="main NAME..." names the variants
+# that do (those whose files still fit the tree's tests).
 #
-#   SOURCE_VARIANTS="main NAME..." [SECTION=render|build] [ROUNDS=N] [TESTS=1] \
+#   SOURCE_VARIANTS="main NAME..." [SECTION=render|build] [ROUNDS=N] [TESTS=1|"NAME..."] \
 #     scripts/gpu/source-variants.sh OUTDIR
 set -uo pipefail
 cd "$(dirname "$0")/../.."
+tested=" ${TESTS:-} "
+[ "${TESTS:-}" = 1 ] && tested=" main "
 out=$(realpath -m "$1")
 mkdir -p "$out"
 vtk=/tmp/vtk-egl
@@ -52,9 +55,9 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
       cp "$f" "$src/$target"
     done
   done
-  # The tests belong to the tree's own headers: built in "main" alone.
+  # The tests belong to the tree's own headers: built in the variants TESTS names.
   targets=(octoray_bench_cuda)
-  [ "${TESTS:-0}" = 1 ] && [ "$v" = main ] && targets+=(octoray_engine_tests)
+  [[ "$tested" == *" $v "* ]] && targets+=(octoray_engine_tests)
   { cmake -S "$src" -B "$src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
       -DCMAKE_CUDA_ARCHITECTURES=90 "${with_vtk[@]}" -DCMAKE_CXX_FLAGS='-include cstdint' \
       -DOCTORAY_GTEST_SOURCE_DIR="$src/.gpu-vtk/googletest" &&
@@ -64,10 +67,12 @@ wait
 for v in $SOURCE_VARIANTS; do
   [ -x /tmp/src-$v/build/bin/octoray_bench_cuda ] || { echo "== $v: build failed"; tail -5 "$out/build-$v.log"; }
 done
-if [ "${TESTS:-0}" = 1 ]; then
-  /tmp/src-main/build/bin/octoray_engine_tests > "$out/variant-main-tests.log" 2>&1
-  echo "== main: engine tests, exit $?"; grep -E "tests ran|PASSED|FAILED" "$out/variant-main-tests.log" | head -5
-fi
+for v in $SOURCE_VARIANTS; do
+  tests=/tmp/src-$v/build/bin/octoray_engine_tests
+  [[ "$tested" == *" $v "* ]] || continue
+  "$tests" > "$out/variant-$v-tests.log" 2>&1
+  echo "== $v: engine tests, exit $?"; grep -E "tests ran|PASSED|FAILED" "$out/variant-$v-tests.log" | head -5
+done
 for r in $(seq "${ROUNDS:-1}"); do
   for v in $SOURCE_VARIANTS; do
     /tmp/src-$v/build/bin/octoray_bench_cuda --only "$section" >> "$out/source-$v.log" 2>&1

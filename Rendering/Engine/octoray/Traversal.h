@@ -356,8 +356,9 @@ OCTORAY_HD_INLINE unsigned OctantsAfter(unsigned m)
   return static_cast<unsigned>(0x80C0A0F088CCAAFFull >> (8u * m)) & 0xFFu;
 }
 
-// A child mask with octant bits flipped as in NodeCrossings.
-OCTORAY_HD_INLINE unsigned MirrorOctants(unsigned mask, unsigned signs)
+// A child mask with octant bits flipped as in NodeCrossings: bit m of the
+// result is bit m ^ signs of the mask.
+constexpr OCTORAY_HD_INLINE unsigned MirrorOctants(unsigned mask, unsigned signs)
 {
   if (signs & 1u)
   {
@@ -373,6 +374,62 @@ OCTORAY_HD_INLINE unsigned MirrorOctants(unsigned mask, unsigned signs)
   }
   return mask;
 }
+
+// MirrorOctants of every mask, for each of the eight signs.
+struct MirroredMasks
+{
+  std::uint8_t bySigns[8][256];
+};
+
+constexpr MirroredMasks EveryMirroredMask()
+{
+  MirroredMasks table{};
+  for (unsigned signs = 0; signs < 8; ++signs)
+  {
+    for (unsigned mask = 0; mask < 256; ++mask)
+    {
+      table.bySigns[signs][mask] = static_cast<std::uint8_t>(MirrorOctants(mask, signs));
+    }
+  }
+  return table;
+}
+
+#if defined(__CUDACC__)
+__device__ const MirroredMasks kMirroredMasks = EveryMirroredMask();
+#endif
+
+// MirrorOctants for one ray's signs. On the device a load from the table
+// (2 kB, which stays in the L1 cache), where the swaps are a dozen integer
+// instructions a step of a traversal that is bound by the integer pipe
+// (Benchmarks/gpu/variants-mirror-table.txt); on the host the swaps.
+class OctantMirror
+{
+public:
+  OCTORAY_HD_INLINE explicit OctantMirror(unsigned signs)
+#if defined(__CUDA_ARCH__)
+    : row(kMirroredMasks.bySigns[signs])
+#else
+    : signs(signs)
+#endif
+  {
+  }
+
+  OCTORAY_HD_INLINE unsigned operator()(unsigned mask) const
+  {
+#if defined(__CUDA_ARCH__)
+    return row[mask];
+#else
+    return MirrorOctants(mask, signs);
+#endif
+  }
+
+private:
+#if defined(__CUDA_ARCH__)
+  const std::uint8_t* row;
+#else
+  unsigned signs;
+#endif
+};
 
 // The corner, on one axis, of the node of `level` that holds the point x of
 // the unit cube: x cut down to a multiple of the node's side (exact in
@@ -404,6 +461,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   float tEnter, float tExit)
 {
   const unsigned signs = DirectionSigns(ray);
+  const OctantMirror mirror(signs);
   // Whether the picture has a level of detail at all (most are drawn down
   // to the leaves): asked once here, so that those pictures skip StopAt's
   // arithmetic at every step.
@@ -420,7 +478,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   // (never empty: a child is stepped to only where it meets that part), so
   // the loop needs no test of its own for voxels before tMin or past tMax.
   unsigned todo =
-    MirrorOctants(childMask, signs) & MetOctants(c.midT, Later(tEnter, ray.tMin), Earlier(tExit, ray.tMax));
+    mirror(childMask) & MetOctants(c.midT, Later(tEnter, ray.tMin), Earlier(tExit, ray.tMax));
   for (;;)
   {
     if (!todo)
@@ -469,7 +527,7 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     // entered (Attributes.h).
     const std::uint64_t groupMasks = tree.childMasks[child >> 3];
     const unsigned grandchildMask = MaskInWord(groupMasks, child);
-    const unsigned met = MirrorOctants(grandchildMask, signs) &
+    const unsigned met = mirror(grandchildMask) &
       MetOctants(innerMidT, Later(span.tEnter, ray.tMin), Earlier(span.tExit, ray.tMax));
     const unsigned after = todo & OctantsAfter(m);
     if (!met)
