@@ -82,4 +82,5 @@ for v in $SOURCE_VARIANTS; do
   echo "== source variant $v"
   grep -E "^(render depth|upload of|build n=.*depth=10)" "$out/source-$v.log"
   [ "$section" = build ] && python3 scripts/gpu/build-ratios.py "$out/source-$v.log" | tail -n +2
+  [ "$section" = render ] && python3 scripts/gpu/render-rates.py "$out/source-$v.log" | tail -n +2
 done
