@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One engine-only device call over source variants (no VTK): the variants
 # built side by side and one benchmark section of each run in turn
-# (source-variants.sh, with the engine tests in "main"), then
+# (source-variants.sh, with the engine tests in the variants TESTS names,
+# "main" by default), then
 # compute-sanitizer over main's CUDA tests of that section and Nsight
 # Compute on the variants in NCU. SECTION=build (the default): the build
 # benchmark (RENDER=1 adds each one's render section), sanitizers over the
@@ -81,8 +82,7 @@ for v in ${NCU:-main before}; do
   done
 done
 elapsed ncu
-mv "$D"/profile16-*.csv /tmp/ 2>/dev/null
-rm -f "$D"/*.csv
+rm -f "$D"/pb-*.csv
 [ -n "$archive" ] && tar czf "$archive" -C "$D" .
 
 cat "$D/variants.txt"

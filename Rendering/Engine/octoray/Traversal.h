@@ -399,9 +399,11 @@ __device__ const MirroredMasks kMirroredMasks = EveryMirroredMask();
 #endif
 
 // MirrorOctants for one ray's signs. On the device a load from the table
-// (2 kB, which stays in the L1 cache), where the swaps are a dozen integer
-// instructions a step of a traversal that is bound by the integer pipe
-// (Benchmarks/gpu/variants-mirror-table.txt); on the host the swaps.
+// (2 kB, which stays in the L1 cache): the swaps took about 14 of the 225
+// instructions of a step, in a kernel that issues an instruction three
+// cycles in four and sends near half of them to the ALU pipe (logic,
+// compares, selects), its busiest (Benchmarks/gpu/variants-mirror-table.txt).
+// On the host the swaps.
 class OctantMirror
 {
 public:
