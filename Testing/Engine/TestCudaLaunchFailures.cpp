@@ -96,18 +96,21 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   // Its automatic depth lies beyond level 10: the full-depth sort runs too,
   // from the kept keys (LeafKeysKernel). Records of two words (colours and
   // reflectivity) travel with the first sort's keys.
-  Cloud second = TightClusters(300, 1e-5, 47);
-  second.scalar.clear();
-  second.normal.clear();
-  second.refraction.clear();
+  Cloud tight = TightClusters(300, 1e-5, 47);
+  tight.scalar.clear();
+  tight.normal.clear();
+  tight.refraction.clear();
+  // Levels of more children than SmallLevelsKernel takes (InnerKernel).
+  const Cloud wide = UniformCloud(50000, 62);
   BuildOptions fixedDepth;
   fixedDepth.depth = 6;
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LeafKeysKernel", "LeafKernel", "InnerKernel" })
+         "LeafKeysKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
   {
     SCOPED_TRACE(kernel);
+    const Cloud& second = std::string(kernel) == "InnerKernel" ? wide : tight;
     auto engine = CreateEngine(Backend::CUDA);
     engine->Build(first.View(), fixedDepth);
     HostOctree before;

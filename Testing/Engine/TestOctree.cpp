@@ -19,6 +19,20 @@ TEST_P(OctreeBuild, UniformRandom)
   ExpectDepthRule(t, c);
 }
 
+// Levels of many children take a select and a loop each, the small ones
+// near the root one pass together (Device::ReduceSmallLevels): a level
+// with more children than a small level has, on either backend, and every
+// level above it.
+TEST_P(OctreeBuild, LevelsOfManyAndOfFewChildren)
+{
+  const Cloud c = UniformCloud(50000, 15);
+  BuildAndCompare(*engine, c, 8);
+  HostOctree t;
+  engine->CopyToHost(t);
+  // More leaves than either backend's kSmallLevelItems (4096 and 16384).
+  EXPECT_GT(t.levelBegin[9] - t.levelBegin[8], 16384u);
+}
+
 TEST_P(OctreeBuild, GaussianClusters)
 {
   BuildAndCompare(*engine, GaussianClusters(20000, 13), 9);

@@ -14,9 +14,11 @@ microseconds (the level phase's selects and loops, level by level). With
 --steps, the last run's launches summed by the build's steps, in the order
 the build queues them: the positions' bounds (during the upload), the keys,
 the records, the sort, the histogram of neighbouring keys, then each level
-from the leaves up (a CUB select and a loop each; a level's select begins
-with its DeviceCompactInitKernel), and the device phases' sum (keys, sort,
-histogram, levels: what the benchmark's phases time, but the records).
+from the leaves (level 10, the depth of --profile-build) up (a CUB select
+and a loop each; a level's select begins with its DeviceCompactInitKernel),
+the levels near the root in one launch (SmallLevelsKernel), and the device
+phases' sum (keys, sort, histogram, levels: what the benchmark's phases
+time, but the records).
 """
 import re
 import sys
@@ -70,6 +72,8 @@ STEPS = (("positions' bounds (in the upload)", ("ReduceRangeKernel", "reduce::De
          ("sort (CUB)", ("DeviceRadixSort",)),
          ("keys", ("QueueSort",)))
 PHASES = ("keys", "sort (CUB)", "histogram of neighbouring keys")
+PROFILE_BUILD_DEPTH = 10  # octoray_bench_cuda --profile-build's
+SMALL_LEVELS = "levels near the root (one launch)"
 
 
 def steps(last):
@@ -81,17 +85,18 @@ def steps(last):
         if "DeviceCompactInitKernel" in full:
             selects += 1
         step = next((name for name, keys in STEPS if any(k in full for k in keys)), None)
-        if step is None or selects:
+        if "SmallLevelsKernel" in full:
+            step = SMALL_LEVELS
+        elif step is None or selects:
             step = -selects  # a level, counted from the leaves; named below
         count, total, traffic = table.get(step, (0, 0.0, 0.0))
         table[step] = (count + 1, total + ms, None if gb is None or traffic is None else traffic + gb)
-    depth = selects - 1
 
     def name(step):
         if not isinstance(step, int):
             return step
-        level = depth + 1 + step
-        return "other" if step == 0 else f"leaves (level {level})" if level == depth else f"level {level}"
+        level = PROFILE_BUILD_DEPTH + 1 + step
+        return "other" if step == 0 else f"leaves (level {level})" if step == -1 else f"level {level}"
     return [(name(step),) + values for step, values in table.items()]
 
 
@@ -99,7 +104,7 @@ def print_steps(path, builds, last):
     print(f"{path}: the last of {builds} builds by step")
     phases = 0.0
     for step, count, ms, gb in steps(last):
-        if step in PHASES or step.startswith(("leaves", "level ")):
+        if step in PHASES or step == SMALL_LEVELS or step.startswith(("leaves", "level ")):
             phases += ms
         dram = f"  {gb:6.3f} GB {gb / ms:5.2f} TB/s" if gb is not None and ms > 0 else ""
         print(f"  {1000 * ms:8.1f} us  {count:3d}x{dram}  {step}")

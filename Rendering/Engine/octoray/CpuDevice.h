@@ -177,6 +177,34 @@ public:
     ParallelFor(n, threads, fn);
   }
 
+  // Levels of at most kSmallLevelItems children, from `top` down to 0 in
+  // turn (OctreeDriver.h's LinkLevels): each level's runs of children
+  // (levels.StartsRun) into `starts`, then levels.Reduce(l, j, starts[j],
+  // starts[j + 1]) for each run j. Here one thread's loop, as the select
+  // and the loop of a level of so few items were.
+  static constexpr std::size_t kSmallLevelItems = kParallelForMinItems;
+  template <typename Levels>
+  void ReduceSmallLevels(const char*, int top, const Levels& levels, std::uint32_t* starts)
+  {
+    for (int l = top; l >= 0; --l)
+    {
+      const std::uint32_t children = levels.Children(l);
+      std::uint32_t runs = 0;
+      for (std::uint32_t c = 0; c < children; ++c)
+      {
+        if (levels.StartsRun(l, c))
+        {
+          starts[runs++] = c;
+        }
+      }
+      starts[runs] = children;
+      for (std::uint32_t j = 0; j < runs; ++j)
+      {
+        levels.Reduce(l, j, starts[j], starts[j + 1]);
+      }
+    }
+  }
+
   template <typename T, typename Map, typename Combine>
   T Reduce(std::size_t n, T identity, Map map, Combine combine)
   {

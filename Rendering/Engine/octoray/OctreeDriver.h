@@ -156,7 +156,7 @@ void RunStarts(Device& d, DriverScratch<Device>& scratch, Keys keys, std::size_t
 {
   d.Select(
     n + 1,
-    OCTORAY_LAMBDA(std::size_t i) { return i == n || i == 0 || (keys[i] >> shift) != (keys[i - 1] >> shift); },
+    OCTORAY_LAMBDA(std::size_t i) { return i == n || StartsRun(keys, i, shift); },
     starts, scratch.counters.Get() + kCounterSelected);
 }
 
@@ -745,7 +745,11 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
     ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
   });
-  for (int l = depth - 1; l >= 0; --l)
+  // Levels of many children: a select and a loop each. The few small ones
+  // near the root together (Device::ReduceSmallLevels).
+  const InnerLevels levels{ view };
+  int l = depth - 1;
+  for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
   {
     const std::uint32_t begin = view.levelBegin[l];
     const std::uint32_t childBegin = view.levelBegin[l + 1];
@@ -759,9 +763,12 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
       RunStarts(d, scratch, view.key + childBegin, view.LevelSize(l + 1), 3, starts);
     }
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
-      const std::uint32_t c0 = childBegin + starts[j];
-      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), view.Key(c0) >> 3, c0, childBegin + starts[j + 1]);
+      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), childBegin + starts[j], childBegin + starts[j + 1]);
     });
+  }
+  if (l >= 0)
+  {
+    d.ReduceSmallLevels("SmallLevelsKernel", l, levels, starts);
   }
 }
 

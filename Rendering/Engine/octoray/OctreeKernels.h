@@ -170,13 +170,21 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   StoreNodeMeans(t, node, sum, static_cast<double>(end - begin));
 }
 
-// Inner `node` has the children [c0, c1) (global indices, one level down):
-// child mask, its group's first child where it starts a group, count and
-// count-weighted means.
-OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint64_t levelKey, std::uint32_t c0,
-  std::uint32_t c1)
+// Whether item i of sorted keys starts a run of equal keys >> shift: the
+// runs of a level's nodes are its parents (shift 3), those of the sorted
+// points the leaves.
+template <typename Keys>
+OCTORAY_HD bool StartsRun(const Keys& keys, std::size_t i, int shift)
 {
-  t.SetKey(node, levelKey);
+  return i == 0 || (keys[i] >> shift) != (keys[i - 1] >> shift);
+}
+
+// Inner `node` has the children [c0, c1) (global indices, one level down):
+// its key (its children's, one level up), child mask, its group's first
+// child where it starts a group, count and count-weighted means.
+OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint32_t c0, std::uint32_t c1)
+{
+  t.SetKey(node, t.Key(c0) >> 3);
   if ((node & 7u) == 0)
   {
     t.childBase[node >> 3] = c0;
@@ -201,6 +209,30 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
     StoreNodeMeans(t, node, sum, static_cast<double>(count));
   }
 }
+
+// The inner levels as Device::ReduceSmallLevels walks them: level l's nodes
+// are the runs of equal parent keys among level l + 1's nodes, its
+// children (c and j count from each level's first node).
+struct InnerLevels
+{
+  OctreeView view;
+
+  OCTORAY_HD std::uint32_t Children(int l) const { return view.LevelSize(l + 1); }
+
+  // Whether child c starts a run of one parent's children.
+  OCTORAY_HD bool StartsRun(int l, std::uint32_t c) const
+  {
+    const std::uint32_t first = view.levelBegin[l + 1];
+    return octoray::StartsRun(NodeKeys{ view.key + first, view.keyHigh ? view.keyHigh + first : nullptr }, c, 3);
+  }
+
+  // Node j of level l from its children [c0, c1).
+  OCTORAY_HD void Reduce(int l, std::uint32_t j, std::uint32_t c0, std::uint32_t c1) const
+  {
+    const std::uint32_t first = view.levelBegin[l + 1];
+    ReduceChildren(view, view.levelBegin[l] + j, first + c0, first + c1);
+  }
+};
 
 // In-place update: a point that changed leaf leaves every node on its old
 // leaf's path to the root and joins every node on its new leaf's. Records
