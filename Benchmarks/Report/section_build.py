@@ -174,9 +174,13 @@ def _steps_at_10m(ctx):
     steps = build_steps(lines[1:])  # under the title line
     table = "\n".join(lines[1:])
     us = dict(steps)
-    levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level "))]
+    # "levels near the root (one launch)" since 9c054dd: ncu-kernel-times.py's SMALL_LEVELS.
+    levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level"))]
     big, small = levels[:3], levels[3:]
     level_us = sum(t for _, t in levels)
+    apart = [name for name, _ in small if name.startswith("level ")]
+    launches = ("%d levels of three launches each, a CUB select, its init and the loop" % len(apart) +
+                (", the rest in one launch" if len(apart) < len(small) else ""))
     return [
         "At 10 M points, where the device phases are furthest from the sort, Nsight Compute times each kernel of "
         "the second of two builds, summed here by step (gpu-check.sh's profile-build part, "
@@ -189,11 +193,10 @@ def _steps_at_10m(ctx):
         "```",
         "",
         "The levels take %.0f µs of the phases' %.0f, more than the sort's %.0f: the leaves and the two levels "
-        "above them %.0f µs, the %d levels nearer the root %.0f µs, three launches each (a CUB select, its "
-        "init, and the loop). Within twice the sort, the keys, the histogram and the levels together would "
-        "have to take no longer than the sort (here %.0f µs)." % (
+        "above them %.0f µs, the levels nearer the root %.0f µs: %s. Within twice the sort, the keys, the "
+        "histogram and the levels together would have to take no longer than the sort (here %.0f µs)." % (
             level_us, us.get("device phases (keys, sort, histogram, levels)", float("nan")),
-            us.get("sort (CUB)", float("nan")), sum(t for _, t in big), len(small), sum(t for _, t in small),
+            us.get("sort (CUB)", float("nan")), sum(t for _, t in big), sum(t for _, t in small), launches,
             us.get("keys", 0) + us.get("histogram of neighbouring keys", 0) + level_us),
         "",
     ]
@@ -480,6 +483,14 @@ def _cuda(ctx):
         "Nodes of one point or one child storing its values as they are, without the sums in double, made the "
         "leaf kernel slower: 1.77 ms at 100 M points in ncu against 1.60 "
         "(Benchmarks/gpu/variants-one-value-nodes.txt, not kept). "
+        "Since 9c054dd the levels of at most 16384 children (four or five near the root) are reduced together "
+        "in one launch of one block (CudaDevice.h's SmallLevelsKernel: each level's run starts by a block-wide "
+        "scan, then its nodes), which the fourteenth session's try had left because every select of its build "
+        "ran slower; this time they did not, beyond one ncu run's spread. In ncu levels 4 to 0 took 32 µs "
+        "where their 15 launches took 82 at 10 M points (79 at 100 M); in the benchmark the level phase at 1 M "
+        "points went from 0.226–0.231 to 0.194–0.202 ms, at 10 M from 0.677–0.679 to 0.649–0.659 ms but for "
+        "one round's 0.862, and at 100 M it stayed within its spread (Benchmarks/gpu/variants-levels-near-root.txt; "
+        "the profile by step below is the report's run, before it). "
         "Node keys take 4 bytes where every level's fit 32 bits (depth 10 and less; Attributes.h's key and "
         "keyHigh, 7e47113): the level phase writes each once and reads it twice, and with the 64-bit keys before "
         "built beside it and run in turn it went from 3.46–3.67 to 2.89–3.10 ms at 100 M points, the device phases "
