@@ -22,7 +22,7 @@ MIRROR_TABLE = (
     "\n\nThe table and the kernel above are the report's run (7e47113). Since ae8927f the device reads a child "
     "mask with its octant bits flipped by the ray's direction signs (MirrorOctants) from a 2 kB table of every mask "
     "for each of the eight signs, where it swapped the bits: ncu's count of each machine instruction of the "
-    "depth-16 frame had the traversal's loop at about 225 warp instructions a step, near half of them on the "
+    "depth-16 frame had the traversal's loop at 228 warp instructions a step (216 since), near half of them on the "
     "integer pipe (its busiest, at 75 % of its peak), and the swaps at about 14 of them. Built beside the engine "
     "before it and run in turn, three rounds on one H100: primary rays at depth 10 2736–2809 Mrays/s against "
     "2583–2634, at depth 16 1049–1071 against 991–1007 (issue 16's goal 1,000), Phong with shadows and a bounce "

@@ -5,9 +5,17 @@ for the K-th table of the file (ncu 2025.3 writes two tables a profiled
 kernel, alike: the first kernel's is 0, the second's 2), the warp
 instructions executed and the stall samples per opcode, most executed
 first, and the most sampled instructions. Used on the build's leaf and inner
-loops (Benchmarks/gpu/variants-leaf-loop.txt).
+loops (Benchmarks/gpu/variants-leaf-loop.txt) and on the render kernel's
+traversal (variants-mirror-table.txt).
 
-    ncu-sass-opcodes.py SOURCE.txt [K]
+    ncu-sass-opcodes.py SOURCE.txt [K] [--loop]
+
+With --loop, the hottest loop instead: the instructions executed at least
+a quarter as often as the most executed one (a loop's body, its branches
+that most steps take, and its joins, which both sides of a branch execute),
+in order, with their counts and stall samples; its steps, the count most of
+those instructions share; and the warp instructions a step, all the
+kernel's executed instructions over its steps.
 """
 import collections
 import sys
@@ -39,10 +47,26 @@ def opcode(sass):
     return word.split(".")[0]
 
 
+def print_loop(rows):
+    most = max(count for _, _, count in rows)
+    hot = [(sass, samples, count) for sass, samples, count in rows if count * 4 >= most]
+    steps = collections.Counter(count for _, _, count in hot).most_common(1)[0][0]
+    total = sum(count for _, _, count in rows)
+    print(f"{len(hot)} instructions in the loop, {steps} steps; {total} warp instructions executed, "
+          f"{total / steps:.1f} a step")
+    print("executed, samples, instruction")
+    for sass, samples, count in hot:
+        print(f"  {count:10d} {samples:7d}  {sass[:70]}")
+
+
 def main():
-    lines = open(sys.argv[1]).read().split("\n")
-    k = int(sys.argv[2]) if len(sys.argv) > 2 else 0
+    args = [a for a in sys.argv[1:] if a != "--loop"]
+    lines = open(args[0]).read().split("\n")
+    k = int(args[1]) if len(args) > 1 else 0
     rows = list(instructions(lines, *tables(lines)[k]))
+    if "--loop" in sys.argv:
+        print_loop(rows)
+        return
     executed = collections.Counter()
     sampled = collections.Counter()
     for sass, samples, count in rows:

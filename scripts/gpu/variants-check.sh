@@ -10,9 +10,9 @@
 # 100 M-point build by step (ncu-kernel-times.py --steps). SECTION=render:
 # the render benchmark, sanitizers over the render and scene tests, and
 # ncu's profile of the depth-16 primary-ray frame (ncu-summary.py) with its
-# SASS and each instruction's count (ncu-sass-opcodes.py). Files go to
-# OUTDIR, packed into ARCHIVE (a device call returns a limited number of
-# files); the closing lines print last.
+# SASS, each instruction's count and the traversal's loop
+# (ncu-sass-opcodes.py). Files go to OUTDIR, packed into ARCHIVE (a device
+# call returns a limited number of files); the closing lines print last.
 #
 #   V="main before" [NCU="main before"] [TESTS=1|"NAME..."] [SECTION=build|render] [ROUNDS=2] \
 #     [RENDER=1] scripts/gpu/variants-check.sh OUTDIR [ARCHIVE]
@@ -70,6 +70,7 @@ for v in ${NCU:-main before}; do
   timeout 150 ncu --clock-control none -k regex:RenderKernel --launch-skip 42 --launch-count 1 \
     --section SourceCounters --page source --print-source sass "$bench" --only render > "$D/sass16-$v.txt" 2>&1
   python3 scripts/gpu/ncu-sass-opcodes.py "$D/sass16-$v.txt" 0 > "$D/opcodes16-$v.txt" 2>&1
+  python3 scripts/gpu/ncu-sass-opcodes.py "$D/sass16-$v.txt" 0 --loop > "$D/loop16-$v.txt" 2>&1
 done
 for v in ${NCU:-main before}; do
   [ "$section" = build ] || break

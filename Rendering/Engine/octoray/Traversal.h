@@ -399,7 +399,7 @@ __device__ const MirroredMasks kMirroredMasks = EveryMirroredMask();
 #endif
 
 // MirrorOctants for one ray's signs. On the device a load from the table
-// (2 kB, which stays in the L1 cache): the swaps took about 14 of the 225
+// (2 kB, which stays in the L1 cache): the swaps took about 14 of the 228
 // instructions of a step, in a kernel that issues an instruction three
 // cycles in four and sends near half of them to the ALU pipe (logic,
 // compares, selects), its busiest (Benchmarks/gpu/variants-mirror-table.txt).
