@@ -7,7 +7,7 @@
 # SRC is the folder scripts/gpu/fetch-vtk.sh filled (vtk92-subset.tar.xz and
 # gl/*.deb). It builds on either machine: on the GPU machine (Ubuntu 24.04,
 # GCC 13, 16 cores: about 5 minutes), or here on Debian 12 once (2 cores:
-# about 40 minutes), packed by scripts/gpu/fetch-vtk.sh --pack and carried,
+# 22 minutes on 2026-11-27), packed by scripts/gpu/fetch-vtk.sh --prebuilt and carried,
 # so that a GPU run spends no device time on VTK.
 set -euo pipefail
 src=$(realpath "$1"); prefix=$(realpath -m "$2")

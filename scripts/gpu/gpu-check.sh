@@ -109,15 +109,10 @@ if want profile; then
   # RenderKernel launches of `--only render`: 10 with the copy to the host,
   # then 10 primary and 10 full frames at depth 10 (one of each profiled),
   # then the same at depth 16 (its primary frame profiled too, the goal
-  # furthest off). The card's clocks are left as they are.
+  # furthest off).
   for run in primary:12 full:22 primary16:42; do
-    step "profile-${run%%:*}" ncu --clock-control none -k regex:RenderKernel --launch-skip "${run##*:}" \
-      --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
-      --section MemoryWorkloadAnalysis --section WarpStateStats --section ComputeWorkloadAnalysis \
-      --section InstructionStats \
-      --metrics 'regex:smsp__average_warps_issue_stalled_.*_per_issue_active\.ratio$,regex:sm__inst_executed_pipe_[a-z0-9_]*\.avg\.pct_of_peak_sustained_active$' \
-      --csv --page details \
-      --log-file "$out/profile-${run%%:*}.csv" $build/bin/octoray_bench_cuda --only render
+    step "profile-${run%%:*}" scripts/gpu/ncu-render.sh "${run##*:}" "$out/profile-${run%%:*}.csv" \
+      $build/bin/octoray_bench_cuda
   done
   python3 scripts/gpu/ncu-summary.py "$out"/profile-primary.csv "$out"/profile-full.csv "$out"/profile-primary16.csv \
     > "$out/profile.txt" 2>&1

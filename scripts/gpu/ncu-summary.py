@@ -2,7 +2,8 @@
 """A short table from Nsight Compute's CSV details pages (ncu --csv --page
 details): per profiled kernel, its time, memory and compute throughput,
 cache hit rates, occupancy, registers and the top stall reasons (warp cycles
-per issued instruction spent in each). Used by gpu-check.sh's profile part.
+per issued instruction spent in each). Used by gpu-check.sh's profile part
+and variants-check.sh's render section (ncu-render.sh makes the CSV).
 
     ncu-summary.py PROFILE.csv...
 """

@@ -61,11 +61,7 @@ elapsed sanitizers
 for v in ${NCU:-main before}; do
   [ "$section" = render ] || break
   bench="/tmp/src-$v/build/bin/octoray_bench_cuda"
-  timeout 150 ncu --clock-control none -k regex:RenderKernel --launch-skip 42 --launch-count 1 \
-    --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
-    --section ComputeWorkloadAnalysis --section InstructionStats \
-    --metrics 'regex:smsp__average_warps_issue_stalled_.*_per_issue_active\.ratio$,regex:sm__inst_executed_pipe_[a-z0-9_]*\.avg\.pct_of_peak_sustained_active$' \
-    --csv --page details --log-file "$D/profile16-$v.csv" "$bench" --only render > /dev/null 2>&1
+  timeout 150 scripts/gpu/ncu-render.sh 42 "$D/profile16-$v.csv" "$bench" > /dev/null 2>&1
   python3 scripts/gpu/ncu-summary.py "$D/profile16-$v.csv" > "$D/profile16-$v.txt" 2>&1
   timeout 150 ncu --clock-control none -k regex:RenderKernel --launch-skip 42 --launch-count 1 \
     --section SourceCounters --page source --print-source sass "$bench" --only render > "$D/sass16-$v.txt" 2>&1
