@@ -16,21 +16,27 @@ SIZE = "960x540"
 REPEATS = 5
 GPU_RENDER_FILE = "bench-render-cuda.json"  # octoray_bench_render --backend cuda on the GPU machine
 
-# The one render change after the report's GPU run, measured in its own
-# calls beside the engine before it (Benchmarks/gpu/variants-mirror-table.txt).
+# The traversal's last change and its last try, each measured in its own
+# calls beside the engine before it (Benchmarks/gpu/variants-mirror-table.txt,
+# variants-paused-planes.txt).
 MIRROR_TABLE = (
-    "\n\nThe table and the kernel above are the report's run (7e47113). Since ae8927f the device reads a child "
-    "mask with its octant bits flipped by the ray's direction signs (MirrorOctants) from a 2 kB table of every mask "
-    "for each of the eight signs, where it swapped the bits: ncu's count of each machine instruction of the "
-    "depth-16 frame had the traversal's loop at 228 warp instructions a step (216 since), near half of them on the "
-    "integer pipe (its busiest, at 75 % of its peak), and the swaps at about 14 of them. Built beside the engine "
-    "before it and run in turn, three rounds on one H100: primary rays at depth 10 2736–2809 Mrays/s against "
-    "2583–2634, at depth 16 1049–1071 against 991–1007 (issue 16's goal 1,000), Phong with shadows and a bounce "
-    "1842–1892 against 1783–1809; in ncu the depth-16 frame took 1.90–1.93 ms with 1477 M warp instructions against "
-    "2.04 ms and 1559 M ([gpu/variants-mirror-table.txt](gpu/variants-mirror-table.txt), its summary lines by "
+    "\n\nSince ae8927f the device reads a child mask with its octant bits flipped by the ray's direction signs "
+    "(MirrorOctants) from a 2 kB table of every mask for each of the eight signs, where it swapped the bits: ncu's "
+    "count of each machine instruction of the depth-16 frame had the traversal's loop at 228 warp instructions a "
+    "step (216 since), near half of them on the integer pipe (its busiest, at 75 % of its peak), and the swaps at "
+    "about 14 of them. Built beside the engine before it and run in turn, three rounds on one H100: primary rays "
+    "at depth 10 2736–2809 Mrays/s against 2583–2634, at depth 16 1049–1071 against 991–1007 (issue 16's goal "
+    "1,000), Phong with shadows and a bounce 1842–1892 against 1783–1809; in ncu the depth-16 frame took "
+    "1.90–1.93 ms with 1477 M warp instructions against 2.04 ms and 1559 M "
+    "([gpu/variants-mirror-table.txt](gpu/variants-mirror-table.txt), its summary lines by "
     "scripts/gpu/render-rates.py). Not kept: the comparisons of the children's test as PTX set masks (ptxas made "
     "each a compare and a select: 6 % slower), the swaps without branches, the first-children word read beside "
-    "the masks, and the register caps of 5 and 7 blocks a multiprocessor (no faster).")
+    "the masks, and the register caps of 5 and 7 blocks a multiprocessor (no faster). Nor a paused node's nine "
+    "crossings and corner kept beside it on the stack, so that going back up reads them where it computes them "
+    "again: the step fell to 184 warp instructions, but 48 more bytes a level for 768 threads a multiprocessor "
+    "outgrew the L1 cache, and every frame ran 2–6 times slower (the depth-16 frame 11.9 ms in ncu against 1.90, "
+    "94 % of its stalls waiting on local memory; "
+    "[gpu/variants-paused-planes.txt](gpu/variants-paused-planes.txt)).")
 
 
 def produce(ctx):
@@ -274,10 +280,6 @@ def _cuda_cloud(ctx):
                  "`profile` part, `ncu --clock-control none`, [gpu/profile.txt](gpu/profile.txt); the kernel is "
                  "built with the register cap OCTORAY_RENDER_MIN_BLOCKS, Rendering/Engine/CMakeLists.txt):\n\n"
                  "```\n%s```\n" % open(profile).read())
-    table = ctx.gpu_file("profile-mirror-table.txt")
-    if table:
-        text += ("\nThe same profile of ae8927f's engine, the child masks mirrored by the table (a later call, "
-                 "[gpu/profile-mirror-table.txt](gpu/profile-mirror-table.txt)):\n\n```\n%s```\n" % open(table).read())
     before = ctx.gpu_file("profile-9b98c7c.txt")
     if before:
         text += ("\nThe same profile before the traversal stepped only to the children the ray meets and came "
