@@ -530,6 +530,21 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
   return sorted;
 }
 
+// fn(words) with the sorted keys as the sort stored them: 32-bit words
+// where the leaf keys fit them, else 64-bit (SortedKeys).
+template <typename Fn>
+void WithKeyWords(const SortedKeys& keys, Fn&& fn)
+{
+  if (keys.narrowKey)
+  {
+    fn(keys.narrowKey);
+  }
+  else
+  {
+    fn(keys.wideKey);
+  }
+}
+
 // Counts the n sorted leaf keys of `depth` levels in DepthChoice's two
 // histograms (DepthHistogramEntries).
 template <class Device, typename Key>
@@ -602,14 +617,8 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
-  if (sorted.keys.narrowKey)
-  {
-    QueueNeighbourHistogram(d, sorted.keys.narrowKey, n, sortDepth, counters + kCounterHistogram);
-  }
-  else
-  {
-    QueueNeighbourHistogram(d, sorted.keys.wideKey, n, sortDepth, counters + kCounterHistogram);
-  }
+  WithKeyWords(sorted.keys,
+    [&](const auto* keys) { QueueNeighbourHistogram(d, keys, n, sortDepth, counters + kCounterHistogram); });
   marks[2] = clock.Mark();
   return sorted;
 }
@@ -733,14 +742,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   std::uint32_t* starts = sorted.spare;
 
   const SortedKeys keys = sorted.keys;
-  if (keys.narrowKey)
-  {
-    RunStarts(d, scratch, keys.narrowKey, s.count, keys.keyShift, starts);
-  }
-  else
-  {
-    RunStarts(d, scratch, keys.wideKey, s.count, keys.keyShift, starts);
-  }
+  WithKeyWords(keys, [&](const auto* words) { RunStarts(d, scratch, words, s.count, keys.keyShift, starts); });
   const std::uint32_t leafBegin = view.levelBegin[depth];
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
     ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
@@ -751,19 +753,19 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   int l = depth - 1;
   for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
   {
-    const std::uint32_t begin = view.levelBegin[l];
-    const std::uint32_t childBegin = view.levelBegin[l + 1];
+    // Keys of one word as a plain array: read as NodeKeys, which test for
+    // high words, the selects took a fifth longer on an H100
+    // (Benchmarks/gpu/variants-inner-reduce.txt).
     if (view.keyHigh)
     {
-      RunStarts(d, scratch, NodeKeys{ view.key + childBegin, view.keyHigh + childBegin }, view.LevelSize(l + 1), 3,
-        starts);
+      RunStarts(d, scratch, levels.ChildKeys(l), levels.Children(l), 3, starts);
     }
     else
     {
-      RunStarts(d, scratch, view.key + childBegin, view.LevelSize(l + 1), 3, starts);
+      RunStarts(d, scratch, view.key + view.levelBegin[l + 1], levels.Children(l), 3, starts);
     }
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
-      ReduceChildren(view, begin + static_cast<std::uint32_t>(j), childBegin + starts[j], childBegin + starts[j + 1]);
+      levels.Reduce(l, static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
     });
   }
   if (l >= 0)

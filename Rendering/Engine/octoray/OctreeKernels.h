@@ -210,21 +210,25 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   }
 }
 
-// The inner levels as Device::ReduceSmallLevels walks them: level l's nodes
-// are the runs of equal parent keys among level l + 1's nodes, its
-// children (c and j count from each level's first node).
+// The inner levels, as LinkLevels reduces them a level a launch and
+// Device::ReduceSmallLevels the small ones together: level l's nodes are the
+// runs of equal parent keys among level l + 1's nodes, its children (c and
+// j count from each level's first node).
 struct InnerLevels
 {
   OctreeView view;
 
   OCTORAY_HD std::uint32_t Children(int l) const { return view.LevelSize(l + 1); }
 
-  // Whether child c starts a run of one parent's children.
-  OCTORAY_HD bool StartsRun(int l, std::uint32_t c) const
+  // The keys of level l's children, as an array from its first child.
+  OCTORAY_HD NodeKeys ChildKeys(int l) const
   {
     const std::uint32_t first = view.levelBegin[l + 1];
-    return octoray::StartsRun(NodeKeys{ view.key + first, view.keyHigh ? view.keyHigh + first : nullptr }, c, 3);
+    return NodeKeys{ view.key + first, view.keyHigh ? view.keyHigh + first : nullptr };
   }
+
+  // Whether child c starts a run of one parent's children.
+  OCTORAY_HD bool StartsRun(int l, std::uint32_t c) const { return octoray::StartsRun(ChildKeys(l), c, 3); }
 
   // Node j of level l from its children [c0, c1).
   OCTORAY_HD void Reduce(int l, std::uint32_t j, std::uint32_t c0, std::uint32_t c1) const
