@@ -41,20 +41,23 @@ def test_counts(xml_path):
     return counts
 
 
+RACECHECK_SUMMARY = "summary-racecheck.txt"
+
+
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
     if not summary_path:
         return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
-    # A run may come in calls (racecheck, the slowest, in a call of its
-    # own): every summary*.txt of the run, read as one, summary.txt (the
-    # final engine's call) first, so that its lines are the ones found.
-    summary = ""
-    names = sorted(os.listdir(os.path.dirname(summary_path)), key=lambda n: (n != "summary.txt", n))
-    for name in names:
-        if name.startswith("summary") and name.endswith(".txt"):
-            with open(os.path.join(os.path.dirname(summary_path), name)) as f:
-                summary += f.read()
+    # The report's call is summary.txt; racecheck, the slowest, ran in a
+    # call of its own (COMMAND.md), whose file the row names.
+    folder = os.path.dirname(summary_path)
+    summaries = []
+    for name in ("summary.txt", RACECHECK_SUMMARY):
+        if os.path.exists(os.path.join(folder, name)):
+            with open(os.path.join(folder, name)) as f:
+                summaries.append((name, f.read()))
+    summary = summaries[0][1]
     device = ""
     if ctx.gpu_file("gpu.txt"):
         with open(ctx.gpu_file("gpu.txt")) as f:
@@ -67,12 +70,17 @@ def render(ctx):
         for group, label in (("all", "engine tests, both backends"), ("cuda", "of which CUDA tests")):
             total, passed, failed, skipped = counts[group]
             rows.append((label, f"{passed} passed, {failed} failed, {skipped} skipped of {total}"))
+    clean = 0
     for log, what in SANITIZERS:
-        found = re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ (?:ERROR SUMMARY|RACECHECK SUMMARY): (.*)$", summary, re.M)
-        step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", summary, re.M)
-        result = found.group(1) if found else "no summary line"
-        if step:
-            result += f" (exit status: {step.group(1)})"
+        result = "no summary line"
+        for name, text in summaries:
+            found = re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ (?:ERROR SUMMARY|RACECHECK SUMMARY): (.*)$", text, re.M)
+            if found:
+                step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", text, re.M)
+                result = found.group(1) + (f" (exit status: {step.group(1)})" if step else "")
+                clean += found.group(1).startswith("0 ")
+                result += "" if name == "summary.txt" else f" ([gpu/{name}](gpu/{name}))"
+                break
         rows.append((what, result))
     steps = [line for line in summary.splitlines() if re.match(r"^[a-z-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
 
@@ -103,8 +111,6 @@ def render(ctx):
     ]
     summary_rows = []
     if ctx.gpu_file("engine-tests.xml"):
-        clean = [log for log, _ in SANITIZERS
-                 if re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ [A-Z ]+: 0 ", summary, re.M)]
         summary_rows.append((f"engine tests on {device.split(',')[0] if device else 'the GPU'}", rows[0][1],
-                             "compute-sanitizer", f"{len(clean)} of {len(SANITIZERS)} tool runs clean"))
+                             "compute-sanitizer", f"{clean} of {len(SANITIZERS)} tool runs clean"))
     return Section("\n".join(text), summary_rows)
