@@ -19,7 +19,7 @@ GPU_RENDER_FILE = "bench-render-cuda.json"  # octoray_bench_render --backend cud
 # The traversal's last change and its last try, each measured in its own
 # calls beside the engine before it (Benchmarks/gpu/variants-mirror-table.txt,
 # variants-paused-planes.txt).
-MIRROR_TABLE = (
+TRAVERSAL_CHANGES = (
     "\n\nSince ae8927f the device reads a child mask with its octant bits flipped by the ray's direction signs "
     "(MirrorOctants) from a 2 kB table of every mask for each of the eight signs, where it swapped the bits: ncu's "
     "count of each machine instruction of the depth-16 frame had the traversal's loop at 228 warp instructions a "
@@ -272,7 +272,7 @@ def _cuda_cloud(ctx):
             "thread per pixel, through the traversal of the section above. At depth 16 the clustered points are "
             "sparse and most rays cross the whole cube without a hit." % csv)
     if ctx.gpu_file("variants-mirror-table.txt"):
-        text += MIRROR_TABLE
+        text += TRAVERSAL_CHANGES
     profile = ctx.gpu_file("profile.txt")
     if profile:
         text += ("\n\nNsight Compute on the render kernel, one depth-10 frame of each kind above and one "

@@ -753,9 +753,9 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   int l = depth - 1;
   for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
   {
-    // Keys of one word as a plain array: read as NodeKeys, which test for
-    // high words, the selects took a fifth longer on an H100
-    // (Benchmarks/gpu/variants-inner-reduce.txt).
+    // Keys of one word go to the select as a plain array: read through
+    // NodeKeys, which tests for a high word, the selects took a fifth
+    // longer on an H100 (Benchmarks/gpu/variants-inner-reduce.txt).
     if (view.keyHigh)
     {
       RunStarts(d, scratch, levels.ChildKeys(l), levels.Children(l), 3, starts);
