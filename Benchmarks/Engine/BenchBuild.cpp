@@ -116,13 +116,7 @@ Run Time(Engine& engine, const std::string& backend, const PointCloudView& cloud
   run.levelSeconds = Summarise(levels).median;
   const MemoryReport memory = engine.Memory();
   run.engineBytes = memory.Total();
-  for (const auto& array : memory.arrays)
-  {
-    if (array.first.rfind("node ", 0) == 0)
-    {
-      run.nodeBytes += array.second;
-    }
-  }
+  run.nodeBytes = memory.NodeBytes();
   return run;
 }
 }

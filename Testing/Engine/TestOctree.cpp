@@ -323,18 +323,10 @@ TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
   const BuildStats stats = engine->Build(c.View(), options);
   const MemoryReport m = engine->Memory();
   EXPECT_EQ(stats.bytes, m.Total());
-  const auto bytesOf = [](const MemoryReport& report, const std::string& label) {
-    std::size_t bytes = 0;
-    for (const auto& a : report.arrays)
-    {
-      bytes += a.first == label ? a.second : 0;
-    }
-    return bytes;
-  };
   // At depth 10 every key fits its low word (Attributes.h): 4 bytes a node.
-  EXPECT_GE(bytesOf(m, "node keys"), stats.nodes * sizeof(std::uint32_t));
-  EXPECT_LE(bytesOf(m, "node keys"), 2 * stats.nodes * sizeof(std::uint32_t));
-  EXPECT_EQ(bytesOf(m, "node keys' high words"), 0u);
+  EXPECT_GE(m.BytesOf("node keys"), stats.nodes * sizeof(std::uint32_t));
+  EXPECT_LE(m.BytesOf("node keys"), 2 * stats.nodes * sizeof(std::uint32_t));
+  EXPECT_EQ(m.BytesOf("node keys' high words"), 0u);
   // Far below a dense skeleton of depth 10: (8^11 - 1) / 7 pointers.
   EXPECT_LT(m.Total(), ((1ull << 33) - 1) / 7 * 8 / 100);
 
@@ -345,8 +337,8 @@ TEST_P(OctreeBuild, ReportsMemoryLinearInNodes)
   for (const char* label : { "node keys", "node keys' high words" })
   {
     SCOPED_TRACE(label);
-    EXPECT_GE(bytesOf(d, label), deep.nodes * sizeof(std::uint32_t));
-    EXPECT_LE(bytesOf(d, label), 2 * deep.nodes * sizeof(std::uint32_t));
+    EXPECT_GE(d.BytesOf(label), deep.nodes * sizeof(std::uint32_t));
+    EXPECT_LE(d.BytesOf(label), 2 * deep.nodes * sizeof(std::uint32_t));
   }
 }
 
@@ -431,18 +423,14 @@ TEST_P(OctreeBuild, WithoutItsPointsHoldsOnlyTheNodes)
   EXPECT_TRUE(BitIdentical(RenderChecked(*engine, s), keptImage));
   // Besides the nodes, only what CUDA's pool cannot give back: the free
   // part of the blocks that the nodes occupy.
-  std::size_t nodeBytes = 0, cachedBytes = 0;
-  for (const auto& a : engine->Memory().arrays)
+  const MemoryReport memory = engine->Memory();
+  for (const auto& a : memory.arrays)
   {
-    if (a.first == MemoryReport::kAllocatorCache)
-    {
-      cachedBytes = a.second;
-      continue;
-    }
-    EXPECT_EQ(a.first.rfind("node ", 0), 0u) << a.first << " kept without keepPoints";
-    nodeBytes += a.second;
+    EXPECT_TRUE(a.first.rfind(MemoryReport::kNodeArrays, 0) == 0 || a.first == MemoryReport::kAllocatorCache)
+      << a.first << " kept without keepPoints";
   }
-  EXPECT_EQ(stats.bytes, nodeBytes + cachedBytes);
+  const std::size_t nodeBytes = memory.NodeBytes();
+  EXPECT_EQ(stats.bytes, nodeBytes + memory.BytesOf(MemoryReport::kAllocatorCache));
   EXPECT_LT(3 * nodeBytes, 2 * keptBytes) << "node arrays " << nodeBytes << " B of " << keptBytes << " B";
   EXPECT_EQ(engine->PointCount(), c.Size());
 

@@ -217,6 +217,9 @@ struct HostOctree : NodeArrays<HostVector>
 struct MemoryReport
 {
   static constexpr const char* kAllocatorCache = "allocator cache";
+  // What the octree's own arrays are labelled with ("node keys"), before
+  // the label of their attribute (Attributes.h).
+  static constexpr const char* kNodeArrays = "node ";
 
   std::vector<std::pair<std::string, std::size_t>> arrays;
   std::size_t Total() const
@@ -237,6 +240,26 @@ struct MemoryReport
       total -= arrays.back().second;
     }
     return total;
+  }
+  // The bytes of the arrays labelled `label`.
+  std::size_t BytesOf(const std::string& label) const
+  {
+    std::size_t bytes = 0;
+    for (const auto& a : arrays)
+    {
+      bytes += a.first == label ? a.second : 0;
+    }
+    return bytes;
+  }
+  // The node arrays' bytes: the octree itself.
+  std::size_t NodeBytes() const
+  {
+    std::size_t bytes = 0;
+    for (const auto& a : arrays)
+    {
+      bytes += a.first.rfind(kNodeArrays, 0) == 0 ? a.second : 0;
+    }
+    return bytes;
   }
   void Add(const std::string& name, std::size_t bytes)
   {

@@ -721,7 +721,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
-    const std::string what = std::string("node ") + a.kLabel;
+    const std::string what = MemoryReport::kNodeArrays + std::string(a.kLabel);
     if (Present(a, s.attributes, depth))
     {
       d.Reserve(a.Of(s.nodes), EntriesFor(a, nodes), what.c_str());
