@@ -46,7 +46,10 @@ sanitize() {
   echo "$log rc $? : $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$D/$log.log" | tail -1)" \
     "$(grep -E '^\[  (PASSED|FAILED)' "$D/$log.log" | head -2 | tr '\n' ' ')" >> "$D/sanitize.txt"
 }
-if [ "$section" = render ]; then
+if [ ! -x "$tests" ]; then
+  echo "sanitizers not run: main's engine tests were not built (TESTS names the variants that build them)" \
+    >> "$D/sanitize.txt"
+elif [ "$section" = render ]; then
   for tool in memcheck initcheck; do sanitize "$tool" "$tool" '*RenderTest*CUDA*:*SceneTest*CUDA*:RenderCUDA*'; done
 else
   sanitize memcheck memcheck '*OctreeBuild*CUDA*:*OctreeUpdate*CUDA*:*Stability*CUDA*'
