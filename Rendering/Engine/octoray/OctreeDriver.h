@@ -721,7 +721,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
-    const std::string what = MemoryReport::kNodeArrays + std::string(a.kLabel);
+    const std::string what = MemoryReport::NodeArray(a.kLabel);
     if (Present(a, s.attributes, depth))
     {
       d.Reserve(a.Of(s.nodes), EntriesFor(a, nodes), what.c_str());
@@ -762,7 +762,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     }
     else
     {
-      RunStarts(d, scratch, view.key + view.levelBegin[l + 1], levels.Children(l), 3, starts);
+      RunStarts(d, scratch, levels.ChildKeys(l).low, levels.Children(l), 3, starts);
     }
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
       levels.Reduce(l, static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);

@@ -90,7 +90,7 @@ template <class Device>
 MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, std::size_t cachedBytes)
 {
   MemoryReport m;
-  ForEachNodeArray([&](auto a) { m.Add(MemoryReport::kNodeArrays + std::string(a.kLabel), a.Of(s.nodes).Bytes()); });
+  ForEachNodeArray([&](auto a) { m.Add(MemoryReport::NodeArray(a.kLabel), a.Of(s.nodes).Bytes()); });
   m.Add("point positions", s.points.xyzFloat.Bytes() + s.points.xyzDouble.Bytes());
   // Each attribute's words of the records.
   const PointRecordLayout& layout = s.points.layout;
