@@ -718,6 +718,13 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const int depth = sorted.depth;
   s.depth = depth;
   s.cube = cube;
+  // The leaves' runs first, which need no node: the device finds them while
+  // the host reserves the nodes. Queued after the reservations, they left
+  // the device waiting for them, at times 0.3 ms at 10 M points on an H100
+  // (Benchmarks/gpu/variants-levels-order.txt).
+  std::uint32_t* starts = sorted.spare;
+  const SortedKeys keys = sorted.keys;
+  WithKeyWords(keys, [&](const auto* words) { RunStarts(d, scratch, words, s.count, keys.keyShift, starts); });
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
@@ -739,10 +746,6 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   }
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
-  std::uint32_t* starts = sorted.spare;
-
-  const SortedKeys keys = sorted.keys;
-  WithKeyWords(keys, [&](const auto* words) { RunStarts(d, scratch, words, s.count, keys.keyShift, starts); });
   const std::uint32_t leafBegin = view.levelBegin[depth];
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
     ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
