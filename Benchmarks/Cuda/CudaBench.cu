@@ -345,8 +345,16 @@ double StagedCopySeconds(Cloud& c)
   return seconds;
 }
 
+// Builds before the timed ones. The engine's memory pool grows over the
+// first builds of a size, a build filling its new octree beside the one it
+// replaces: at 10 M points the node arrays' reservations took 0.15-0.25 ms
+// of the host in the first four builds (the device waiting for them) and
+// 0.02 ms from the fifth on (Benchmarks/gpu/variants-levels-order.txt).
+// The timed builds are what rebuilding at one size costs.
+constexpr int kWarmUpBuilds = 4;
+
 // A build's whole call against the pinned copy, measured pair by pair
-// (build, then copy, `repeats` times after a warm-up build): the medians of
+// (build, then copy, `repeats` times after the warm-up builds): the medians of
 // each and the median of the pairs' ratios, which a drift of the host's
 // copy speed moves less than it moves either median (both halves of a pair
 // copy through the same host at nearly the same time). `phases` holds the
@@ -362,7 +370,10 @@ struct PairedBuild
 
 PairedBuild TimeBuildAgainstCopy(int repeats, PinnedCopy& copy, const std::function<BuildStats()>& build)
 {
-  build();
+  for (int w = 0; w < kWarmUpBuilds; ++w)
+  {
+    build();
+  }
   std::vector<double> builds, copies, ratios;
   std::vector<BuildStats> stats;
   for (int r = 0; r < repeats; ++r)
