@@ -347,7 +347,7 @@ double StagedCopySeconds(Cloud& c)
 
 // Builds before the timed ones. The engine's memory pool grows over the
 // first builds of a size, a build filling its new octree beside the one it
-// replaces: at 10 M points the node arrays' reservations took 0.15-0.25 ms
+// replaces: at 10 M points the node arrays' reservations took 0.17-0.25 ms
 // of the host in the first four builds (the device waiting for them) and
 // 0.02 ms from the fifth on (Benchmarks/gpu/variants-levels-order.txt).
 // The timed builds are what rebuilding at one size costs.

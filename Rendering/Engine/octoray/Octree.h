@@ -220,7 +220,7 @@ struct MemoryReport
   // What the octree's own arrays are labelled with ("node keys"), before
   // the label of their attribute (Attributes.h).
   static constexpr const char* kNodeArrays = "node ";
-  // The label of the node array of an attribute's label ("node keys").
+  // The label of the node array whose own label is `label` ("node keys").
   static std::string NodeArray(const char* label) { return kNodeArrays + std::string(label); }
 
   std::vector<std::pair<std::string, std::size_t>> arrays;

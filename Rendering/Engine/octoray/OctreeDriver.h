@@ -718,10 +718,10 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const int depth = sorted.depth;
   s.depth = depth;
   s.cube = cube;
-  // The leaves' runs first, which need no node: the device finds them while
-  // the host reserves the nodes. Queued after the reservations, they left
-  // the device waiting for them, at times 0.3 ms at 10 M points on an H100
-  // (Benchmarks/gpu/variants-levels-order.txt).
+  // The leaves' runs first, which need no node array: the device finds them
+  // while the host reserves the nodes. The reservations took 0.2-0.3 ms at
+  // 10 M points and up to 1 ms at 100 M on an H100 while the memory pool
+  // grew, the device idle (Benchmarks/gpu/variants-levels-order.txt).
   std::uint32_t* starts = sorted.spare;
   const SortedKeys keys = sorted.keys;
   WithKeyWords(keys, [&](const auto* words) { RunStarts(d, scratch, words, s.count, keys.keyShift, starts); });
