@@ -741,7 +741,7 @@ int Run(int argc, char** argv)
           { "host_staging_copy_seconds", peers.hostStaging },
           { "host_staging_beside_copy_seconds", peers.hostBesideCopy },
           { "staged_copy_seconds", peers.staged },
-          { "lean_seconds", leanSeconds } } });
+          { "lean_seconds", leanSeconds }, { "warm_up_builds", double(kWarmUpBuilds) } } });
       records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
         { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });
     }

@@ -381,6 +381,10 @@ def _cuda(ctx):
     # build sorts at depth 10 and less, 32-bit keys with 8-byte records (0
     # deeper, where it sorts the floor's pairs).
     own = any(r.get("build_sort_seconds") for r in builds)
+    # And since 7ad2508: how many builds went before the timed ones (one
+    # before it), which let the engine's memory pool settle.
+    warm_ups = int(builds[0].get("warm_up_builds", 1)) if builds else 1
+    warm_up_text = "one warm-up build" if warm_ups == 1 else "%d warm-up builds" % warm_ups
     rows, csv_rows, staging_rows = [], [], []
     for r in builds:
         if staging:
@@ -431,7 +435,8 @@ def _cuda(ctx):
         "From %s. Gaussian clusters with colour and reflectivity, float positions. \"Whole call\" is `Engine::Build` "
         "including the upload of the points from the caller's pageable host memory; the floor is a bare "
         "`cub::DeviceRadixSort::SortPairs` of as many 64-bit keys (3·depth bits) with 32-bit indices, timed with CUDA "
-        "events in the same run. Medians of 7. The device phases are the device's own time (CUDA events between "
+        "events in the same run. Medians of 7 builds after %s. The device phases are the device's own time (CUDA "
+        "events between "
         "them); the attributes' upload goes with the positions'. GPU bytes per point include "
         "the sort buffers the engine keeps for rebuilds and the memory its allocator keeps for the next build (split "
         "in the second table). The pinned copy: the same input arrays as one block of page-locked host memory copied "
@@ -441,7 +446,7 @@ def _cuda(ctx):
         "reflectivity; records of one or two words travel so, longer ones are gathered by index, "
         "OctreeKernels.h's SortedKeys); *CUB sort of 32-bit keys with records* is that sort of as many random "
         "keys, timed the same way, the same 12 bytes a point and pass as the floor's pairs, and *pairs* marks the "
-        "depths whose keys do not fit 32 bits.%s" % (gpu_source(ctx, name), "" if phases else
+        "depths whose keys do not fit 32 bits.%s" % (gpu_source(ctx, name), warm_up_text, "" if phases else
                                    " (This run's records predate the device phases; the next GPU run adds them.)"),
         "",
         ctx.table(header, rows),
