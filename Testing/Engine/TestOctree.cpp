@@ -426,7 +426,7 @@ TEST_P(OctreeBuild, WithoutItsPointsHoldsOnlyTheNodes)
   const MemoryReport memory = engine->Memory();
   for (const auto& a : memory.arrays)
   {
-    EXPECT_TRUE(a.first.rfind(MemoryReport::kNodeArrays, 0) == 0 || a.first == MemoryReport::kAllocatorCache)
+    EXPECT_TRUE(MemoryReport::IsNodeArray(a.first) || a.first == MemoryReport::kAllocatorCache)
       << a.first << " kept without keepPoints";
   }
   const std::size_t nodeBytes = memory.NodeBytes();

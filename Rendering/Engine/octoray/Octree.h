@@ -222,6 +222,8 @@ struct MemoryReport
   static constexpr const char* kNodeArrays = "node ";
   // The label of the node array whose own label is `label` ("node keys").
   static std::string NodeArray(const char* label) { return kNodeArrays + std::string(label); }
+  // Whether `label` names one of the octree's own arrays.
+  static bool IsNodeArray(const std::string& label) { return label.rfind(kNodeArrays, 0) == 0; }
 
   std::vector<std::pair<std::string, std::size_t>> arrays;
   std::size_t Total() const
@@ -259,7 +261,7 @@ struct MemoryReport
     std::size_t bytes = 0;
     for (const auto& a : arrays)
     {
-      bytes += a.first.rfind(kNodeArrays, 0) == 0 ? a.second : 0;
+      bytes += IsNodeArray(a.first) ? a.second : 0;
     }
     return bytes;
   }
