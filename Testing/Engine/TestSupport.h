@@ -286,7 +286,8 @@ inline void ExpectMatchesReference(const HostOctree& t, const Cloud& c)
         EXPECT_TRUE(f == t.levelBegin[l + 1] || (t.Key(f - 1) >> 3) != key) << "first child is not the first";
       }
       const double inv = 1.0 / ref.count;
-      // Means of float data summed in double: relative error ~1e-7.
+      // Means of float data, a leaf's points summed in double and an inner
+      // node's children in float (ReduceChildren): ~1e-7 relative a level.
       const float tol = 2e-6f;
       ASSERT_EQ(t.color8.empty(), c.rgb.empty());
       ASSERT_TRUE(t.color.empty()) << "8-bit colours are kept as 8-bit";

@@ -107,8 +107,10 @@ enum AttributeBits : unsigned
 };
 
 // An attribute value as floats, the slots of the vector in which build and
-// update sum it (in double) and from which they store its mean: its floats
-// in order, for any value made of floats alone (float, Rgba, Vec3f).
+// update sum it (a leaf's points and an update's changes in double, an inner
+// node's children in float: OctreeKernels.h) and from which they store its
+// mean: its floats in order, for any value made of floats alone (float,
+// Rgba, Vec3f).
 template <typename T>
 struct AttributeValue
 {
@@ -130,8 +132,8 @@ struct AttributeValue
   }
 };
 
-// Values stored rounded: summed as the floats ToFloats gives (in double, as
-// every attribute) and stored as FromFloats of their mean. A leaf's mean is
+// Values stored rounded: summed as the floats ToFloats gives (as every
+// attribute) and stored as FromFloats of their mean. A leaf's mean is
 // rounded once; an inner node's is the count-weighted mean of its children's
 // rounded ones, rounded again (the bounds below). Being rounded, such a mean
 // cannot be adjusted by the points that leave and join a node (an update's
