@@ -105,6 +105,18 @@ def seconds(s):
     return "%.3f ms" % (s * 1e3)
 
 
+def device_phases(r):
+    """A CUDA build record's device phases: keys, sort and levels."""
+    return r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+
+
+def call_over_copy(r):
+    """A CUDA build record's whole call over the pinned copy of its input:
+    the median of the pairs where the run recorded it (since the overlapped
+    upload), else the two medians' ratio."""
+    return r.get("call_over_pinned_copy") or r["seconds"] / r["pinned_upload_seconds"]
+
+
 def human_bytes(b):
     for unit in ("B", "KB", "MB", "GB", "TB", "PB"):
         if b < 1000:
@@ -156,7 +168,7 @@ def _host_floor_at_10m(builds):
               and r.get("host_staging_beside_copy_seconds")), None)
     if not r:
         return ""
-    phases = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+    phases = device_phases(r)
     return (" In this report's run, at 10 M points, the host's half alone took %s, and with the pinned copy at once "
             "%s: %.2f times the pinned copy (%s), the lowest a staged upload could reach on this run's host "
             "(2.2–3.6 ms for the host's half, about 1.1 times for both at once, in the one pass's first calls). "
@@ -400,7 +412,7 @@ def _cuda(ctx):
                                    seconds(r["lean_seconds"]), "%.1f" % m.get("lean_bytes_per_point", 0)])
         row = [count(r["n"]), r["depth"], seconds(r["seconds"])]
         if phases:
-            device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+            device = device_phases(r)
             row += ["%s (%.2f / %.2f / %.2f)" % (seconds(device), r["key_seconds"] * 1e3, r["sort_seconds"] * 1e3,
                                                  r["level_seconds"] * 1e3)]
         row += [seconds(r["peer_seconds"]), "%.0f" % (r["seconds"] / r["peer_seconds"])]
@@ -412,10 +424,7 @@ def _cuda(ctx):
         if phases:
             row += [count(r["nodes"])]
         if upload:
-            # Runs since the overlapped upload pair each build with a copy
-            # and record the median of the pairs' ratios.
-            ratio = r.get("call_over_pinned_copy") or r["seconds"] / r["pinned_upload_seconds"]
-            row += [seconds(r["pinned_upload_seconds"]), "%.2f" % ratio]
+            row += [seconds(r["pinned_upload_seconds"]), "%.2f" % call_over_copy(r)]
         row += ["%.0f" % mem.get((r["n"], r["depth"]), 0)]
         rows.append(row)
         csv_rows.append([r["n"], r["depth"], r["seconds"], r["peer_seconds"], mem.get((r["n"], r["depth"])),
@@ -701,20 +710,56 @@ def _cuda(ctx):
         # memory, which a caller with pinned or device-resident points skips.
         r = ten[0]
         if phases:
-            device = r["key_seconds"] + r["sort_seconds"] + r["level_seconds"]
+            device = device_phases(r)
             against = "bare CUB radix sort " + seconds(r["peer_seconds"])
             ratio = "%.1f× the sort" % (device / r["peer_seconds"])
             if r.get("build_sort_seconds"):
                 against += " (of the 32-bit keys with 8-byte records the build sorts: %s)" % \
                     seconds(r["build_sort_seconds"])
                 ratio += " (%.1f×)" % (device / r["build_sort_seconds"])
+            against += "; issue 16's goal ≤ 2× the sort"
             summary.append(("CUDA octree build, 10 M points, depth 10, device phases (GPU run; whole call with "
                             "the upload: %s)" % seconds(r["seconds"]), seconds(device), against, ratio))
         else:
             summary.append(("CUDA octree build, 10 M points, depth 10 (whole call, GPU run)", seconds(r["seconds"]),
                             "bare CUB radix sort " + seconds(r["peer_seconds"]),
                             "%.0f× the sort" % (r["seconds"] / r["peer_seconds"])))
-    return "\n".join(text) + "\n", summary
+    return "\n".join(text) + "\n", summary + _goal_rows(builds, records, phases, upload)
+
+
+def _goal_rows(builds, records, phases, upload):
+    """The README summary's rows for issue 16's build and size goals of this
+    run: the 100 M build, the whole call against the pinned copy, the bytes
+    per point of every attribute, the billion points' frame rate."""
+    rows = []
+    deep = {r["n"]: r for r in builds if r["depth"] == 10}
+    big = deep.get(100000000)
+    if big and phases:
+        device = device_phases(big)
+        rows.append(("CUDA octree build, 100 M points, depth 10, device phases (GPU run)", seconds(device),
+                     "bare CUB radix sort %s; issue 16's goals ≤ 15 ms and ≤ 2× the sort" %
+                     seconds(big["peer_seconds"]), "%.1f× the sort" % (device / big["peer_seconds"])))
+    calls = [deep[n] for n in (10000000, 100000000) if n in deep]
+    if upload and calls:
+        rows.append(("CUDA octree build from pageable host arrays, whole call, %s points, depth 10 (GPU run)" %
+                     " / ".join(count(r["n"]) for r in calls),
+                     " / ".join(seconds(r["seconds"]) for r in calls),
+                     "pinned copy of the same bytes %s; issue 16's goal ≤ 1.5×" %
+                     " / ".join(seconds(r["pinned_upload_seconds"]) for r in calls),
+                     " / ".join("%.2f×" % call_over_copy(r) for r in calls)))
+    every = [r for r in records if r["name"] == "gpu bytes per point, every attribute"]
+    if every:
+        r = every[0]
+        rows.append(("GPU memory, %s points, depth %d, every attribute (GPU run)" % (count(r["n"]), r["depth"]),
+                     "%.2f bytes/point" % r["seconds"], "issue 16's goal ≤ 24 bytes/point",
+                     "%.2f× the goal" % (r["seconds"] / 24)))
+    billion = {r["name"]: r for r in records if r["name"].startswith("device points")}
+    primary = billion.get("device points primary 1920x1080")
+    if primary:
+        rows.append(("%s device-generated points on one GPU, primary rays 1920×1080 (GPU run)" %
+                     count(primary["n"]), "%.0f frames/s" % (1 / primary["seconds"]),
+                     "issue 16's goal ≥ 60 frames/s", "%.0f× the goal" % (1 / primary["seconds"] / 60)))
+    return rows
 
 
 def _quantisation(ctx):

@@ -257,10 +257,10 @@ def _cuda_cloud(ctx):
                      "%.0f" % rays if rays else "–", "%.0f" % (1 / r["seconds"]),
                      "%d (%.2f×)" % (goal, rays / goal) if goal and rays else "–"])
         csv_rows.append([r["n"], r["depth"], mode, r["seconds"], pixels / r["seconds"] / 1e6])
-        if primary and r["depth"] == 10:
-            summary.append(("CUDA render 1920×1080, primary rays, 10 M points (GPU run)",
-                            "%.0f Mrays/s" % (pixels / r["seconds"] / 1e6), "issue 16's goal 2 000 Mrays/s",
-                            "%.2f×" % (pixels / r["seconds"] / 1e6 / 2000)))
+        if goal and rays:
+            summary.append(("CUDA render 1920×1080, %s, 10 M points, depth %d (GPU run)" % (mode, r["depth"]),
+                            "%.0f Mrays/s" % rays, "issue 16's goal %s Mrays/s" % count(goal),
+                            "%.2f×" % (rays / goal)))
     csv = ctx.write_csv("render-cuda", ["points", "depth", "mode", "device_s", "mpixels_s"], csv_rows)
     text = ("From %s: the octoray_bench_cuda cloud (Gaussian clusters with colour and reflectivity), camera outside "
             "the cube; device time of the frame from `RenderStats.seconds` with the picture left on the device (as "
