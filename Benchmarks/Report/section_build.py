@@ -711,7 +711,7 @@ def _cuda(ctx):
     text += [
         "Update of moved points against a full rebuild of the same points (whole calls, positions uploaded from "
         "the host and checked for NaN/Inf on the device first); both moves change the topology, so the update "
-        "re-sorts the stored keys in the same buffers rather than adjusting counts in place:",
+        "computes and sorts the keys again in the same buffers rather than adjusting counts in place:",
         "",
         ctx.table(["moved", "points", "depth", "update", "rebuild", "update / rebuild"], urows),
     ]
@@ -966,7 +966,7 @@ them (the median holds them).
 
 {engine}
 
-Memory of octoray (`Engine::Memory().Total()`: point copy, full-depth keys, sort buffers and node arrays) against the
+Memory of octoray (`Engine::Memory().Total()`: point copy, sort buffers and node arrays) against the
 thesis's dense pointer skeleton of the same depth, 8 B × (8^(L+1)−1)/7:
 
 {memory}
@@ -979,8 +979,9 @@ Reading these figures:
   than by compute; only where those levels do not settle the depth does it sort the full-depth keys too (63 bits, 6
   passes, with indices). 2-thread medians on this shared machine swing from run to run; read the 1-thread column
   for ratios.
-- B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, full-depth key 8 B, the sort's keys
-  and their second buffer, the records in sorted order); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
+- B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, the sort's keys and their second
+  buffer, the records in sorted order; the points' keys are not kept: a rebuild computes them again from the
+  positions); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
   octoray only at shallow depth on uniform data; from depth 9 on it is larger and grows 8× per level.
 - vtkSMPTools in Debian's ParaView defaults to the Sequential backend; the benchmark switches it to STDThread so
   vtkStaticPointLocator's threaded build is measured.

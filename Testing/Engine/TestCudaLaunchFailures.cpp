@@ -94,7 +94,7 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
 {
   const Cloud first = UniformCloud(1500, 61);
   // Its automatic depth lies beyond level 10: the full-depth sort runs too,
-  // from the kept keys (LeafKeysKernel). Records of two words (colours and
+  // its keys computed again. Records of two words (colours and
   // reflectivity) travel with the first sort's keys.
   Cloud tight = TightClusters(300, 1e-5, 47);
   tight.scalar.clear();
@@ -107,7 +107,7 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LeafKeysKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
+         "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
   {
     SCOPED_TRACE(kernel);
     const Cloud& second = std::string(kernel) == "InnerKernel" ? wide : tight;

@@ -439,16 +439,38 @@ TEST(Attributes, SlotsAndBitsFollowTheList)
   const Rgba mean = AttributeValue<Rgba>::Mean(sum, 0.5);
   EXPECT_EQ(mean.r, 0.5f);
   EXPECT_EQ(mean.a, 2.0f);
-  // Colours are stored as bytes, rounded to nearest and clamped to [0,1].
-  const double bytes[4] = { 0.0, 255.0 / 255.0, 128.0 / 255.0, 4.0 };
+  // 8-bit colours are summed as whole bytes and stored as bytes, rounded to
+  // nearest (halves up) and clamped to 255.
+  const std::uint64_t bytes[4] = { 0, 255, 128, 4 * 255 };
   const Rgba8 mean8 = AttributeValue<Rgba8>::Mean(bytes, 0.5);
   EXPECT_EQ(mean8.r, 0);
   EXPECT_EQ(mean8.g, 128) << "127.5 rounds up";
   EXPECT_EQ(mean8.b, 64);
   EXPECT_EQ(mean8.a, 255);
-  AttributeValue<Rgba8>::ToSlots(Rgba8{ 0, 51, 255, 128 }, v);
-  EXPECT_FLOAT_EQ(v[1], 0.2f);
-  EXPECT_FLOAT_EQ(v[2], 1.0f);
+  std::uint32_t whole[4];
+  AttributeValue<Rgba8>::ToSlots(Rgba8{ 0, 51, 255, 128 }, whole);
+  EXPECT_EQ(whole[1], 51u);
+  EXPECT_EQ(whole[2], 255u);
+  // Sums of bytes times weights beside double sums: in 64-bit integers,
+  // exact, a weight of -1 too (modulo 2^64), and only the byte entries;
+  // floats in double. Beside float sums, the bytes in float.
+  SlotSums<double> sums;
+  sums.Add(kSlotColor8, whole[2], 3u);
+  sums.Add(kSlotColor8, whole[1], -1);
+  sums.Add(kSlotReflectivity, 0.5f, 4u);
+  EXPECT_EQ(sums.whole[kSlotColor8], 3u * 255u - 51u);
+  EXPECT_EQ(sums.real[kSlotColor8], 0.0);
+  EXPECT_EQ(sums.real[kSlotReflectivity], 2.0);
+  static_assert(std::is_same<SlotSums<double>::Whole, std::uint64_t>::value, "exact sums of a leaf's bytes");
+  static_assert(std::is_same<SlotSums<float>::Whole, float>::value, "an inner node's bytes in float");
+  EXPECT_EQ(sums.Of(Attribute<kAttributeColor8>()), sums.whole + kSlotColor8);
+  EXPECT_EQ(sums.Of(Attribute<kAttributeReflectivity>()), sums.real + kSlotReflectivity);
+  const std::uint64_t thirds[4] = { 10, 11, 765, 0 };
+  const Rgba8 third = AttributeValue<Rgba8>::Mean(thirds, 1.0 / 3.0);
+  EXPECT_EQ(third.r, 3) << "3.33 rounds down";
+  EXPECT_EQ(third.g, 4) << "3.67 rounds up";
+  EXPECT_EQ(third.b, 255);
+  EXPECT_EQ(third.a, 0);
   EXPECT_FALSE(AttributeValue<Rgba>::kRounded);
   EXPECT_TRUE(AttributeValue<Rgba8>::kRounded);
   EXPECT_EQ(kRoundedAttributes, static_cast<unsigned>(kHasColor8 | kHasScalar | kHasNormal));

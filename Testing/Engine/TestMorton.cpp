@@ -30,6 +30,24 @@ TEST(Morton, RoundTripsRandomAndExtremeCells)
   EXPECT_EQ(EncodeMorton(2, 0, 0), 8u);
 }
 
+// A key at a depth, made from the cell's top bits (in 32 bits down to
+// depth 10), is the full-depth key without its triples below that depth.
+TEST(Morton, KeysAtADepthAreTheFullKeysShifted)
+{
+  std::mt19937_64 rng(2);
+  std::uniform_int_distribution<std::uint32_t> cell(0, (1u << 21) - 1);
+  const std::uint32_t top = (1u << 21) - 1;
+  for (int i = 0; i < 20000; ++i)
+  {
+    const std::uint32_t x = i ? cell(rng) : top, y = i ? cell(rng) : top, z = i ? cell(rng) : top;
+    for (int depth = 0; depth <= kMaxLevel; ++depth)
+    {
+      ASSERT_EQ(EncodeMortonAt(x, y, z, depth), EncodeMorton(x, y, z) >> (3 * (kMaxLevel - depth)))
+        << "cell " << x << " " << y << " " << z << " at depth " << depth;
+    }
+  }
+}
+
 TEST(Morton, KeysOrderLikeTheOctree)
 {
   // A parent's key is its children's keys without their last triple.

@@ -395,7 +395,7 @@ TEST_P(OctreeBuild, ReportsMemoryUnderItsLabels)
   const std::vector<std::string> expected = { "node keys", "node child masks", "node first children",
     "node point counts", "node 8-bit colours", "node scalars", "node reflectivities", "node refraction indices",
     "node normals", "point positions", "point 8-bit colours", "point scalars", "point reflectivities",
-    "point refraction indices", "point normals", "point keys", "sort buffers" };
+    "point refraction indices", "point normals", "sort buffers" };
   EXPECT_EQ(labels, expected);
 }
 

@@ -360,13 +360,13 @@ inline void ExpectSameOctree(const HostOctree& a, const HostOctree& b, bool exac
       using Value = AttributeValue<typename A::Type>;
       for (std::size_t n = 0; n < x.size(); ++n)
       {
-        float u[Value::kSlots], v[Value::kSlots];
+        typename Value::Slot u[Value::kSlots], v[Value::kSlots];
         Value::ToSlots(x[n], u);
         Value::ToSlots(y[n], v);
         for (int k = 0; k < Value::kSlots; ++k)
         {
-          const float tol = exact ? 0.0f : 1e-5f;
-          ASSERT_NEAR(u[k], v[k], tol) << "node " << A::kLabel << " slot " << k << " of node " << n;
+          const double tol = exact ? 0.0 : 1e-5;
+          ASSERT_NEAR(double(u[k]), double(v[k]), tol) << "node " << A::kLabel << " slot " << k << " of node " << n;
         }
       }
     }

@@ -106,20 +106,21 @@ enum AttributeBits : unsigned
 #undef OCTORAY_BIT
 };
 
-// An attribute value as floats, the slots of the vector in which build and
-// update sum it (a leaf's points and an update's changes in double, an inner
-// node's children in float: OctreeKernels.h) and from which they store its
-// mean: its floats in order, for any value made of floats alone (float,
-// Rgba, Vec3f).
+// An attribute value as its slots (Slot: float, or whole bytes), the
+// entries of the sums in which build and update add it up (SlotSums below)
+// and from which they store its mean: its floats in order, for any value
+// made of floats alone (float, Rgba, Vec3f).
 template <typename T>
 struct AttributeValue
 {
   static_assert(sizeof(T) % sizeof(float) == 0 && std::is_trivially_copyable<T>::value, "a value made of floats");
   static constexpr int kSlots = static_cast<int>(sizeof(T) / sizeof(float));
   static constexpr bool kRounded = false; // the mean is stored as computed
+  using Slot = float;
 
   OCTORAY_HD static void ToSlots(const T& value, float* v) { memcpy(v, &value, sizeof(T)); }
-  OCTORAY_HD static T Mean(const double* sum, double inv)
+  template <typename Real>
+  OCTORAY_HD static T Mean(const Real* sum, double inv)
   {
     float mean[kSlots];
     for (int k = 0; k < kSlots; ++k)
@@ -132,8 +133,9 @@ struct AttributeValue
   }
 };
 
-// Values stored rounded: summed as the floats ToFloats gives (as every
-// attribute) and stored as FromFloats of their mean. A leaf's mean is
+// Values stored rounded: summed as the floats ToFloats gives (as the
+// attributes of floats) and stored as FromFloats of their mean (8-bit
+// colours alike, as whole bytes: below). A leaf's mean is
 // rounded once; an inner node's is the count-weighted mean of its children's
 // rounded ones, rounded again (the bounds below). Being rounded, such a mean
 // cannot be adjusted by the points that leave and join a node (an update's
@@ -144,9 +146,11 @@ struct RoundedAttributeValue
 {
   static constexpr int kSlots = Slots;
   static constexpr bool kRounded = true;
+  using Slot = float;
 
   OCTORAY_HD static void ToSlots(const T& value, float* v) { ToFloats(value, v); }
-  OCTORAY_HD static T Mean(const double* sum, double inv)
+  template <typename Real>
+  OCTORAY_HD static T Mean(const Real* sum, double inv)
   {
     float mean[Slots];
     for (int k = 0; k < Slots; ++k)
@@ -158,17 +162,6 @@ struct RoundedAttributeValue
     return value;
   }
 };
-
-// 8-bit colours: four channels in [0,1], stored as bytes.
-OCTORAY_HD void ToFloats(const Rgba8& value, float* v)
-{
-  const Rgba c = ToRgba(value);
-  v[0] = c.r, v[1] = c.g, v[2] = c.b, v[3] = c.a;
-}
-OCTORAY_HD void FromFloats(const float* v, Rgba8& value)
-{
-  value = ToRgba8(Rgba{ v[0], v[1], v[2], v[3] });
-}
 
 // Scalars: their unit values, stored as codes (Scalar16.h); the points'
 // values are rounded too (ScalarErrorBound).
@@ -192,9 +185,36 @@ OCTORAY_HD void FromFloats(const float* v, OctNormal& value)
   value = EncodeNormal(Vec3f{ v[0], v[1], v[2] });
 }
 
+// 8-bit colours, stored rounded as the others above: their channels are
+// summed as whole bytes (a leaf's in 64-bit integers: SlotSums) and the mean
+// rounded to the nearest byte (halves up). A leaf's sums are exact, in any
+// order, and a byte needs no conversion to add, where as a float in [0,1]
+// summed in double each channel of each point took two. The leaf kernel
+// was little faster for it on an H100, 223 us at 10 M points against 227
+// (Benchmarks/gpu/variants-unkept-keys.txt): the conversions were not what
+// bounds it.
 template <>
-struct AttributeValue<Rgba8> : RoundedAttributeValue<Rgba8, 4>
+struct AttributeValue<Rgba8>
 {
+  static constexpr int kSlots = 4;
+  static constexpr bool kRounded = true;
+  using Slot = std::uint32_t;
+
+  OCTORAY_HD static void ToSlots(const Rgba8& c, std::uint32_t* v)
+  {
+    v[0] = c.r, v[1] = c.g, v[2] = c.b, v[3] = c.a;
+  }
+  template <typename Sum>
+  OCTORAY_HD static Rgba8 Mean(const Sum* sum, double inv)
+  {
+    std::uint8_t mean[4];
+    for (int k = 0; k < 4; ++k)
+    {
+      const double byte = static_cast<double>(sum[k]) * inv;
+      mean[k] = static_cast<std::uint8_t>((byte < 255.0 ? byte : 255.0) + 0.5);
+    }
+    return Rgba8{ mean[0], mean[1], mean[2], mean[3] };
+  }
 };
 template <>
 struct AttributeValue<Scalar16> : RoundedAttributeValue<Scalar16, 1>
@@ -213,6 +233,47 @@ enum AttributeSlot : int
   OCTORAY_ATTRIBUTES(OCTORAY_SLOTS)
 #undef OCTORAY_SLOTS
     kSlotCount
+};
+
+// The sums of a node's slots, each slot's value times a weight (a child's
+// point count, 1 for a point, -1 for a point that leaves). Floats add up in
+// Real: double for a leaf's points and an update's changes, float for an
+// inner node's children (OctreeKernels.h). Whole bytes beside double sums
+// add up in 64-bit integers, exact in any order (a weight of -1 wraps, and
+// the sum comes right modulo 2^64); beside float sums in float, as the
+// children's other slots: in 64-bit integers the inner loop held 48
+// registers on an H100 where it holds 40, five blocks a multiprocessor
+// instead of six. Of the entries, only those of the slots added to live.
+template <typename Real>
+struct SlotSums
+{
+  using Whole = typename std::conditional<std::is_same<Real, double>::value, std::uint64_t, float>::type;
+  Real real[kSlotCount] = {};
+  Whole whole[kSlotCount] = {};
+
+  template <typename Weight>
+  OCTORAY_HD void Add(int k, float x, Weight weight)
+  {
+    real[k] += x * static_cast<Real>(weight);
+  }
+  template <typename Weight>
+  OCTORAY_HD void Add(int k, std::uint32_t x, Weight weight)
+  {
+    whole[k] += static_cast<Whole>(x) * static_cast<Whole>(weight);
+  }
+  // The entries of the slots of attribute a, as its Mean reads them.
+  template <class A>
+  OCTORAY_HD auto Of(A) const
+  {
+    if constexpr (std::is_same<typename AttributeValue<typename A::Type>::Slot, float>::value)
+    {
+      return real + A::kSlot;
+    }
+    else
+    {
+      return whole + A::kSlot;
+    }
+  }
 };
 
 // The largest difference between a node's stored 8-bit colour channel at
@@ -317,14 +378,15 @@ OCTORAY_HD void ForEachAttribute(Fn&& fn)
 #undef OCTORAY_CALL
 }
 
-// fn(slot, float) for each slot of a value of attribute a (a descriptor).
-// `value` is a copy of the stored one: ToSlots's memcpy straight from an
-// array reads it a byte at a time.
+// fn(slot, value) for each slot of a value of attribute a (a descriptor),
+// the value a float or a whole byte (AttributeValue::Slot). `value` is a
+// copy of the stored one: ToSlots's memcpy straight from an array reads it
+// a byte at a time.
 template <class A, typename Fn>
 OCTORAY_HD void ForEachSlotOf(A, const typename A::Type& value, Fn&& fn)
 {
   using Value = AttributeValue<typename A::Type>;
-  float v[Value::kSlots];
+  typename Value::Slot v[Value::kSlots];
   Value::ToSlots(value, v);
   for (int k = 0; k < Value::kSlots; ++k)
   {

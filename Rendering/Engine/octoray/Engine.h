@@ -43,7 +43,8 @@ public:
   // Points that stay in their leaf cost nothing; when points change leaf
   // but no node appears or empties, counts and means are adjusted along
   // their paths (cost proportional to the points moved); otherwise the
-  // stored keys are re-sorted and the levels rebuilt in the same buffers.
+  // keys are computed and sorted again and the levels rebuilt in the same
+  // buffers.
   // Indices must be distinct. When a point leaves
   // the root cube, the octree is rebuilt around the new bounds
   // (UpdateStats::Path::NewCube) at the same depth. Throws Error for a

@@ -546,23 +546,34 @@ void WithKeyWords(const SortedKeys& keys, Fn&& fn)
 }
 
 // Counts the n sorted leaf keys of `depth` levels in DepthChoice's two
-// histograms (DepthHistogramEntries).
+// histograms (DepthHistogramEntries) where the depth is to be chosen, else
+// in newNode alone (NewNodeEntry; alone's counts stay zero).
 template <class Device, typename Key>
-void QueueNeighbourHistogram(Device& d, const Key* keys, std::size_t n, int depth, std::uint64_t* counts)
+void QueueNeighbourHistogram(Device& d, const Key* keys, std::size_t n, int depth, bool chooseDepth,
+  std::uint64_t* counts)
 {
-  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
+  if (chooseDepth)
+  {
+    d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
+      OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
+  }
+  else
+  {
+    d.template Histogram<kDepthHistogramBins>("NeighbourHistogramKernel", n,
+      OCTORAY_LAMBDA(std::size_t i) { return NewNodeEntry(keys, i, depth); }, counts);
+  }
 }
 
 // Queues the sort of the state's points by their keys at `sortDepth`
-// (kMaxLevel: full depth): the keys (computed, or the stored ones), the
+// (kMaxLevel: full depth): the keys, computed from the positions, the
 // sort, and the histogram of neighbouring sorted keys. beforeSort(), if
 // given, runs on the host between the keys and the sort; the points'
-// records must exist after it. Marks on `clock`: marks[0] after the keys,
-// marks[1] before the sort, marks[2] after the histogram.
+// records must exist after it. chooseDepth: the histogram the automatic
+// depth reads, else the level sizes alone. Marks on `clock`: marks[0]
+// after the keys, marks[1] before the sort, marks[2] after the histogram.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int sortDepth, bool computeKeys, const FirstFailure& outside, typename Device::Clock& clock, int marks[3],
+  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[3],
   const std::function<void()>& beforeSort)
 {
   const std::size_t n = s.count;
@@ -570,28 +581,22 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   const bool travel = SortedKeys::RecordsTravel(sortDepth, s.points.layout.stride);
   const SortInput input = ReserveSortInput(d, scratch, n, narrow, !travel);
   const PointArraysView pts = s.Points();
-  std::uint64_t* pointKey = DataOrNull(s.points.key); // null: not kept
-  // Only the bits down to sortDepth need sorting.
-  const int leafShift = 3 * (kMaxLevel - sortDepth);
-  if (computeKeys)
-  {
-    d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
-      std::uint64_t key = 0;
-      if (!ComputePointKey(pts, cube, i, key))
-      {
-        outside.Report(i);
-      }
-      if (pointKey)
-      {
-        pointKey[i] = key;
-      }
-      input.Enter(i, key >> leafShift);
-    });
-  }
-  else
-  {
-    d.ForEach("LeafKeysKernel", n, OCTORAY_LAMBDA(std::size_t i) { input.Enter(i, pointKey[i] >> leafShift); });
-  }
+  // Only the bits down to sortDepth need sorting. The keys are computed
+  // from the positions each time, not kept: kept full-depth keys took 8
+  // bytes a point, and without writing them this kernel took 73 us at 10 M
+  // points against 84, 703 against 836 at 100 M, on an H100
+  // (Benchmarks/gpu/variants-unkept-keys.txt).
+  const RootCube::CellMap grid = cube.Grid();
+  d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
+    const Vec3d p = pts.Position(i);
+    std::uint32_t cell[3] = {};
+    const bool inside = grid.Cell(p.x, p.y, p.z, cell);
+    if (!inside)
+    {
+      outside.Report(i);
+    }
+    input.Enter(i, inside ? EncodeMortonAt(cell[0], cell[1], cell[2], sortDepth) : 0);
+  });
   marks[0] = clock.Mark();
   if (beforeSort)
   {
@@ -618,7 +623,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
   WithKeyWords(sorted.keys,
-    [&](const auto* keys) { QueueNeighbourHistogram(d, keys, n, sortDepth, counters + kCounterHistogram); });
+    [&](const auto* keys) { QueueNeighbourHistogram(d, keys, n, sortDepth, chooseDepth, counters + kCounterHistogram); });
   marks[2] = clock.Mark();
   return sorted;
 }
@@ -653,30 +658,24 @@ void ReadHistogram(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
 // argument of a function that holds device lambdas.)
 template <class Device>
 SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, typename Device::Clock& clock, int phases[8],
-  const std::function<void()>& beforeSort)
+  int requestedDepth, typename Device::Clock& clock, int phases[8], const std::function<void()>& beforeSort)
 {
-  if (s.keepPoints)
-  {
-    d.Reserve(s.points.key, s.count, "point keys");
-  }
   std::fill_n(phases, 8, -1);
   phases[0] = clock.Mark();
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
   const FirstFailure outside = ArmFirstFailure(d, scratch);
   const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
-  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, computeKeys, outside, clock, phases + 1, beforeSort);
+  const bool chooseDepth = requestedDepth == 0;
+  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, chooseDepth, outside, clock, phases + 1, beforeSort);
   ReadHistogram(d, scratch, s, sorted);
-  if (requestedDepth == 0)
+  if (chooseDepth)
   {
     int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
     if (depth == 0)
     {
       phases[4] = clock.Mark();
-      const bool keysKept = DataOrNull(s.points.key) != nullptr; // written by the first sort's keys
-      sorted =
-        QueueSort(d, scratch, s, cube, kMaxLevel, computeKeys && !keysKept, outside, clock, phases + 5, nullptr);
+      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, true, outside, clock, phases + 5, nullptr);
       ReadHistogram(d, scratch, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }
@@ -784,13 +783,13 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
 // device waiting for beforeSort) counts in none.
 template <class Device>
 BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, bool computeKeys, const std::function<void()>& beforeSort = nullptr)
+  int requestedDepth, const std::function<void()>& beforeSort = nullptr)
 {
   BuildStats stats;
   stats.points = s.count;
   typename Device::Clock clock;
   int phases[8];
-  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, computeKeys, clock, phases, beforeSort);
+  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, clock, phases, beforeSort);
   const int levelsBegin = clock.Mark();
   LinkLevels(d, scratch, s, sorted, cube);
   const int levelsEnd = clock.Mark();
@@ -823,7 +822,6 @@ void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   d.Release(s.points.xyzFloat);
   d.Release(s.points.xyzDouble);
   d.Release(s.points.records);
-  d.Release(s.points.key);
   DriverScratch<Device>::ForEachSortBuffer(scratch, [&](auto& buffer) { d.Release(buffer); });
   d.Release(scratch.counters);
   d.ReleaseScratch();
@@ -858,7 +856,7 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.points.layout = RecordLayoutOf(points); // the sort's shape depends on it
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
-  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, true, [&] {
+  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, [&] {
     // The attributes become records that the sort moves.
     phase = std::chrono::steady_clock::now();
     const float* scalar = attributes.values[kAttributeScalar].Get();
@@ -975,11 +973,30 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
     throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, positions.Position(bad)));
   }
 
+  // Each move's leaf before and after it; the moves that changed leaf, in
+  // order; the first point that left the cube.
+  typename Device::template Buffer<std::uint64_t> fromLeaf, toLeaf;
+  typename Device::template Buffer<std::uint32_t> changedMoves;
+  d.Reserve(fromLeaf, moved, "update moves");
+  d.Reserve(toLeaf, moved, "update moves");
+  d.Reserve(changedMoves, moved, "update moves");
+  const PointArraysView pts = s.Points();
+  const RootCube cube = s.cube;
+  const int leafShift = 3 * (kMaxLevel - s.depth);
+  std::uint64_t* from = fromLeaf.Get();
+  std::uint64_t* into = toLeaf.Get();
+
   writing = true;
   float* xyzFloat = s.points.xyzFloat.Get();
   double* xyzDouble = s.points.xyzDouble.Get();
+  // A point's old leaf from the position it leaves, read before the new one
+  // is written (the engine keeps no keys; every stored point lies inside
+  // the cube).
   d.ForEach("ScatterPositionsKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
+    std::uint64_t key = 0;
+    ComputePointKey(pts, cube, i, key);
+    from[k] = key >> leafShift;
     const Vec3d p = to.Position(k);
     for (int a = 0; a < 3; ++a)
     {
@@ -993,28 +1010,14 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
       }
     }
   });
-
-  // New keys; the moves that changed leaf, in order; the first point that
-  // left the cube. One copy to the host: that point and the moves' count.
-  typename Device::template Buffer<std::uint64_t> fromLeaf, toLeaf;
-  typename Device::template Buffer<std::uint32_t> changedMoves;
-  d.Reserve(fromLeaf, moved, "update moves");
-  d.Reserve(toLeaf, moved, "update moves");
-  d.Reserve(changedMoves, moved, "update moves");
-  const PointArraysView pts = s.Points();
-  const RootCube cube = s.cube;
-  const int leafShift = 3 * (kMaxLevel - s.depth);
-  std::uint64_t* pointKey = s.points.key.Get();
-  std::uint64_t* from = fromLeaf.Get();
-  std::uint64_t* into = toLeaf.Get();
+  // The new leaves from the positions as stored (floats, where they are).
+  // One copy to the host: the first point outside and the moves' count.
   const FirstFailure outside = ArmFirstFailure(d, scratch);
   d.ForEach("MovedKeysKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
     std::uint64_t key = 0;
     const bool inside = ComputePointKey(pts, cube, i, key);
-    from[k] = pointKey[i] >> leafShift;
     into[k] = inside ? key >> leafShift : from[k];
-    pointKey[i] = inside ? key : pointKey[i];
     if (!inside)
     {
       outside.Report(i);
@@ -1030,7 +1033,7 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   {
     // A point left the cube: rebuild around the new bounds, at the same depth.
     const Bounds b = PositionBounds(d, pts);
-    BuildLevels(d, scratch, s, RootCube::FromBounds(b.lo, b.hi), s.depth, true);
+    BuildLevels(d, scratch, s, RootCube::FromBounds(b.lo, b.hi), s.depth);
     stats.changedLeaf = moved;
     stats.path = UpdateStats::Path::NewCube;
   }
@@ -1048,8 +1051,8 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   {
     // Nodes appear or empty, too many points moved for the in-place path,
     // or the nodes hold rounded means (Attributes.h) that it cannot adjust:
-    // the stored keys sorted again, the levels rebuilt in place.
-    BuildLevels(d, scratch, s, s.cube, s.depth, false);
+    // the keys computed and sorted again, the levels rebuilt in place.
+    BuildLevels(d, scratch, s, s.cube, s.depth);
     stats.changedLeaf = changed;
     stats.path = UpdateStats::Path::Relevel;
   }

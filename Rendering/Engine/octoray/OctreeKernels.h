@@ -96,15 +96,16 @@ OCTORAY_HD void ForEachNodeSlot(const OctreeView& t, std::uint32_t n, Fn&& fn)
   });
 }
 
-// Writes sum / count into the node's present attributes.
-OCTORAY_HD void StoreNodeMeans(const OctreeView& t, std::uint32_t n, const double sum[kSlotCount], double count)
+// Writes sums / count into the node's present attributes.
+template <typename Real>
+OCTORAY_HD void StoreNodeMeans(const OctreeView& t, std::uint32_t n, const SlotSums<Real>& sums, double count)
 {
   const double inv = count > 0.0 ? 1.0 / count : 0.0;
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
     if (A::Of(t))
     {
-      A::Of(t)[n] = AttributeValue<typename A::Type>::Mean(sum + A::kSlot, inv);
+      A::Of(t)[n] = AttributeValue<typename A::Type>::Mean(sums.Of(a), inv);
     }
   });
 }
@@ -162,12 +163,12 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   {
     return;
   }
-  double sum[kSlotCount] = {};
+  SlotSums<double> sums;
   for (std::uint32_t s = begin; s < end; ++s)
   {
-    ForEachRecordSlot(sorted.Record(pts, s), pts.layout, [&](int k, float x) { sum[k] += x; });
+    ForEachRecordSlot(sorted.Record(pts, s), pts.layout, [&](int k, auto x) { sums.Add(k, x, 1); });
   }
-  StoreNodeMeans(t, node, sum, static_cast<double>(end - begin));
+  StoreNodeMeans(t, node, sums, static_cast<double>(end - begin));
 }
 
 // Whether item i of sorted keys starts a run of equal keys >> shift: the
@@ -182,14 +183,14 @@ OCTORAY_HD bool StartsRun(const Keys& keys, std::size_t i, int shift)
 // Inner `node` has the children [c0, c1) (global indices, one level down):
 // its key (its children's, one level up), child mask, its group's first
 // child where it starts a group, count and count-weighted means. The
-// children's weighted values add up in float: eight terms at most, so the
-// sum's relative error stays below 5e-7 (about 1e-7 as a rule), far inside
-// what nodes store (8-bit colours, 16-bit scalars and normals) and the
-// tests' 2e-6 for float attributes. In double the loop held 56 registers on
-// an H100, four blocks a multiprocessor; in float 40 and six, and level 9
-// of 10 M points took 150 us against 182 (Benchmarks/gpu/
-// variants-inner-float.txt). A leaf's points stay summed in double
-// (ReduceLeaf): a leaf may hold millions.
+// children's weighted values add up in float (8-bit colours in whole
+// bytes, exactly: SlotSums): eight terms at most, so the sum's relative
+// error stays below 5e-7 (about 1e-7 as a rule), far inside what nodes
+// store (16-bit scalars and normals) and the tests' 2e-6 for float
+// attributes. In double the loop held 56 registers on an H100, four blocks
+// a multiprocessor; in float 40 and six, and level 9 of 10 M points took
+// 150 us against 182 (Benchmarks/gpu/variants-inner-float.txt). A leaf's
+// points stay summed in double (ReduceLeaf): a leaf may hold millions.
 OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint32_t c0, std::uint32_t c1)
 {
   t.SetKey(node, t.Key(c0) >> 3);
@@ -199,7 +200,7 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
   }
   unsigned mask = 0;
   std::uint32_t count = 0;
-  float sum[kSlotCount] = {};
+  SlotSums<float> sums;
   for (std::uint32_t c = c0; c < c1; ++c)
   {
     mask |= 1u << OctantOf(t.key[c]); // a key's low word holds its octant
@@ -207,20 +208,14 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
     count += n;
     if (t.attributes) // one test the compiler can take out of the loop, not one an attribute
     {
-      const float weight = static_cast<float>(n);
-      ForEachNodeSlot(t, c, [&](int k, float x) { sum[k] += x * weight; });
+      ForEachNodeSlot(t, c, [&](int k, auto x) { sums.Add(k, x, n); });
     }
   }
   t.SetChildMask(node, mask);
   t.pointCount[node] = count;
   if (t.attributes)
   {
-    double sumAsDouble[kSlotCount];
-    for (int k = 0; k < kSlotCount; ++k)
-    {
-      sumAsDouble[k] = sum[k];
-    }
-    StoreNodeMeans(t, node, sumAsDouble, static_cast<double>(count));
+    StoreNodeMeans(t, node, sums, static_cast<double>(count));
   }
 }
 
@@ -313,16 +308,15 @@ OCTORAY_HD void ApplyRecords(const OctreeView& t, const PointArraysView& pts, co
   const long long count = static_cast<long long>(t.pointCount[n]) + RecordedCountChange(recordPoint, begin, end);
   if (t.attributes)
   {
-    double sum[kSlotCount] = {};
+    SlotSums<double> sums;
     for (std::uint32_t j = begin; j < end; ++j)
     {
-      const bool joins = recordPoint[j] & 1u;
-      ForEachRecordSlot(pts.Record(recordPoint[j] >> 1), pts.layout,
-        [&](int k, float x) { sum[k] += joins ? x : -x; });
+      const int weight = (recordPoint[j] & 1u) ? 1 : -1; // joins or leaves
+      ForEachRecordSlot(pts.Record(recordPoint[j] >> 1), pts.layout, [&](int k, auto x) { sums.Add(k, x, weight); });
     }
     const std::uint32_t before = t.pointCount[n];
-    ForEachNodeSlot(t, n, [&](int k, float mean) { sum[k] = static_cast<double>(mean) * before + sum[k]; });
-    StoreNodeMeans(t, n, sum, static_cast<double>(count));
+    ForEachNodeSlot(t, n, [&](int k, auto mean) { sums.Add(k, mean, before); });
+    StoreNodeMeans(t, n, sums, static_cast<double>(count));
   }
   t.pointCount[n] = static_cast<std::uint32_t>(count);
 }

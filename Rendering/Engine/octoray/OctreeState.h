@@ -98,7 +98,6 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
   ForEachAttribute([&](auto a) {
     m.Add(std::string("point ") + a.kLabel, layout.offset[a.kIndex] >= 0 ? RecordWords(a) * perWord : 0);
   });
-  m.Add("point keys", s.points.key.Bytes());
   m.Add("sort buffers", sortBytes);
   m.Add(MemoryReport::kAllocatorCache, cachedBytes);
   return m;

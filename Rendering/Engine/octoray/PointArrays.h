@@ -89,7 +89,6 @@ struct PointArrays
   Buffer<double> xyzDouble;
   Buffer<std::uint32_t> records; // the attributes, layout.stride words per point
   PointRecordLayout layout;
-  Buffer<std::uint64_t> key; // full-depth key of each point
 };
 
 // Plain pointers into PointArrays (or into a caller's positions): null

@@ -56,19 +56,36 @@ struct RootCube
   // Full-depth grid cell of a point; false when the point lies outside.
   OCTORAY_HD bool GridCell(double x, double y, double z, std::uint32_t cell[3]) const
   {
-    const double cellsPerUnit = static_cast<double>(1u << kMaxLevel) / size;
-    const double p[3] = { x, y, z };
-    for (int a = 0; a < 3; ++a)
+    return Grid().Cell(x, y, z, cell);
+  }
+
+  // The map onto the full-depth grid, its scale divided out once: a loop
+  // over points takes it rather than the cube, which would divide again
+  // for every point.
+  struct CellMap
+  {
+    double origin[3];
+    double cellsPerUnit;
+
+    OCTORAY_HD bool Cell(double x, double y, double z, std::uint32_t cell[3]) const
     {
-      const double g = (p[a] - origin[a]) * cellsPerUnit;
-      // Written so that NaN also fails the test.
-      if (!(g >= 0.0 && g < static_cast<double>(1u << kMaxLevel)))
+      const double p[3] = { x, y, z };
+      for (int a = 0; a < 3; ++a)
       {
-        return false;
+        const double g = (p[a] - origin[a]) * cellsPerUnit;
+        // Written so that NaN also fails the test.
+        if (!(g >= 0.0 && g < static_cast<double>(1u << kMaxLevel)))
+        {
+          return false;
+        }
+        cell[a] = static_cast<std::uint32_t>(g);
       }
-      cell[a] = static_cast<std::uint32_t>(g);
+      return true;
     }
-    return true;
+  };
+  OCTORAY_HD CellMap Grid() const
+  {
+    return CellMap{ { origin[0], origin[1], origin[2] }, static_cast<double>(1u << kMaxLevel) / size };
   }
 
   OCTORAY_HD bool Contains(const Vec3d& p) const
