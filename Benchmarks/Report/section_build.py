@@ -490,7 +490,18 @@ def _cuda(ctx):
         "most eight terms, the error below 5e-7 a level): the inner levels' loop holds 40 registers where the sums "
         "in double took 56, six blocks a multiprocessor instead of four. Built beside the sums in double and run in "
         "turn, its five kernels took 0.199 ms at 10 M points against 0.243 in ncu (0.527 against 0.625 at 100 M), "
-        "and the level phase 0.58 ms against 0.62 (Benchmarks/gpu/variants-inner-float.txt). The levels' selects "
+        "and the level phase 0.58 ms against 0.62 (Benchmarks/gpu/variants-inner-float.txt). Since 36ab25e the "
+        "engine keeps no keys of the points (8 bytes a point that the keys kernel wrote for updates): a rebuild "
+        "or an update computes them again from the positions, and at their depth, the cell's top bits spread in "
+        "32-bit arithmetic where they fit (Morton.h's EncodeMortonAt); a build of a requested depth counts the "
+        "histogram's level sizes alone (23 bins, where the automatic depth's two histograms take 46); and 8-bit "
+        "colours add up as whole bytes, a leaf's in 64-bit integers. Built beside fc8eae0's engine and run in "
+        "turn, in ncu the keys kernel took 57 µs at 10 M points against 84 (567 against 835 at 100 M), the "
+        "histogram 29 against 40 (218 against 353), the leaves and level 9 1–3 % less, the device phases by step "
+        "1129 µs against 1178 (7563 against 8050); in the benchmark the device phases at 10 M points took "
+        "1.20–1.21 ms against 1.23–1.25, 2.06–2.20 times the sort against 2.09–2.24 (the sort read 0.55–0.60 ms "
+        "in those calls), and 1.66–1.72 times at 100 M against 1.77–1.80 (Benchmarks/gpu/variants-unkept-keys.txt). "
+        "The levels' selects "
         "are CUB's DeviceSelect::If, its predicate reading two keys; on the same sorted keys DeviceSelect::"
         "UniqueByKey took 1.45–1.76 times as long, and a select of tiles with a decoupled look-back written for "
         "them 1.06–2.89 times (Benchmarks/gpu/variants-run-starts-select.txt). Every level's run starts from one pass over the sorted points instead (a "
@@ -725,11 +736,11 @@ def _cuda(ctx):
         if phases:
             device = device_phases(r)
             against = "bare CUB radix sort " + seconds(r["peer_seconds"])
-            ratio = "%.1f× the sort" % (device / r["peer_seconds"])
+            ratio = "%.2f× the sort" % (device / r["peer_seconds"])
             if r.get("build_sort_seconds"):
                 against += " (of the 32-bit keys with 8-byte records the build sorts: %s)" % \
                     seconds(r["build_sort_seconds"])
-                ratio += " (%.1f×)" % (device / r["build_sort_seconds"])
+                ratio += " (%.2f×)" % (device / r["build_sort_seconds"])
             against += "; issue 16's goal ≤ %g× the sort" % GOAL_OVER_SORT
             summary.append(("CUDA octree build, 10 M points, depth 10, device phases (GPU run; whole call with "
                             "the upload: %s)" % seconds(r["seconds"]), seconds(device), against, ratio))
@@ -752,7 +763,7 @@ def _goal_rows(builds, records, phases, upload):
         rows.append(("CUDA octree build, 100 M points, depth 10, device phases (GPU run)", seconds(device),
                      "bare CUB radix sort %s; issue 16's goals ≤ %s and ≤ %g× the sort" %
                      (seconds(big["peer_seconds"]), seconds(GOAL_BUILD_100M), GOAL_OVER_SORT),
-                     "%.1f× the sort" % (device / big["peer_seconds"])))
+                     "%.2f× the sort" % (device / big["peer_seconds"])))
     calls = [deep[n] for n in (10000000, 100000000) if n in deep]
     if upload and calls:
         rows.append(("CUDA octree build from pageable host arrays, whole call, %s points, depth 10 (GPU run)" %
