@@ -588,14 +588,12 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   // (Benchmarks/gpu/variants-unkept-keys.txt).
   const RootCube::CellMap grid = cube.Grid();
   d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
-    const Vec3d p = pts.Position(i);
-    std::uint32_t cell[3] = {};
-    const bool inside = grid.Cell(p.x, p.y, p.z, cell);
-    if (!inside)
+    std::uint64_t key = 0;
+    if (!ComputeLeafKey(pts, grid, i, sortDepth, key))
     {
       outside.Report(i);
     }
-    input.Enter(i, inside ? EncodeMortonAt(cell[0], cell[1], cell[2], sortDepth) : 0);
+    input.Enter(i, key);
   });
   marks[0] = clock.Mark();
   if (beforeSort)
@@ -622,8 +620,9 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
-  WithKeyWords(sorted.keys,
-    [&](const auto* keys) { QueueNeighbourHistogram(d, keys, n, sortDepth, chooseDepth, counters + kCounterHistogram); });
+  WithKeyWords(sorted.keys, [&](const auto* keys) {
+    QueueNeighbourHistogram(d, keys, n, sortDepth, chooseDepth, counters + kCounterHistogram);
+  });
   marks[2] = clock.Mark();
   return sorted;
 }
@@ -981,8 +980,8 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   d.Reserve(toLeaf, moved, "update moves");
   d.Reserve(changedMoves, moved, "update moves");
   const PointArraysView pts = s.Points();
-  const RootCube cube = s.cube;
-  const int leafShift = 3 * (kMaxLevel - s.depth);
+  const RootCube::CellMap grid = s.cube.Grid();
+  const int depth = s.depth;
   std::uint64_t* from = fromLeaf.Get();
   std::uint64_t* into = toLeaf.Get();
 
@@ -990,13 +989,10 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   float* xyzFloat = s.points.xyzFloat.Get();
   double* xyzDouble = s.points.xyzDouble.Get();
   // A point's old leaf from the position it leaves, read before the new one
-  // is written (the engine keeps no keys; every stored point lies inside
-  // the cube).
+  // is written (every stored point lies inside the cube).
   d.ForEach("ScatterPositionsKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
-    std::uint64_t key = 0;
-    ComputePointKey(pts, cube, i, key);
-    from[k] = key >> leafShift;
+    ComputeLeafKey(pts, grid, i, depth, from[k]);
     const Vec3d p = to.Position(k);
     for (int a = 0; a < 3; ++a)
     {
@@ -1016,8 +1012,8 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
   d.ForEach("MovedKeysKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
     std::uint64_t key = 0;
-    const bool inside = ComputePointKey(pts, cube, i, key);
-    into[k] = inside ? key >> leafShift : from[k];
+    const bool inside = ComputeLeafKey(pts, grid, i, depth, key);
+    into[k] = inside ? key : from[k];
     if (!inside)
     {
       outside.Report(i);

@@ -110,11 +110,17 @@ OCTORAY_HD void StoreNodeMeans(const OctreeView& t, std::uint32_t n, const SlotS
   });
 }
 
-// Point i's full-depth key; false if it is not finite or lies outside the cube.
-OCTORAY_HD bool ComputePointKey(const PointArraysView& pts, const RootCube& cube, std::size_t i, std::uint64_t& key)
+// Point i's leaf key at `depth` levels, on the grid of the cube (Grid());
+// false, and the key 0, if it is not finite or lies outside the cube. The
+// engine keeps no keys: the build and an update compute them here.
+OCTORAY_HD bool ComputeLeafKey(const PointArraysView& pts, const RootCube::CellMap& grid, std::size_t i, int depth,
+  std::uint64_t& key)
 {
   const Vec3d p = pts.Position(i);
-  return cube.FullKey(p.x, p.y, p.z, key);
+  std::uint32_t cell[3] = {};
+  const bool inside = grid.Cell(p.x, p.y, p.z, cell);
+  key = inside ? EncodeMortonAt(cell[0], cell[1], cell[2], depth) : 0;
+  return inside;
 }
 
 // The points in the order of their leaf keys, as the build's sort leaves
