@@ -189,8 +189,8 @@ OCTORAY_HD void FromFloats(const float* v, OctNormal& value)
 // summed as whole bytes (a leaf's in 64-bit integers: SlotSums) and the mean
 // rounded to the nearest byte (halves up). A leaf's sums are exact, in any
 // order, and a byte needs no conversion to add, where as a float in [0,1]
-// summed in double each channel of each point took two. The leaf kernel
-// was little faster for it on an H100, 223 us at 10 M points against 227
+// summed in double each channel of each point took two. The leaf loop was
+// little faster for it on an H100, 174 us at 10 M points against 177
 // (Benchmarks/gpu/variants-unkept-keys.txt): the conversions were not what
 // bounds it.
 template <>
