@@ -7,6 +7,7 @@
 // input array in PointCloudView and whatever reads it.
 #pragma once
 
+#include "Morton.h"
 #include "OctahedralNormal.h"
 #include "Scalar16.h"
 #include "Types.h"
@@ -49,6 +50,7 @@ namespace octoray
 
 // The shallowest octree whose deepest keys (3 bits a level) pass 32 bits.
 constexpr int kWideKeyDepth = 11;
+static_assert(!KeysFitWord(kWideKeyDepth) && KeysFitWord(kWideKeyDepth - 1), "one word up to kWideKeyDepth");
 
 // Node n's level-local key from its low and (where stored) high words.
 OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* high, std::size_t n)

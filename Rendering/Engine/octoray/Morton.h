@@ -62,6 +62,14 @@ OCTORAY_HD std::uint64_t EncodeMorton(std::uint32_t x, std::uint32_t y, std::uin
   return SpreadBits3(x) | (SpreadBits3(y) << 1) | (SpreadBits3(z) << 2);
 }
 
+// Whether keys of `depth` levels (3 bits a level) fit a 32-bit word: depth
+// 10 and less. The build sorts such keys as words (SortedKeys::Narrow) and
+// stores its nodes' keys in one word (Attributes.h's kWideKeyDepth).
+OCTORAY_HD constexpr bool KeysFitWord(int depth)
+{
+  return 3 * depth <= 32;
+}
+
 // SpreadBits3 of the low 10 bits, in 32-bit arithmetic.
 OCTORAY_HD std::uint32_t SpreadBits3Narrow(std::uint32_t v)
 {
@@ -83,7 +91,7 @@ OCTORAY_HD std::uint64_t EncodeMortonAt(std::uint32_t x, std::uint32_t y, std::u
 {
   const int below = kMaxLevel - depth;
   x >>= below, y >>= below, z >>= below;
-  if (3 * depth <= 32)
+  if (KeysFitWord(depth))
   {
     return SpreadBits3Narrow(x) | (SpreadBits3Narrow(y) << 1) | (SpreadBits3Narrow(z) << 2);
   }

@@ -138,7 +138,7 @@ struct SortedKeys
   const std::uint32_t* records;   // the records in sorted order (the layout's stride), where they travelled
   int keyShift;                   // bits of the sorted keys below the leaf level
 
-  static constexpr OCTORAY_HD bool Narrow(int depth) { return 3 * depth <= 32; }
+  static constexpr OCTORAY_HD bool Narrow(int depth) { return KeysFitWord(depth); }
   static constexpr OCTORAY_HD bool RecordsTravel(int depth, int stride) { return Narrow(depth) && stride <= 2; }
 
   OCTORAY_HD std::uint64_t LeafKey(std::size_t s) const
