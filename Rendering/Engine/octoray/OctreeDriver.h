@@ -584,8 +584,9 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   // Only the bits down to sortDepth need sorting. The keys are computed
   // from the positions each time, not kept: kept full-depth keys took 8
   // bytes a point, and without writing them this kernel took 73 us at 10 M
-  // points against 84, 703 against 836 at 100 M, on an H100
-  // (Benchmarks/gpu/variants-unkept-keys.txt).
+  // points against 84, 703 against 836 at 100 M, on an H100; 57 and 567
+  // with the keys made at their depth (ComputeLeafKey;
+  // Benchmarks/gpu/variants-unkept-keys.txt).
   const RootCube::CellMap grid = cube.Grid();
   d.ForEach("KeysKernel", n, OCTORAY_LAMBDA(std::size_t i) {
     std::uint64_t key = 0;
