@@ -107,7 +107,7 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
+         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
   {
     SCOPED_TRACE(kernel);
     const Cloud& second = std::string(kernel) == "InnerKernel" ? wide : tight;

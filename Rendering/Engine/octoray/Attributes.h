@@ -58,14 +58,6 @@ OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* 
   return (high ? std::uint64_t{ high[n] } << 32 : 0u) | low[n];
 }
 
-// Nodes' keys of both words, read as one array (keys[i]).
-struct NodeKeys
-{
-  const std::uint32_t* low;
-  const std::uint32_t* high;
-  OCTORAY_HD std::uint64_t operator[](std::size_t i) const { return NodeKey(low, high, i); }
-};
-
 // Optional per-point attributes, each stored per node as the plain mean over
 // the points beneath it, and only where the input had it:
 // X(member, Name, Type, Input, label). Input says how the caller's arrays

@@ -41,4 +41,14 @@ namespace octoray
 // Deepest level of the octree: 21 bits per axis fill a 63-bit Morton key.
 constexpr int kMaxLevel = 21;
 constexpr std::uint32_t kInvalidIndex = 0xFFFFFFFFu;
+
+// Where a device's PlaceNested (OctreeDriver.h) writes `count` lists, one a
+// level of the octree at most, each with room for its items and one entry
+// more.
+struct NestedLists
+{
+  static constexpr int kMaxLists = kMaxLevel + 1;
+  std::uint32_t* list[kMaxLists];
+  int count;
+};
 }

@@ -4,6 +4,7 @@
 // result is the same whatever the thread count.
 #pragma once
 
+#include "Config.h"
 #include "Parallel.h"
 #include "RadixSort.h"
 
@@ -177,31 +178,90 @@ public:
     ParallelFor(n, threads, fn);
   }
 
+  // CountNested's chunks, which PlaceNested follows.
+  int NestedChunks(std::size_t n) const { return n < kParallelPassMinItems ? 1 : threads; }
+
   // Levels of at most kSmallLevelItems children, from `top` down to 0 in
-  // turn (OctreeDriver.h's LinkLevels): each level's runs of children
-  // (levels.StartsRun) into `starts`, then levels.Reduce(l, j, starts[j],
-  // starts[j + 1]) for each run j. Here one thread's loop, as the select
-  // and the loop of a level of so few items were.
+  // turn (OctreeDriver.h's LinkLevels): levels.Reduce(l, j, starts[j],
+  // starts[j + 1]) for each node j of level l, `starts` its nested list.
+  // Here one thread's loop, as a loop of so few items was.
   static constexpr std::size_t kSmallLevelItems = kParallelForMinItems;
   template <typename Levels>
-  void ReduceSmallLevels(const char*, int top, const Levels& levels, std::uint32_t* starts)
+  void ReduceSmallLevels(const char*, int top, const Levels& levels, const NestedLists& lists)
   {
     for (int l = top; l >= 0; --l)
     {
-      const std::uint32_t children = levels.Children(l);
-      std::uint32_t runs = 0;
-      for (std::uint32_t c = 0; c < children; ++c)
-      {
-        if (levels.StartsRun(l, c))
-        {
-          starts[runs++] = c;
-        }
-      }
-      starts[runs] = children;
-      for (std::uint32_t j = 0; j < runs; ++j)
+      const std::uint32_t* starts = lists.list[l];
+      for (std::uint32_t j = 0; j < levels.view.LevelSize(l); ++j)
       {
         levels.Reduce(l, j, starts[j], starts[j + 1]);
       }
+    }
+  }
+
+  // Each chunk counts its items by their first list (tally[c * lists + f]:
+  // chunk c's items of first list f), then places them after the chunks
+  // before it, in each of their lists from the last one up, so that each
+  // list records the item's place in the list after it.
+  template <typename FirstList>
+  void CountNested(const char*, std::size_t n, int lists, FirstList firstList, Buffer<std::uint32_t>& tally,
+    std::uint64_t* counts)
+  {
+    const int chunks = NestedChunks(n);
+    tally.Reserve(static_cast<std::size_t>(chunks) * lists);
+    std::fill_n(tally.Get(), tally.Count(), 0u);
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::uint32_t* count = tally.Get() + static_cast<std::size_t>(c) * lists;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        const int first = firstList(i);
+        if (first < lists)
+        {
+          ++count[first];
+        }
+      }
+    });
+    for (std::size_t k = 0; k < tally.Count(); ++k)
+    {
+      counts[k % lists] += tally.Get()[k];
+    }
+  }
+
+  template <typename FirstList>
+  void PlaceNested(const char*, std::size_t n, FirstList firstList, const Buffer<std::uint32_t>& tally,
+    const NestedLists& out)
+  {
+    const int lists = out.count;
+    const int chunks = NestedChunks(n);
+    // next[c * lists + l]: chunk c's first place in list l, which holds the
+    // items of first list l and less; the row after the last chunk: the sizes.
+    std::vector<std::uint32_t> next(static_cast<std::size_t>(chunks + 1) * lists, 0);
+    for (int c = 0; c < chunks; ++c)
+    {
+      std::uint32_t inList = 0;
+      for (int l = 0; l < lists; ++l)
+      {
+        inList += tally.Get()[static_cast<std::size_t>(c) * lists + l];
+        next[static_cast<std::size_t>(c + 1) * lists + l] = next[static_cast<std::size_t>(c) * lists + l] + inList;
+      }
+    }
+    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
+      std::uint32_t* place = next.data() + static_cast<std::size_t>(c) * lists;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        const int first = firstList(i);
+        std::uint32_t below = static_cast<std::uint32_t>(i);
+        for (int l = lists - 1; l >= first; --l)
+        {
+          out.list[l][place[l]] = below;
+          below = place[l]++;
+        }
+      }
+    });
+    const std::uint32_t* size = next.data() + static_cast<std::size_t>(chunks) * lists;
+    for (int l = 0; l < lists; ++l)
+    {
+      out.list[l][size[l]] = l + 1 < lists ? size[l + 1] : static_cast<std::uint32_t>(n);
     }
   }
 

@@ -11,9 +11,9 @@
 #include "CudaUpload.h"
 
 #include <cub/block/block_reduce.cuh>
-#include <cub/block/block_scan.cuh>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
+#include <cub/device/device_scan.cuh>
 #include <cub/device/device_select.cuh>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
@@ -50,58 +50,172 @@ __global__ void __launch_bounds__(kBlock, 4) ForEachKernel(std::size_t n, Fn fn)
   }
 }
 
-// The levels of CudaDevice::ReduceSmallLevels in one block, in one launch:
-// each level's runs found by a block-wide scan of its children's run
-// starts, a tile at a time, then its nodes reduced, the block in step
-// between levels. A CUB select and a loop a level took three launches of
-// 13-19 us each for levels of a few thousand nodes near the root; levels 4
-// to 0 of 10 M points now take 32 us, where they took 82
+// The levels of CudaDevice::ReduceSmallLevels in one block, in one launch,
+// the block in step between levels. A CUB select and a loop a level took
+// three launches of 13-19 us each for levels of a few thousand nodes near
+// the root; levels 4 to 0 of 10 M points took 32 us so, where they took 82
 // (Benchmarks/gpu/variants-levels-near-root.txt).
 constexpr int kSmallLevelThreads = 1024;
-constexpr int kSmallLevelItemsPerThread = 4;
 
 template <typename Levels>
-__global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int top, Levels levels,
-  std::uint32_t* starts)
+__global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int top, Levels levels, NestedLists lists)
 {
-  using Scan = cub::BlockScan<std::uint32_t, kSmallLevelThreads>;
-  __shared__ typename Scan::TempStorage scan;
-  constexpr std::uint32_t kTile = kSmallLevelThreads * kSmallLevelItemsPerThread;
   for (int l = top; l >= 0; --l)
   {
-    const std::uint32_t children = levels.Children(l);
-    std::uint32_t runs = 0; // the same in every thread
-    for (std::uint32_t tile = 0; tile < children; tile += kTile)
-    {
-      const std::uint32_t first = tile + threadIdx.x * kSmallLevelItemsPerThread;
-      std::uint32_t starting[kSmallLevelItemsPerThread];
-      std::uint32_t rank[kSmallLevelItemsPerThread];
-      for (int k = 0; k < kSmallLevelItemsPerThread; ++k)
-      {
-        starting[k] = first + k < children && levels.StartsRun(l, first + k);
-      }
-      std::uint32_t tileRuns = 0;
-      Scan(scan).ExclusiveSum(starting, rank, tileRuns);
-      for (int k = 0; k < kSmallLevelItemsPerThread; ++k)
-      {
-        if (starting[k])
-        {
-          starts[runs + rank[k]] = first + k;
-        }
-      }
-      runs += tileRuns;
-      __syncthreads(); // before the scan's storage is used again
-    }
-    if (threadIdx.x == 0)
-    {
-      starts[runs] = children;
-    }
-    __syncthreads(); // the runs' ends, written by other threads
-    for (std::uint32_t j = threadIdx.x; j < runs; j += blockDim.x)
+    const std::uint32_t* starts = lists.list[l];
+    for (std::uint32_t j = threadIdx.x; j < levels.view.LevelSize(l); j += blockDim.x)
     {
       levels.Reduce(l, j, starts[j], starts[j + 1]);
     }
-    __syncthreads(); // the level above reads these nodes, and `starts` is written again
+    __syncthreads(); // the level above reads these nodes
+  }
+}
+
+// CudaDevice's nested lists in warp tiles of kNestedItemsPerLane rounds of
+// 32 items: each warp tile counts its items in each list
+// (NestedCountKernel), one scan over those counts, list after list, gives
+// each warp tile its first place in each list, and each warp tile places
+// its items (NestedPlaceKernel). Lane l keeps list l's count or place, so
+// that a round's items go to a list by one ballot. A round visits the lists
+// from the first of any of its items on: in sorted points, the few levels
+// nearest the leaves.
+constexpr int kNestedItemsPerLane = 16;
+constexpr std::size_t kNestedWarpTile = 32 * std::size_t(kNestedItemsPerLane);
+static_assert(NestedLists::kMaxLists <= 32, "a warp's lane l holds list l's count");
+static_assert(kBlock % 32 == 0, "whole warps a block");
+
+inline std::size_t NestedWarpTiles(std::size_t n)
+{
+  return std::max<std::size_t>(1, (n + kNestedWarpTile - 1) / kNestedWarpTile);
+}
+
+// The least of the warp's values (the PTX for GPUs before sm_80, which the
+// CUDA build also carries, has no redux instruction).
+__device__ inline int WarpMin(int value)
+{
+#if __CUDA_ARCH__ >= 800
+  return __reduce_min_sync(0xFFFFFFFFu, value);
+#else
+  for (int offset = 16; offset > 0; offset /= 2)
+  {
+    value = min(value, __shfl_xor_sync(0xFFFFFFFFu, value, offset));
+  }
+  return value;
+#endif
+}
+
+// The first lists of this lane's items in its warp's tile (`lists`, in
+// none, past the last item), loaded before they are used so that the loads
+// overlap; the tile's number.
+template <typename FirstList>
+__device__ inline std::size_t LoadFirstLists(std::size_t n, int lists, FirstList firstList,
+  int (&first)[kNestedItemsPerLane])
+{
+  const std::size_t tile = (blockIdx.x * std::size_t(blockDim.x) + threadIdx.x) / 32;
+  const std::size_t begin = tile * kNestedWarpTile + (threadIdx.x & 31u);
+#pragma unroll
+  for (int r = 0; r < kNestedItemsPerLane; ++r)
+  {
+    const std::size_t i = begin + 32 * std::size_t(r);
+    const int f = i < n ? firstList(i) : lists;
+    first[r] = f < lists ? f : lists;
+  }
+  return tile;
+}
+
+// counts[l * tiles + tile]: warp tile `tile`'s items in list l (those of
+// first list l and less); then one 0, so that the scan's last entry is the
+// size of every list together. histogram[f] += the items of first list f,
+// added up in the block first.
+template <typename FirstList>
+__global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, FirstList firstList,
+  std::uint32_t* counts, unsigned long long* histogram)
+{
+  __shared__ std::uint32_t blockCount[NestedLists::kMaxLists];
+  if (threadIdx.x < NestedLists::kMaxLists)
+  {
+    blockCount[threadIdx.x] = 0;
+  }
+  __syncthreads();
+  int first[kNestedItemsPerLane];
+  const std::size_t tile = LoadFirstLists(n, lists, firstList, first);
+  const int lane = threadIdx.x & 31u;
+  std::uint32_t mine = 0; // lane l: list l's
+#pragma unroll
+  for (int r = 0; r < kNestedItemsPerLane; ++r)
+  {
+    for (int l = WarpMin(first[r]); l < lists; ++l)
+    {
+      const unsigned in = __ballot_sync(0xFFFFFFFFu, first[r] <= l);
+      mine += lane == l ? __popc(in) : 0;
+    }
+  }
+  const std::uint32_t before = __shfl_up_sync(0xFFFFFFFFu, mine, 1); // list l - 1's
+  if (tile < tiles && lane < lists)
+  {
+    counts[lane * tiles + tile] = mine;
+    const std::uint32_t ofFirstList = lane > 0 ? mine - before : mine;
+    if (ofFirstList)
+    {
+      atomicAdd(&blockCount[lane], ofFirstList);
+    }
+  }
+  if (tile == 0 && lane == 0)
+  {
+    counts[lists * tiles] = 0;
+  }
+  __syncthreads();
+  if (threadIdx.x < lists && blockCount[threadIdx.x])
+  {
+    atomicAdd(&histogram[threadIdx.x], static_cast<unsigned long long>(blockCount[threadIdx.x]));
+  }
+}
+
+// Places each warp tile's items, round by round, in each of their lists,
+// the last first, so that list l records the place in list l + 1.
+// `firstPlace` is the exclusive scan of NestedCountKernel's counts.
+template <typename FirstList>
+__global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList firstList, NestedLists out,
+  const std::uint32_t* firstPlace)
+{
+  const int lists = out.count;
+  int first[kNestedItemsPerLane];
+  const std::size_t tile = LoadFirstLists(n, lists, firstList, first);
+  if (tile >= tiles)
+  {
+    return;
+  }
+  const int lane = threadIdx.x & 31u;
+  std::uint32_t next = 0; // lane l: the tile's next place in list l
+  if (lane < lists)
+  {
+    const std::uint32_t listBegin = firstPlace[lane * tiles];
+    next = firstPlace[lane * tiles + tile] - listBegin;
+    if (tile == 0) // after its items, each list records the next one's size
+    {
+      const std::uint32_t size = firstPlace[(lane + 1) * tiles] - listBegin;
+      out.list[lane][size] = lane + 1 < lists ? firstPlace[(lane + 2) * tiles] - firstPlace[(lane + 1) * tiles]
+                                              : static_cast<std::uint32_t>(n);
+    }
+  }
+  const std::size_t begin = tile * kNestedWarpTile + lane;
+#pragma unroll
+  for (int r = 0; r < kNestedItemsPerLane; ++r)
+  {
+    std::uint32_t below = static_cast<std::uint32_t>(begin + 32 * std::size_t(r));
+    const int low = WarpMin(first[r]);
+    for (int l = lists - 1; l >= low; --l)
+    {
+      const unsigned in = __ballot_sync(0xFFFFFFFFu, first[r] <= l);
+      const std::uint32_t listNext = __shfl_sync(0xFFFFFFFFu, next, l);
+      if (first[r] <= l)
+      {
+        const std::uint32_t place = listNext + __popc(in & ((1u << lane) - 1u));
+        out.list[l][place] = below;
+        below = place;
+      }
+      next += lane == l ? __popc(in) : 0;
+    }
   }
 }
 
@@ -402,14 +516,42 @@ public:
     }
   }
 
-  // As CpuDevice::ReduceSmallLevels: levels whose children a block scans in
-  // at most four tiles, all in one block (SmallLevelsKernel).
-  static constexpr std::size_t kSmallLevelItems =
-    4 * std::size_t(cuda::kSmallLevelThreads) * cuda::kSmallLevelItemsPerThread;
+  // As CpuDevice::ReduceSmallLevels: levels of at most 16 children a
+  // thread of one block, all in that block (SmallLevelsKernel).
+  static constexpr std::size_t kSmallLevelItems = 16 * std::size_t(cuda::kSmallLevelThreads);
   template <typename Levels>
-  void ReduceSmallLevels(const char* name, int top, const Levels& levels, std::uint32_t* starts)
+  void ReduceSmallLevels(const char* name, int top, const Levels& levels, const NestedLists& lists)
   {
-    Launch(name, cuda::SmallLevelsKernel<Levels>, 1, cuda::kSmallLevelThreads, top, levels, starts);
+    Launch(name, cuda::SmallLevelsKernel<Levels>, 1, cuda::kSmallLevelThreads, top, levels, lists);
+  }
+
+  // As CpuDevice's: `tally` holds the warp tiles' counts and their scan,
+  // lists * tiles + 1 entries each.
+  template <typename FirstList>
+  void CountNested(const char* name, std::size_t n, int lists, FirstList firstList, Buffer<std::uint32_t>& tally,
+    std::uint64_t* counts)
+  {
+    static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit counts");
+    const std::size_t tiles = cuda::NestedWarpTiles(n);
+    const std::size_t entries = static_cast<std::size_t>(lists) * tiles + 1;
+    std::uint32_t* none = nullptr;
+    std::size_t scanBytes = 0;
+    CudaCheck(cub::DeviceScan::ExclusiveSum(nullptr, scanBytes, none, none, entries), "cub::DeviceScan");
+    Reserve(tally, 2 * entries, "nested lists");
+    Launch(name, cuda::NestedCountKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, lists, tiles,
+      firstList, tally.Get(), reinterpret_cast<unsigned long long*>(counts));
+    CudaCheck(cub::DeviceScan::ExclusiveSum(Temporary(scanBytes), scanBytes, tally.Get(), tally.Get() + entries, entries),
+      "cub::DeviceScan");
+  }
+
+  template <typename FirstList>
+  void PlaceNested(const char* name, std::size_t n, FirstList firstList, const Buffer<std::uint32_t>& tally,
+    const NestedLists& out)
+  {
+    const std::size_t tiles = cuda::NestedWarpTiles(n);
+    const std::size_t entries = static_cast<std::size_t>(out.count) * tiles + 1;
+    Launch(name, cuda::NestedPlaceKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, tiles, firstList,
+      out, tally.Get() + entries);
   }
 
   template <typename T, typename Map, typename Combine>

@@ -51,16 +51,25 @@ OCTORAY_HD BinPair DepthHistogramEntries(const Key* keys, std::size_t n, std::si
   return BinPair{ i > 0 ? withPrev + 1 : -1, kDepthHistogramBins + (withPrev > withNext ? withPrev : withNext) + 1 };
 }
 
-// Where sorted key i counts in the newNode histogram alone (second: -1),
-// all a build of a requested depth reads from it (its level sizes): half
-// the counters and one comparison a key fewer than DepthHistogramEntries.
-// On an H100 the histogram took 30 us at 10 M points against 40, and 217
-// against 338 at 100 M (Benchmarks/gpu/variants-unkept-keys.txt).
+// The shallowest level at which sorted key i of n starts a node, which it
+// starts at every level from there to the leaves: 0 for the first key,
+// else one below the deepest level it shares with the previous key, its
+// newNode bin (kMaxLevel + 1 where the keys are equal: none). The sorted
+// keys are leaf keys of `depth` levels once shifted right by `shift` bits
+// (32 or 64 bits). Level l's run starts are the keys of first new level l
+// and less (the build's nested lists: OctreeDriver.h's LinkLevels).
 template <typename Key>
-OCTORAY_HD BinPair NewNodeEntry(const Key* keys, std::size_t i, int depth)
+struct FirstNewLevels
 {
-  return BinPair{ i > 0 ? SharedLevels(keys[i - 1], keys[i], depth) + 1 : -1, -1 };
-}
+  const Key* keys;
+  int depth;
+  int shift;
+
+  OCTORAY_HD int operator()(std::size_t i) const
+  {
+    return i > 0 ? SharedLevels(keys[i - 1] >> shift, keys[i] >> shift, depth) + 1 : 0;
+  }
+};
 
 // Nodes at `level` (0..21) from the newNode histogram: the first key starts
 // one, and so does every key that shares fewer than `level` levels with its

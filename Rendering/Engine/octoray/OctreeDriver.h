@@ -18,6 +18,13 @@
 //   Reduce(n, identity, map, combine) combine over every map(i), returned to the host
 //   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
+//   CountNested(name, n, lists, firstList, tally, counts)   nested selections: i in [0, n) belongs to every list
+//                                     from firstList(i) to lists - 1 (none where firstList(i) >= lists);
+//                                     counts[f] += the items of first list f, and `tally` (a 32-bit buffer)
+//                                     what PlaceNested needs
+//   PlaceNested(name, n, firstList, tally, out)   those lists, in order, into the NestedLists `out`: the last
+//                                     holds the items, list l < lists - 1 each item's place in list l + 1,
+//                                     and after its items each list the size of the next (the last: n)
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
 //   SortPairsFrom(keys[2], valuesIn, valuesOut, n, bits, what)   the same, the values read from valuesIn (left as
@@ -144,19 +151,15 @@ std::uint64_t FirstFailedStep(Device& d, DriverScratch<Device>& scratch, const c
   return result;
 }
 
-// starts[r] = where the r-th run of equal (key >> shift) among n sorted
-// keys starts, with n after the last run: the nodes one level up (shift 3),
-// the leaves (the sorted words' keyShift) or the records of one node
-// (shift 0). `keys`: an array, or what reads as one (NodeKeys). `starts`
-// has room for n + 1; the count goes to kCounterSelected, which the host
-// reads only where it does not know it.
-template <class Device, typename Keys>
-void RunStarts(Device& d, DriverScratch<Device>& scratch, Keys keys, std::size_t n, int shift,
-  std::uint32_t* starts)
+// starts[r] = where the r-th run of equal keys among n sorted keys starts
+// (the in-place update's records of one node), with n after the last run.
+// `starts` has room for n + 1; the count goes to kCounterSelected.
+template <class Device, typename Key>
+void RunStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, std::uint32_t* starts)
 {
   d.Select(
     n + 1,
-    OCTORAY_LAMBDA(std::size_t i) { return i == n || StartsRun(keys, i, shift); },
+    OCTORAY_LAMBDA(std::size_t i) { return i == n || i == 0 || keys[i] != keys[i - 1]; },
     starts, scratch.counters.Get() + kCounterSelected);
 }
 
@@ -405,6 +408,7 @@ struct SortedPoints
   SortedKeys keys;
   std::uint32_t* spare; // a 32-bit array the sort left free (n + 1 entries): room for run starts
   int depth;
+  bool counted; // the levels' run starts counted at `depth` (CountLevelStarts), with the histogram
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
@@ -546,30 +550,42 @@ void WithKeyWords(const SortedKeys& keys, Fn&& fn)
 }
 
 // Counts the n sorted leaf keys of `depth` levels in DepthChoice's two
-// histograms (DepthHistogramEntries) where the depth is to be chosen, else
-// in newNode alone (NewNodeEntry; alone's counts stay zero).
+// histograms (DepthHistogramEntries), which the automatic depth reads.
 template <class Device, typename Key>
-void QueueNeighbourHistogram(Device& d, const Key* keys, std::size_t n, int depth, bool chooseDepth,
+void QueueDepthHistograms(Device& d, const Key* keys, std::size_t n, int depth, std::uint64_t* counts)
+{
+  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
+    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
+}
+
+// The levels' run starts of the n sorted points at `depth` (keys shifted
+// right by `shift` bits), counted for PlaceLevelStarts: every level's size
+// goes to the newNode histogram `counts` (DepthChoice.h's FirstNewLevels is
+// each key's bin, and the first key's 0, which NodesAtLevel leaves out).
+template <class Device, typename Key>
+void CountLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth, int shift,
   std::uint64_t* counts)
 {
-  if (chooseDepth)
-  {
-    d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-      OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
-  }
-  else
-  {
-    d.template Histogram<kDepthHistogramBins>("NeighbourHistogramKernel", n,
-      OCTORAY_LAMBDA(std::size_t i) { return NewNodeEntry(keys, i, depth); }, counts);
-  }
+  d.CountNested("LevelCountKernel", n, depth + 1, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally,
+    counts);
+}
+
+// Every level's run starts, as counted: the leaves' first points in
+// lists.list[depth], each inner level's first children in lists.list[l].
+template <class Device, typename Key>
+void PlaceLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth, int shift,
+  const NestedLists& lists)
+{
+  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally, lists);
 }
 
 // Queues the sort of the state's points by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys, computed from the positions, the
 // sort, and the histogram of neighbouring sorted keys. beforeSort(), if
 // given, runs on the host between the keys and the sort; the points'
-// records must exist after it. chooseDepth: the histogram the automatic
-// depth reads, else the level sizes alone. Marks on `clock`: marks[0]
+// records must exist after it. chooseDepth: the histograms the automatic
+// depth reads, else the levels' run starts counted (CountLevelStarts),
+// their sizes in the histogram. Marks on `clock`: marks[0]
 // after the keys, marks[1] before the sort, marks[2] after the histogram.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
@@ -621,8 +637,16 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
+  sorted.counted = !chooseDepth;
   WithKeyWords(sorted.keys, [&](const auto* keys) {
-    QueueNeighbourHistogram(d, keys, n, sortDepth, chooseDepth, counters + kCounterHistogram);
+    if (chooseDepth)
+    {
+      QueueDepthHistograms(d, keys, n, sortDepth, counters + kCounterHistogram);
+    }
+    else
+    {
+      CountLevelStarts(d, scratch, keys, n, sortDepth, 0, counters + kCounterHistogram);
+    }
   });
   marks[2] = clock.Mark();
   return sorted;
@@ -707,9 +731,30 @@ inline void SetLevelBegins(const std::uint64_t newNode[kDepthHistogramBins], int
   }
 }
 
+// Where PlaceLevelStarts writes each level's run starts: the leaves' in the
+// array the sort left free, the inner levels' one after another in
+// scratch.levelStarts, each with one entry more than the level has nodes.
+template <class Device>
+NestedLists ReserveLevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeState<Device>& s,
+  std::uint32_t* spare)
+{
+  const int depth = s.depth;
+  d.Reserve(scratch.levelStarts, s.levelBegin[depth] + depth, "level starts");
+  NestedLists lists;
+  lists.count = depth + 1;
+  for (int l = 0; l < depth; ++l)
+  {
+    lists.list[l] = scratch.levelStarts.Get() + s.levelBegin[l] + l;
+  }
+  lists.list[depth] = spare;
+  return lists;
+}
+
 // The node arrays from the sorted points: leaves, then each level from the
 // one below, its nodes the runs of equal parent keys. The level sizes are
-// known from the histogram, so nothing returns to the host per level.
+// known from the histogram, and every level's run starts come from one pass
+// over the sorted points (PlaceLevelStarts), so nothing returns to the host
+// per level.
 template <class Device>
 void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const SortedPoints& sorted,
   const RootCube& cube)
@@ -717,13 +762,13 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const int depth = sorted.depth;
   s.depth = depth;
   s.cube = cube;
-  // The leaves' runs first, which need no node array: the device finds them
-  // while the host reserves the nodes. The reservations took 0.2-0.3 ms at
-  // 10 M points and up to 1 ms at 100 M on an H100 while the memory pool
-  // grew, the device idle (Benchmarks/gpu/variants-levels-order.txt).
-  std::uint32_t* starts = sorted.spare;
   const SortedKeys keys = sorted.keys;
-  WithKeyWords(keys, [&](const auto* words) { RunStarts(d, scratch, words, s.count, keys.keyShift, starts); });
+  if (!sorted.counted) // the automatic depth: its histograms gave the sizes
+  {
+    WithKeyWords(keys, [&](const auto* words) {
+      CountLevelStarts(d, scratch, words, s.count, depth, keys.keyShift, scratch.counters.Get() + kCounterHistogram);
+    });
+  }
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
@@ -743,31 +788,26 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   {
     d.FillBytes(s.nodes.childMasks.Get() + (nodes - 1) / 8, 1, 0);
   }
+  const NestedLists starts = ReserveLevelStarts(d, scratch, s, sorted.spare);
+  WithKeyWords(keys, [&](const auto* words) {
+    PlaceLevelStarts(d, scratch, words, s.count, depth, keys.keyShift, starts);
+  });
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
   const std::uint32_t leafBegin = view.levelBegin[depth];
+  const std::uint32_t* leafStarts = starts.list[depth];
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
-    ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
+    ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), leafStarts[j], leafStarts[j + 1]);
   });
-  // Levels of many children: a select and a loop each. The few small ones
-  // near the root together (Device::ReduceSmallLevels).
+  // Levels of many children a loop each; the few small ones near the root
+  // together (Device::ReduceSmallLevels).
   const InnerLevels levels{ view };
   int l = depth - 1;
   for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
   {
-    // Keys of one word go to the select as a plain array: read through
-    // NodeKeys, which tests for a high word, the selects took a fifth
-    // longer on an H100 (Benchmarks/gpu/variants-inner-reduce.txt).
-    if (view.keyHigh)
-    {
-      RunStarts(d, scratch, levels.ChildKeys(l), levels.Children(l), 3, starts);
-    }
-    else
-    {
-      RunStarts(d, scratch, levels.ChildKeys(l).low, levels.Children(l), 3, starts);
-    }
+    const std::uint32_t* children = starts.list[l];
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
-      levels.Reduce(l, static_cast<std::uint32_t>(j), starts[j], starts[j + 1]);
+      levels.Reduce(l, static_cast<std::uint32_t>(j), children[j], children[j + 1]);
     });
   }
   if (l >= 0)
@@ -822,7 +862,7 @@ void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   d.Release(s.points.xyzFloat);
   d.Release(s.points.xyzDouble);
   d.Release(s.points.records);
-  DriverScratch<Device>::ForEachSortBuffer(scratch, [&](auto& buffer) { d.Release(buffer); });
+  DriverScratch<Device>::ForEachScratchBuffer(scratch, [&](auto& buffer) { d.Release(buffer); });
   d.Release(scratch.counters);
   d.ReleaseScratch();
 }
@@ -924,7 +964,7 @@ bool UpdateInPlace(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   const std::uint32_t* byNode = keys[result];
   const std::uint32_t* pointOf = values[result];
   std::uint32_t* starts = values[1 - result];
-  RunStarts(d, scratch, byNode, records, 0, starts);
+  RunStarts(d, scratch, byNode, records, starts);
   std::uint64_t runs = 0;
   d.ToHost(scratch.counters.Get() + kCounterSelected, 1, &runs, "run starts");
   --runs; // the end of the last run

@@ -177,15 +177,6 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   StoreNodeMeans(t, node, sums, static_cast<double>(end - begin));
 }
 
-// Whether item i of sorted keys starts a run of equal keys >> shift: the
-// runs of a level's nodes are its parents (shift 3), those of the sorted
-// points the leaves.
-template <typename Keys>
-OCTORAY_HD bool StartsRun(const Keys& keys, std::size_t i, int shift)
-{
-  return i == 0 || (keys[i] >> shift) != (keys[i - 1] >> shift);
-}
-
 // Inner `node` has the children [c0, c1) (global indices, one level down):
 // its key (its children's, one level up), child mask, its group's first
 // child where it starts a group, count and count-weighted means. The
@@ -228,22 +219,13 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
 // The inner levels, as LinkLevels reduces them a level a launch and
 // Device::ReduceSmallLevels the small ones together: level l's nodes are the
 // runs of equal parent keys among level l + 1's nodes, its children (c and
-// j count from each level's first node).
+// j count from each level's first node; the runs' starts come from
+// LinkLevels' nested lists).
 struct InnerLevels
 {
   OctreeView view;
 
   OCTORAY_HD std::uint32_t Children(int l) const { return view.LevelSize(l + 1); }
-
-  // The keys of level l's children, as an array from its first child.
-  OCTORAY_HD NodeKeys ChildKeys(int l) const
-  {
-    const std::uint32_t first = view.levelBegin[l + 1];
-    return NodeKeys{ view.key + first, view.keyHigh ? view.keyHigh + first : nullptr };
-  }
-
-  // Whether child c starts a run of one parent's children.
-  OCTORAY_HD bool StartsRun(int l, std::uint32_t c) const { return octoray::StartsRun(ChildKeys(l), c, 3); }
 
   // Node j of level l from its children [c0, c1).
   OCTORAY_HD void Reduce(int l, std::uint32_t j, std::uint32_t c0, std::uint32_t c1) const

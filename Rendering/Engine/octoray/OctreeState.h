@@ -60,11 +60,16 @@ struct DriverScratch
   Buffer<std::uint32_t> narrowKey[2];
   Buffer<std::uint32_t> sortIndex[2];
   Buffer<std::uint32_t> sortRecords;
+  // The levels' run starts: what Device::CountNested counts for
+  // PlaceNested, and the nested lists of the inner levels (the leaves' go
+  // to the array the sort left free).
+  Buffer<std::uint32_t> levelTally;
+  Buffer<std::uint32_t> levelStarts;
   Buffer<std::uint64_t> counters; // what loops report to the host (CounterSlot, OctreeDriver.h)
 
-  // fn(buffer) for each sort buffer of `scratch` (const or not).
+  // fn(buffer) for each buffer of `scratch` but the counters (const or not).
   template <class Scratch, class Fn>
-  static void ForEachSortBuffer(Scratch& scratch, Fn&& fn)
+  static void ForEachScratchBuffer(Scratch& scratch, Fn&& fn)
   {
     for (int b = 0; b < 2; ++b)
     {
@@ -73,12 +78,14 @@ struct DriverScratch
       fn(scratch.sortIndex[b]);
     }
     fn(scratch.sortRecords);
+    fn(scratch.levelTally);
+    fn(scratch.levelStarts);
   }
 
   std::size_t Bytes() const
   {
     std::size_t bytes = counters.Bytes();
-    ForEachSortBuffer(*this, [&](const auto& buffer) { bytes += buffer.Bytes(); });
+    ForEachScratchBuffer(*this, [&](const auto& buffer) { bytes += buffer.Bytes(); });
     return bytes;
   }
 };
