@@ -233,7 +233,9 @@ TEST(CpuDevice, SelectKeepsOrderAndCounts)
 // order, the items whose first list is l or less (the last list the items
 // themselves, each other list an item's place in the next), then the size
 // of the next list; the counts are those of each first list. First lists
-// past the last (an item in no list) come too.
+// past the last (an item in no list) come too. The lists before the last
+// go end to end, and only where they fit: with one entry too few, the last
+// list alone.
 TEST(CpuDevice, NestedListsHoldEachItemFromItsFirstListOn)
 {
   OnEverySplit([](std::size_t n, CpuDevice& d) {
@@ -263,18 +265,23 @@ TEST(CpuDevice, NestedListsHoldEachItemFromItsFirstListOn)
       expected[l].push_back(l + 1 < lists ? static_cast<std::uint32_t>(expected[l + 1].size() - 1)
                                           : static_cast<std::uint32_t>(n));
     }
-    std::vector<std::vector<std::uint32_t>> out(lists, std::vector<std::uint32_t>(n + 1, 0xDEADBEEFu));
-    NestedLists nested;
-    nested.count = lists;
-    for (int l = 0; l < lists; ++l)
+    std::vector<std::uint32_t> packed;
+    for (int l = 0; l + 1 < lists; ++l)
     {
-      nested.list[l] = out[l].data();
+      packed.insert(packed.end(), expected[l].begin(), expected[l].end());
     }
-    d.PlaceNested("test", n, firstList, tally, nested);
+    for (const std::size_t room : { packed.size(), packed.size() - 1 })
+    {
+      std::vector<std::uint32_t> last(n + 1, 0xDEADBEEFu);
+      std::vector<std::uint32_t> packedOut(packed.size(), 0xDEADBEEFu);
+      NestedLists out{ lists, last.data(), packedOut.data(), room };
+      d.PlaceNested("test", n, firstList, tally, out);
+      EXPECT_TRUE(std::equal(expected[lists - 1].begin(), expected[lists - 1].end(), last.begin())) << room;
+      EXPECT_EQ(packedOut == packed, room == packed.size()) << room;
+    }
     for (int l = 0; l < lists; ++l)
     {
       EXPECT_EQ(counts[l], expectedCounts[l]) << "list " << l;
-      EXPECT_TRUE(std::equal(expected[l].begin(), expected[l].end(), out[l].begin())) << "list " << l;
     }
   });
 }

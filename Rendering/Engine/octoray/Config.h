@@ -43,12 +43,26 @@ constexpr int kMaxLevel = 21;
 constexpr std::uint32_t kInvalidIndex = 0xFFFFFFFFu;
 
 // Where a device's PlaceNested (OctreeDriver.h) writes `count` lists, one a
-// level of the octree at most, each with room for its items and one entry
-// more.
+// level of the octree at most, each with one entry more than it has items:
+// the last list in `last`, the others end to end in `packed`, which has
+// room for `packedRoom` entries. The sizes of the packed lists are known
+// only once they are counted, on the device: where they do not fit, the
+// last list alone is written.
 struct NestedLists
 {
   static constexpr int kMaxLists = kMaxLevel + 1;
-  std::uint32_t* list[kMaxLists];
   int count;
+  std::uint32_t* last;
+  std::uint32_t* packed;
+  std::size_t packedRoom;
+
+  // List l, after `itemsBefore` items of the lists before it.
+  OCTORAY_HD std::uint32_t* List(int l, std::size_t itemsBefore) const
+  {
+    return l + 1 == count ? last : packed + itemsBefore + l;
+  }
+
+  // Whether the packed lists, of `packedItems` items together, fit.
+  OCTORAY_HD bool PackedFit(std::size_t packedItems) const { return packedItems + (count - 1) <= packedRoom; }
 };
 }

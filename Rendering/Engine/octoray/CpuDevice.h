@@ -191,7 +191,7 @@ public:
   {
     for (int l = top; l >= 0; --l)
     {
-      const std::uint32_t* starts = lists.list[l];
+      const std::uint32_t* starts = lists.List(l, levels.view.levelBegin[l]);
       for (std::uint32_t j = 0; j < levels.view.LevelSize(l); ++j)
       {
         levels.Reduce(l, j, starts[j], starts[j + 1]);
@@ -245,23 +245,31 @@ public:
         next[static_cast<std::size_t>(c + 1) * lists + l] = next[static_cast<std::size_t>(c) * lists + l] + inList;
       }
     }
+    const std::uint32_t* size = next.data() + static_cast<std::size_t>(chunks) * lists;
+    std::uint32_t* list[NestedLists::kMaxLists];
+    std::size_t itemsBefore = 0;
+    for (int l = 0; l < lists; ++l)
+    {
+      list[l] = out.List(l, itemsBefore);
+      itemsBefore += size[l];
+    }
+    const int lowest = out.PackedFit(itemsBefore - size[lists - 1]) ? 0 : lists - 1;
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::uint32_t* place = next.data() + static_cast<std::size_t>(c) * lists;
       for (std::size_t i = begin; i < end; ++i)
       {
-        const int first = firstList(i);
+        const int first = std::max(firstList(i), lowest);
         std::uint32_t below = static_cast<std::uint32_t>(i);
         for (int l = lists - 1; l >= first; --l)
         {
-          out.list[l][place[l]] = below;
+          list[l][place[l]] = below;
           below = place[l]++;
         }
       }
     });
-    const std::uint32_t* size = next.data() + static_cast<std::size_t>(chunks) * lists;
-    for (int l = 0; l < lists; ++l)
+    for (int l = lowest; l < lists; ++l)
     {
-      out.list[l][size[l]] = l + 1 < lists ? size[l + 1] : static_cast<std::uint32_t>(n);
+      list[l][size[l]] = l + 1 < lists ? size[l + 1] : static_cast<std::uint32_t>(n);
     }
   }
 

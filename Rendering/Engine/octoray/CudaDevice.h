@@ -62,7 +62,7 @@ __global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int t
 {
   for (int l = top; l >= 0; --l)
   {
-    const std::uint32_t* starts = lists.list[l];
+    const std::uint32_t* starts = lists.List(l, levels.view.levelBegin[l]);
     for (std::uint32_t j = threadIdx.x; j < levels.view.LevelSize(l); j += blockDim.x)
     {
       levels.Reduce(l, j, starts[j], starts[j + 1]);
@@ -172,8 +172,10 @@ __global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, F
 }
 
 // Places each warp tile's items, round by round, in each of their lists,
-// the last first, so that list l records the place in list l + 1.
-// `firstPlace` is the exclusive scan of NestedCountKernel's counts.
+// the last first, so that list l records the place in list l + 1; the
+// lists before the last only where they fit. `firstPlace` is the exclusive
+// scan of NestedCountKernel's counts: list l's entries for the warp tiles,
+// after those of the lists before it.
 template <typename FirstList>
 __global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList firstList, NestedLists out,
   const std::uint32_t* firstPlace)
@@ -186,16 +188,19 @@ __global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList fi
     return;
   }
   const int lane = threadIdx.x & 31u;
+  const int lowest = out.PackedFit(firstPlace[(lists - 1) * tiles]) ? 0 : lists - 1;
   std::uint32_t next = 0; // lane l: the tile's next place in list l
+  std::uint32_t* list = nullptr; // lane l: list l
   if (lane < lists)
   {
-    const std::uint32_t listBegin = firstPlace[lane * tiles];
-    next = firstPlace[lane * tiles + tile] - listBegin;
-    if (tile == 0) // after its items, each list records the next one's size
+    const std::uint32_t itemsBefore = firstPlace[lane * tiles];
+    list = out.List(lane, itemsBefore);
+    next = firstPlace[lane * tiles + tile] - itemsBefore;
+    if (tile == 0 && lane >= lowest) // after its items, each list records the next one's size
     {
-      const std::uint32_t size = firstPlace[(lane + 1) * tiles] - listBegin;
-      out.list[lane][size] = lane + 1 < lists ? firstPlace[(lane + 2) * tiles] - firstPlace[(lane + 1) * tiles]
-                                              : static_cast<std::uint32_t>(n);
+      const std::uint32_t size = firstPlace[(lane + 1) * tiles] - itemsBefore;
+      list[size] = lane + 1 < lists ? firstPlace[(lane + 2) * tiles] - firstPlace[(lane + 1) * tiles]
+                                    : static_cast<std::uint32_t>(n);
     }
   }
   const std::size_t begin = tile * kNestedWarpTile + lane;
@@ -203,15 +208,17 @@ __global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList fi
   for (int r = 0; r < kNestedItemsPerLane; ++r)
   {
     std::uint32_t below = static_cast<std::uint32_t>(begin + 32 * std::size_t(r));
-    const int low = WarpMin(first[r]);
+    const int low = max(WarpMin(first[r]), lowest);
     for (int l = lists - 1; l >= low; --l)
     {
       const unsigned in = __ballot_sync(0xFFFFFFFFu, first[r] <= l);
       const std::uint32_t listNext = __shfl_sync(0xFFFFFFFFu, next, l);
+      auto* const listOf = reinterpret_cast<std::uint32_t*>(
+        __shfl_sync(0xFFFFFFFFu, reinterpret_cast<unsigned long long>(list), l));
       if (first[r] <= l)
       {
         const std::uint32_t place = listNext + __popc(in & ((1u << lane) - 1u));
-        out.list[l][place] = below;
+        listOf[place] = below;
         below = place;
       }
       next += lane == l ? __popc(in) : 0;

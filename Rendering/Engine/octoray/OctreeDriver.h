@@ -408,7 +408,8 @@ struct SortedPoints
   SortedKeys keys;
   std::uint32_t* spare; // a 32-bit array the sort left free (n + 1 entries): room for run starts
   int depth;
-  bool counted; // the levels' run starts counted at `depth` (CountLevelStarts), with the histogram
+  bool counted;          // the levels' run starts counted at `depth` (CountLevelStarts), with the histogram
+  std::size_t placedRoom; // and placed, the inner levels' where they fit this room (PlaceLevelStarts); 0: not placed
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
@@ -571,12 +572,29 @@ void CountLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys
 }
 
 // Every level's run starts, as counted: the leaves' first points in
-// lists.list[depth], each inner level's first children in lists.list[l].
+// `leafStarts` (n + 1 entries), the inner levels' first children end to
+// end in scratch.levelStarts, level l's from levelBegin[l] + l on, where
+// they fit the room it has (NestedLists); returns that room.
 template <class Device, typename Key>
-void PlaceLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth, int shift,
-  const NestedLists& lists)
+std::size_t PlaceLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth,
+  int shift, std::uint32_t* leafStarts)
 {
-  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally, lists);
+  NestedLists out;
+  out.count = depth + 1;
+  out.last = leafStarts;
+  out.packed = scratch.levelStarts.Get();
+  out.packedRoom = scratch.levelStarts.Bytes() / sizeof(std::uint32_t);
+  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally, out);
+  return out.packedRoom;
+}
+
+// Whether the level lists' entries of n points at `depth`, at most n a
+// level, can be numbered in 32 bits before the host has checked the node
+// count (SetLevelBegins): where they can, the lists are placed while the
+// host reads the level sizes.
+inline bool LevelListsFitWord(std::size_t n, int depth)
+{
+  return n <= kInvalidIndex / static_cast<std::size_t>(depth + 1);
 }
 
 // Queues the sort of the state's points by their keys at `sortDepth`
@@ -638,6 +656,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
   sorted.counted = !chooseDepth;
+  sorted.placedRoom = 0;
   WithKeyWords(sorted.keys, [&](const auto* keys) {
     if (chooseDepth)
     {
@@ -646,6 +665,10 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
     else
     {
       CountLevelStarts(d, scratch, keys, n, sortDepth, 0, counters + kCounterHistogram);
+      if (LevelListsFitWord(n, sortDepth))
+      {
+        sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
+      }
     }
   });
   marks[2] = clock.Mark();
@@ -731,22 +754,27 @@ inline void SetLevelBegins(const std::uint64_t newNode[kDepthHistogramBins], int
   }
 }
 
-// Where PlaceLevelStarts writes each level's run starts: the leaves' in the
-// array the sort left free, the inner levels' one after another in
-// scratch.levelStarts, each with one entry more than the level has nodes.
+// Each level's run starts (PlaceLevelStarts): the leaves' in the array the
+// sort left free, the inner levels' in scratch.levelStarts. Placed with the
+// sort where the room they had was enough, else here.
 template <class Device>
-NestedLists ReserveLevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeState<Device>& s,
-  std::uint32_t* spare)
+NestedLists LevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeState<Device>& s,
+  const SortedPoints& sorted)
 {
   const int depth = s.depth;
-  d.Reserve(scratch.levelStarts, s.levelBegin[depth] + depth, "level starts");
+  const std::size_t innerEntries = s.levelBegin[depth] + static_cast<std::size_t>(depth);
+  if (innerEntries > sorted.placedRoom)
+  {
+    d.Reserve(scratch.levelStarts, innerEntries, "level starts");
+    WithKeyWords(sorted.keys, [&](const auto* words) {
+      PlaceLevelStarts(d, scratch, words, s.count, depth, sorted.keys.keyShift, sorted.spare);
+    });
+  }
   NestedLists lists;
   lists.count = depth + 1;
-  for (int l = 0; l < depth; ++l)
-  {
-    lists.list[l] = scratch.levelStarts.Get() + s.levelBegin[l] + l;
-  }
-  lists.list[depth] = spare;
+  lists.last = sorted.spare;
+  lists.packed = scratch.levelStarts.Get();
+  lists.packedRoom = innerEntries;
   return lists;
 }
 
@@ -788,14 +816,11 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   {
     d.FillBytes(s.nodes.childMasks.Get() + (nodes - 1) / 8, 1, 0);
   }
-  const NestedLists starts = ReserveLevelStarts(d, scratch, s, sorted.spare);
-  WithKeyWords(keys, [&](const auto* words) {
-    PlaceLevelStarts(d, scratch, words, s.count, depth, keys.keyShift, starts);
-  });
+  const NestedLists starts = LevelStarts(d, scratch, s, sorted);
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
   const std::uint32_t leafBegin = view.levelBegin[depth];
-  const std::uint32_t* leafStarts = starts.list[depth];
+  const std::uint32_t* leafStarts = starts.last;
   d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
     ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), leafStarts[j], leafStarts[j + 1]);
   });
@@ -805,7 +830,7 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   int l = depth - 1;
   for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
   {
-    const std::uint32_t* children = starts.list[l];
+    const std::uint32_t* children = starts.List(l, s.levelBegin[l]);
     d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
       levels.Reduce(l, static_cast<std::uint32_t>(j), children[j], children[j + 1]);
     });
