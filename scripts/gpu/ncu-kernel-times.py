@@ -13,12 +13,13 @@ With --launches, every launch of that last run in order instead, in
 microseconds (the level phase's selects and loops, level by level). With
 --steps, the last run's launches summed by the build's steps, in the order
 the build queues them: the positions' bounds (during the upload), the keys,
-the records, the sort, the histogram of neighbouring keys, then each level
-from the leaves (level 10, the depth of --profile-build) up (a CUB select
-and a loop each; a level's select begins with its DeviceCompactInitKernel),
-the levels near the root in one launch (SmallLevelsKernel), and the device
-phases' sum (keys, sort, histogram, levels: what the benchmark's phases
-time, but the records).
+the records, the sort, the levels' run starts counted with their sizes and
+placed (before cd56a2a: the histogram of neighbouring keys), then each level
+from the leaves (level 10, the depth of --profile-build) up (a loop each;
+before cd56a2a a CUB select and a loop, the select beginning with its
+DeviceCompactInitKernel), the levels near the root in one launch
+(SmallLevelsKernel), and the device phases' sum (keys, sort, level sizes,
+levels: what the benchmark's phases time, but the records).
 """
 import re
 import sys
@@ -68,10 +69,13 @@ def short_names(full_names):
 # lambda of QueueSort, as the keys' is).
 STEPS = (("positions' bounds (in the upload)", ("ReduceRangeKernel", "reduce::DeviceReduce")),
          ("histogram of neighbouring keys", ("cuda::HistogramKernel",)),
+         ("levels' run starts counted, their sizes", ("NestedCountKernel", "scan::DeviceScan")),
+         ("levels' run starts placed", ("NestedPlaceKernel",)),
          ("records", ("IngestAttributes",)),
          ("sort (CUB)", ("DeviceRadixSort",)),
          ("keys", ("QueueSort",)))
-PHASES = ("keys", "sort (CUB)", "histogram of neighbouring keys")
+PHASES = ("keys", "sort (CUB)", "histogram of neighbouring keys", "levels' run starts counted, their sizes",
+          "levels' run starts placed")
 PROFILE_BUILD_DEPTH = 10  # octoray_bench_cuda --profile-build's
 SMALL_LEVELS = "levels near the root (one launch)"
 
@@ -79,16 +83,19 @@ SMALL_LEVELS = "levels near the root (one launch)"
 def steps(last):
     """(step, launches, ms, GB or None) for the run's launches, in order;
     the levels from the leaves (the depth) up to the root (level 0), each
-    from its select's init kernel."""
-    table, selects = {}, 0
+    from its select's init kernel where it has a select (builds before
+    cd56a2a), else its loop."""
+    table, levels, selected = {}, 0, False
     for full, ms, gb in last:
-        if "DeviceCompactInitKernel" in full:
-            selects += 1
         step = next((name for name, keys in STEPS if any(k in full for k in keys)), None)
+        if "DeviceCompactInitKernel" in full:
+            levels, selected = levels + 1, True
+        elif "LinkLevels" in full:
+            levels, selected = levels + (0 if selected else 1), False
         if "SmallLevelsKernel" in full:
             step = SMALL_LEVELS
-        elif step is None or selects:
-            step = -selects  # a level, counted from the leaves; named below
+        elif step is None or selected:
+            step = -levels  # a level, counted from the leaves; named below
         count, total, traffic = table.get(step, (0, 0.0, 0.0))
         table[step] = (count + 1, total + ms, None if gb is None or traffic is None else traffic + gb)
 
@@ -108,7 +115,7 @@ def print_steps(path, builds, last):
             phases += ms
         dram = f"  {gb:6.3f} GB {gb / ms:5.2f} TB/s" if gb is not None and ms > 0 else ""
         print(f"  {1000 * ms:8.1f} us  {count:3d}x{dram}  {step}")
-    print(f"  {1000 * phases:8.1f} us        device phases (keys, sort, histogram, levels)")
+    print(f"  {1000 * phases:8.1f} us        device phases (keys, sort, level sizes, levels)")
 
 
 def main():
