@@ -155,6 +155,8 @@ public:
   {
     std::copy_n(data, n, host);
   }
+  void QueueToHost(const std::uint64_t* data, std::size_t n, const char*) { Queued.assign(data, data + n); }
+  void WaitToHost(std::uint64_t* host, const char*) { std::copy(Queued.begin(), Queued.end(), host); }
   template <typename T>
   void FillBytes(T* data, std::size_t n, unsigned char byte)
   {
@@ -391,5 +393,6 @@ private:
   }
 
   std::tuple<HostBuffer<std::uint32_t>, HostBuffer<std::uint64_t>> Scratch;
+  std::vector<std::uint64_t> Queued; // QueueToHost's words
 };
 }

@@ -313,6 +313,47 @@ __global__ void ReduceRangeKernel(const T* data, std::size_t begin, std::size_t 
   }
 }
 
+// A page-locked host buffer of a few 64-bit words and an event: a copy from
+// the device that returns at once and is waited for later
+// (CudaDevice::QueueToHost), so that the host can queue more work first.
+class QueuedRead
+{
+public:
+  static constexpr std::size_t kWords = 64;
+  QueuedRead() = default;
+  QueuedRead(const QueuedRead&) = delete;
+  QueuedRead& operator=(const QueuedRead&) = delete;
+  ~QueuedRead()
+  {
+    if (Done)
+    {
+      cudaEventDestroy(Done);
+      cudaFreeHost(Words);
+    }
+  }
+  void Queue(const std::uint64_t* data, std::size_t n, const char* what)
+  {
+    if (!Done)
+    {
+      CudaCheck(cudaMallocHost(&Words, kWords * sizeof(std::uint64_t)), "cudaMallocHost");
+      CudaCheck(cudaEventCreateWithFlags(&Done, cudaEventDisableTiming), "cudaEventCreate");
+    }
+    CudaCheck(cudaMemcpyAsync(Words, data, n * sizeof(std::uint64_t), cudaMemcpyDeviceToHost, 0), what);
+    CudaCheck(cudaEventRecord(Done, 0), what);
+    Count = n;
+  }
+  void Wait(std::uint64_t* host, const char* what)
+  {
+    CudaCheck(cudaEventSynchronize(Done), what);
+    std::copy_n(Words, Count, host);
+  }
+
+private:
+  std::uint64_t* Words = nullptr;
+  cudaEvent_t Done = nullptr;
+  std::size_t Count = 0;
+};
+
 // Reads the partial results of ReduceRangeKernel for the final reduction.
 template <typename R>
 struct PartialResult
@@ -499,6 +540,17 @@ public:
       CudaCheck(cudaMemcpy(host, data, n * sizeof(T), cudaMemcpyDeviceToHost), what);
     }
   }
+  // A copy to the host that waits for the device only in
+  // WaitToHost: the host can queue more work meanwhile.
+  void QueueToHost(const std::uint64_t* data, std::size_t n, const char* what)
+  {
+    if (n > cuda::QueuedRead::kWords)
+    {
+      throw Error(std::string("octoray: ") + what + ": more words than a queued read holds");
+    }
+    Read.Queue(data, n, what);
+  }
+  void WaitToHost(std::uint64_t* host, const char* what) { Read.Wait(host, what); }
   template <typename T>
   void FillBytes(T* data, std::size_t n, unsigned char byte)
   {
@@ -654,5 +706,6 @@ private:
   // Page-locked host buffers through which large pageable arrays go
   // (CudaUpload.h); not in the memory report, which counts device bytes.
   cuda::HostStaging Staging;
+  cuda::QueuedRead Read;
 };
 }

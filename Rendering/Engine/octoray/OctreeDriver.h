@@ -665,25 +665,33 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
     else
     {
       CountLevelStarts(d, scratch, keys, n, sortDepth, 0, counters + kCounterHistogram);
-      if (LevelListsFitWord(n, sortDepth))
-      {
-        sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
-      }
     }
   });
+  // The histograms and the key check on their way to the host (ReadHistogram).
+  static_assert(kCounterFirst == kCounterHistogram + 2 * kDepthHistogramBins, "one copy: histograms, key check");
+  d.QueueToHost(counters + kCounterHistogram, 2 * kDepthHistogramBins + 1, "the level sizes");
+  // Meanwhile the device places the levels' run starts where the room the
+  // last build left holds them. Placed after the host had read the level
+  // sizes, at 10 M points they waited 0.04 ms for it, at 100 M 0.5 ms, while
+  // the host reserved the node arrays (Benchmarks/gpu/variants-nested-levels.txt).
+  if (!chooseDepth && LevelListsFitWord(n, sortDepth))
+  {
+    WithKeyWords(sorted.keys, [&](const auto* keys) {
+      sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
+    });
+  }
   marks[2] = clock.Mark();
   return sorted;
 }
 
-// The histogram of a queued sort, and the key check of its keys: one copy
-// to the host. A point outside the cube is an error naming it.
+// The histogram of a queued sort, and the key check of its keys, as
+// QueueSort sent them to the host. A point outside the cube is an error
+// naming it.
 template <class Device>
-void ReadHistogram(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, SortedPoints& sorted)
+void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
 {
-  static_assert(kCounterFirst == kCounterHistogram + 2 * kDepthHistogramBins, "one copy: histograms, key check");
   std::uint64_t report[2 * kDepthHistogramBins + 1];
-  d.ToHost(scratch.counters.Get() + kCounterHistogram, 2 * kDepthHistogramBins + 1, report,
-    "NeighbourHistogramKernel");
+  d.WaitToHost(report, "the level sizes");
   if (report[2 * kDepthHistogramBins] != kNoIndex)
   {
     const std::size_t outside = report[2 * kDepthHistogramBins];
@@ -715,7 +723,7 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
   const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
   const bool chooseDepth = requestedDepth == 0;
   SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, chooseDepth, outside, clock, phases + 1, beforeSort);
-  ReadHistogram(d, scratch, s, sorted);
+  ReadHistogram(d, s, sorted);
   if (chooseDepth)
   {
     int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
@@ -723,7 +731,7 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     {
       phases[4] = clock.Mark();
       sorted = QueueSort(d, scratch, s, cube, kMaxLevel, true, outside, clock, phases + 5, nullptr);
-      ReadHistogram(d, scratch, s, sorted);
+      ReadHistogram(d, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }
     // The leaf keys: the sorted keys (at sorted.depth) without their bits below the depth.
