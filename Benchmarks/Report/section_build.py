@@ -205,12 +205,15 @@ def _steps_at_10m(ctx):
     table = "\n".join(lines[1:])
     us = dict(steps)
     # "levels near the root (one launch)" since 9c054dd: ncu-kernel-times.py's SMALL_LEVELS.
-    levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level"))]
+    levels = [(name, t) for name, t in steps if name.startswith(("leaves", "level ", "levels near"))]
     big, small = levels[:3], levels[3:]
     level_us = sum(t for _, t in levels)
     apart = [name for name, _ in small if name.startswith("level ")]
-    launches = ("%d levels of three launches each, a CUB select, its init and the loop" % len(apart) +
+    launches = ("%d levels of one launch each" % len(apart) +
                 (", the rest in one launch" if len(apart) < len(small) else ""))
+    # The steps before the levels: the level sizes counted (the histogram before cd56a2a) and the
+    # levels' run starts placed (ncu-kernel-times.py's STEPS).
+    runs_us = sum(t for name, t in steps if name.startswith(("levels' run starts", "histogram")))
     return [
         "At 10 M points, where the device phases are furthest from the sort, Nsight Compute times each kernel of "
         "the second of two builds, summed here by step (gpu-check.sh's profile-build part, "
@@ -222,12 +225,13 @@ def _steps_at_10m(ctx):
         table,
         "```",
         "",
-        "The levels take %.0f µs of the phases' %.0f, more than the sort's %.0f: the leaves and the two levels "
-        "above them %.0f µs, the levels nearer the root %.0f µs: %s. Within twice the sort, the keys, the "
-        "histogram and the levels together would have to take no longer than the sort (here %.0f µs)." % (
-            level_us, us.get("device phases (keys, sort, histogram, levels)", float("nan")),
+        "The levels' run starts, counted with the level sizes and placed, take %.0f µs, and the levels' loops "
+        "%.0f µs of the phases' %.0f, against the sort's %.0f: the leaves and the two levels above them %.0f µs, "
+        "the levels nearer the root %.0f µs: %s. Within twice the sort, the keys, the run starts and the levels "
+        "together would have to take no longer than the sort (here %.0f µs)." % (
+            runs_us, level_us, us.get("device phases (keys, sort, level sizes, levels)", float("nan")),
             us.get("sort (CUB)", float("nan")), sum(t for _, t in big), sum(t for _, t in small), launches,
-            us.get("keys", 0) + us.get("histogram of neighbouring keys", 0) + level_us),
+            us.get("keys", 0) + runs_us + level_us),
         "",
     ]
 
@@ -479,9 +483,24 @@ def _cuda(ctx):
         "",
         "The engine's sort runs at its floor. What separates the whole call from it is the upload of the points "
         "from pageable memory (most of it at 10 M and more); what separates the device phases from it are the "
-        "keys, the histogram of neighbouring keys and the levels: one kernel for the "
-        "leaves and one CUB select plus one kernel per level above them (Benchmarks/gpu/profile-build.txt lists "
-        "them for 100 M points). The level phase also waited for the host, which reserved the node arrays before "
+        "keys, the levels' run starts and the levels: one loop for the leaves and one per level above them "
+        "(Benchmarks/gpu/profile-build.txt lists their kernels for 100 M points). Every level's run starts come "
+        "from one pass over the sorted points since cd56a2a: a point starts a node at every level from the first "
+        "its key does not share with the previous key (DepthChoice.h's FirstNewLevels), so one pass counts each "
+        "warp tile's points in each level's list, and the level sizes with them, in place of the histogram of "
+        "neighbouring keys at a requested depth; a scan gives each tile its places, and a second pass places them, "
+        "the leaves' list first (Device::CountNested and PlaceNested, CudaDevice.h's NestedCountKernel and "
+        "NestedPlaceKernel). Each level above the leaves then takes one loop, where a CUB select and a loop took "
+        "three launches. Since 2dddea0 the placement runs while the host reads the level sizes and reserves the "
+        "node arrays (a queued copy, Device::QueueToHost), in the room the last build left for the inner levels' "
+        "lists; placed after that, it had waited 0.04 ms for the host at 10 M points and 0.5 ms at 100 M. Built "
+        "beside 18cba2c's engine and run in turn, the device phases at 10 M points took 1.126–1.129 ms against "
+        "1.200 (1.98–2.01 times the sort against 2.11), at 1 M 0.257–0.268 against 0.329, and at 100 M 7.66–8.14 "
+        "against 7.68, the level phase there still waiting for the host's reservations in some builds; in ncu at "
+        "10 M points the count, the scan and the placement took 48 and 72 µs, the levels' loops 390, where the "
+        "histogram took 29 µs and the levels with their selects 549 (Benchmarks/gpu/variants-nested-levels.txt). "
+        "The placement's pass runs at 1.1 TB/s, the count's at 0.9: each round of 32 points visits the lists "
+        "from the shallowest that any of them starts, a ballot each. The level phase also waited for the host, which reserved the node arrays before "
         "it queued the phase's first kernel: 0.2–0.3 ms at 10 M points while the engine's memory pool grew, over "
         "the first four builds of a size. Since 2330cb0 the leaves' select runs on the device meanwhile. Since "
         "7ad2508 the benchmark times its builds once the pool has settled. In three rounds of it, the level phase "
@@ -508,8 +527,9 @@ def _cuda(ctx):
         "The levels' selects "
         "are CUB's DeviceSelect::If, its predicate reading two keys; on the same sorted keys DeviceSelect::"
         "UniqueByKey took 1.45–1.76 times as long, and a select of tiles with a decoupled look-back written for "
-        "them 1.06–2.89 times (Benchmarks/gpu/variants-run-starts-select.txt). Every level's run starts from one pass over the sorted points instead (a "
-        "count pass, a scan and a placing pass; Benchmarks/gpu/variants-nested.txt, not kept) took 0.07–0.09 ms "
+        "them 1.06–2.89 times (Benchmarks/gpu/variants-run-starts-select.txt). The thirteenth session's first try of every level's run starts from one pass over the sorted points (a "
+        "count pass, a scan and a placing pass after the histogram and the host's reservations; "
+        "Benchmarks/gpu/variants-nested.txt, not kept) took 0.07–0.09 ms "
         "off the level phase at 10 M points and added 0.4–0.9 ms at 100 M, its two passes running at 0.8–1.3 TB/s "
         "against 1.4–1.8 for the selects. CUB's sort with 10-bit digits, three passes over the 30-bit keys "
         "instead of four, took 6.51 ms at 100 M points against 4.21 (Benchmarks/gpu/variants-wide-digits.txt, not "

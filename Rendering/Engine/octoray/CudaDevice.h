@@ -597,9 +597,10 @@ public:
     std::size_t scanBytes = 0;
     CudaCheck(cub::DeviceScan::ExclusiveSum(nullptr, scanBytes, none, none, entries), "cub::DeviceScan");
     Reserve(tally, 2 * entries, "nested lists");
+    std::uint32_t* tileCounts = tally.Get();
     Launch(name, cuda::NestedCountKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, lists, tiles,
-      firstList, tally.Get(), reinterpret_cast<unsigned long long*>(counts));
-    CudaCheck(cub::DeviceScan::ExclusiveSum(Temporary(scanBytes), scanBytes, tally.Get(), tally.Get() + entries, entries),
+      firstList, tileCounts, reinterpret_cast<unsigned long long*>(counts));
+    CudaCheck(cub::DeviceScan::ExclusiveSum(Temporary(scanBytes), scanBytes, tileCounts, tileCounts + entries, entries),
       "cub::DeviceScan");
   }
 
