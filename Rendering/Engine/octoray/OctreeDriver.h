@@ -14,6 +14,8 @@
 //   Prepare(host, n, what, fills)     room for another caller's array, whose copy it adds to fills (CUDA)
 //   Adopt(staged, buffer, n)          a staged array becomes the buffer's content (copied, or taken over)
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
+//   QueueToHost(data, n, what), WaitToHost(host, what)   a copy of n 64-bit words to the host that the host
+//                                     waits for only in WaitToHost, queuing more work meanwhile
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
 //   Reduce(n, identity, map, combine) combine over every map(i), returned to the host
 //   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
@@ -23,8 +25,9 @@
 //                                     counts[f] += the items of first list f, and `tally` (a 32-bit buffer)
 //                                     what PlaceNested needs
 //   PlaceNested(name, n, firstList, tally, out)   those lists, in order, into the NestedLists `out`: the last
-//                                     holds the items, list l < lists - 1 each item's place in list l + 1,
-//                                     and after its items each list the size of the next (the last: n)
+//                                     holds the items, list l < lists - 1 each item's place in list l + 1
+//                                     (written only where out's room holds them), and after its items each
+//                                     list the size of the next (the last: n)
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
 //   SortPairsFrom(keys[2], valuesIn, valuesOut, n, bits, what)   the same, the values read from valuesIn (left as
