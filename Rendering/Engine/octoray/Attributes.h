@@ -24,9 +24,9 @@ namespace octoray
 //               32 bits
 //   keyHigh     its high 32 bits, in octrees deeper than 10 levels alone:
 //               above, keys of 64 bits took 8 bytes a node where the keys of
-//               every level fit 4, and the level phase, which writes each
-//               node's key once and reads it twice (a select, the parent's
-//               loop), took 20 % longer at 100 M points
+//               every level fit 4, and the level phase, which then wrote
+//               each node's key once and read it twice (a select, the
+//               parent's loop), took 20 % longer at 100 M points
 //               (Benchmarks/gpu/variants-node-keys.txt)
 //   childMasks  each node's child mask (bit o set: the child in octant o
 //               exists), eight nodes' to a word: node n's is byte n % 8 of

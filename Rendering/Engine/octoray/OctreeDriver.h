@@ -606,8 +606,9 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 // given, runs on the host between the keys and the sort; the points'
 // records must exist after it. chooseDepth: the histograms the automatic
 // depth reads, else the levels' run starts counted (CountLevelStarts),
-// their sizes in the histogram. Marks on `clock`: marks[0]
-// after the keys, marks[1] before the sort, marks[2] after the histogram.
+// their sizes in the histogram, and placed where they fit. Marks on
+// `clock`: marks[0] after the keys, marks[1] before the sort, marks[2]
+// after the histograms or the run starts.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
   int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[3],
