@@ -248,14 +248,17 @@ public:
       }
     }
     const std::uint32_t* size = next.data() + static_cast<std::size_t>(chunks) * lists;
-    std::uint32_t* list[NestedLists::kMaxLists];
-    std::size_t itemsBefore = 0;
-    for (int l = 0; l < lists; ++l)
+    std::size_t itemsBefore[NestedLists::kMaxLists] = {};
+    for (int l = 1; l < lists; ++l)
     {
-      list[l] = out.List(l, itemsBefore);
-      itemsBefore += size[l];
+      itemsBefore[l] = itemsBefore[l - 1] + size[l - 1];
     }
-    const int lowest = out.PackedFit(itemsBefore - size[lists - 1]) ? 0 : lists - 1;
+    const int lowest = out.PackedFit(itemsBefore[lists - 1]) ? 0 : lists - 1;
+    std::uint32_t* list[NestedLists::kMaxLists] = {}; // those written
+    for (int l = lowest; l < lists; ++l)
+    {
+      list[l] = out.List(l, itemsBefore[l]);
+    }
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::uint32_t* place = next.data() + static_cast<std::size_t>(c) * lists;
       for (std::size_t i = begin; i < end; ++i)

@@ -190,11 +190,11 @@ __global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList fi
   const int lane = threadIdx.x & 31u;
   const int lowest = out.PackedFit(firstPlace[(lists - 1) * tiles]) ? 0 : lists - 1;
   std::uint32_t next = 0; // lane l: the tile's next place in list l
-  std::uint32_t* list = nullptr; // lane l: list l
+  std::uint32_t* list = nullptr; // lane l: list l, where it is written
   if (lane < lists)
   {
     const std::uint32_t itemsBefore = firstPlace[lane * tiles];
-    list = out.List(lane, itemsBefore);
+    list = lane >= lowest ? out.List(lane, itemsBefore) : nullptr;
     next = firstPlace[lane * tiles + tile] - itemsBefore;
     if (tile == 0 && lane >= lowest) // after its items, each list records the next one's size
     {
