@@ -75,8 +75,8 @@ __global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int t
 // 32 items: each warp tile counts its items in each list
 // (NestedCountKernel), one scan over those counts, list after list, gives
 // each warp tile its first place in each list, and each warp tile places
-// its items (NestedPlaceKernel). Lane l keeps list l's count or place, so
-// that a round's items go to a list by one ballot. A round visits the lists
+// its items (NestedPlaceKernel). Lane l keeps list l's count or place; a
+// round's items go to a list by one ballot, and a round visits the lists
 // from the first of any of its items on: in sorted points, the few levels
 // nearest the leaves.
 constexpr int kNestedItemsPerLane = 16;
@@ -123,10 +123,49 @@ __device__ inline std::size_t LoadFirstLists(std::size_t n, int lists, FirstList
   return tile;
 }
 
+// The sum of the warp's values (as WarpMin).
+__device__ inline unsigned WarpSum(unsigned value)
+{
+#if __CUDA_ARCH__ >= 800
+  return __reduce_add_sync(0xFFFFFFFFu, value);
+#else
+  for (int offset = 16; offset > 0; offset /= 2)
+  {
+    value += __shfl_xor_sync(0xFFFFFFFFu, value, offset);
+  }
+  return value;
+#endif
+}
+
+// A lane's items counted by their first list, in 5-bit fields of two
+// 64-bit words: lists 0 to 11 in the first, 12 on in the second (the
+// first list `lists`, none, lands in a field that nobody reads). A lane
+// adds a field per item where a ballot a list and a round took one vote
+// for each list from the round's first on.
+struct FirstListFields
+{
+  static constexpr int kBits = 5;
+  static constexpr int kPerWord = 12;
+  unsigned long long word[2] = { 0, 0 };
+
+  __device__ void Add(int first)
+  {
+    const bool high = first >= kPerWord;
+    const unsigned long long one = 1ull << (kBits * (high ? first - kPerWord : first));
+    word[0] += high ? 0 : one;
+    word[1] += high ? one : 0;
+  }
+  // Of list f, where f is known when compiled (the loop is unrolled).
+  __device__ unsigned Of(int f) const { return (word[f / kPerWord] >> (kBits * (f % kPerWord))) & 31u; }
+};
+static_assert(kNestedItemsPerLane < 32, "a lane's count of one list fits FirstListFields' 5 bits");
+static_assert(NestedLists::kMaxLists < 2 * FirstListFields::kPerWord, "every first list, none too, has a field");
+
 // counts[l * tiles + tile]: warp tile `tile`'s items in list l (those of
 // first list l and less); then one 0, so that the scan's last entry is the
 // size of every list together. histogram[f] += the items of first list f,
-// added up in the block first.
+// added up in the block first. The warp adds its lanes' fields up two
+// lists at a time, in 16-bit halves (512 items a tile at most).
 template <typename FirstList>
 __global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, FirstList firstList,
   std::uint32_t* counts, unsigned long long* histogram)
@@ -140,21 +179,32 @@ __global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, F
   int first[kNestedItemsPerLane];
   const std::size_t tile = LoadFirstLists(n, lists, firstList, first);
   const int lane = threadIdx.x & 31u;
-  std::uint32_t mine = 0; // lane l: list l's
+  FirstListFields fields;
 #pragma unroll
   for (int r = 0; r < kNestedItemsPerLane; ++r)
   {
-    for (int l = WarpMin(first[r]); l < lists; ++l)
-    {
-      const unsigned in = __ballot_sync(0xFFFFFFFFu, first[r] <= l);
-      mine += lane == l ? __popc(in) : 0;
-    }
+    fields.Add(first[r]);
   }
-  const std::uint32_t before = __shfl_up_sync(0xFFFFFFFFu, mine, 1); // list l - 1's
+  std::uint32_t ofFirstList = 0; // lane l: the tile's items of first list l
+#pragma unroll
+  for (int pair = 0; pair < NestedLists::kMaxLists / 2; ++pair)
+  {
+    if (2 * pair >= lists)
+    {
+      break;
+    }
+    const unsigned both = WarpSum(fields.Of(2 * pair) | fields.Of(2 * pair + 1) << 16);
+    ofFirstList = lane / 2 == pair ? (lane & 1 ? both >> 16 : both & 0xFFFFu) : ofFirstList;
+  }
+  std::uint32_t mine = ofFirstList; // lane l: list l's, the items of first list l and less
+  for (int offset = 1; offset < 32; offset *= 2)
+  {
+    const std::uint32_t below = __shfl_up_sync(0xFFFFFFFFu, mine, offset);
+    mine += lane >= offset ? below : 0;
+  }
   if (tile < tiles && lane < lists)
   {
     counts[lane * tiles + tile] = mine;
-    const std::uint32_t ofFirstList = lane > 0 ? mine - before : mine;
     if (ofFirstList)
     {
       atomicAdd(&blockCount[lane], ofFirstList);
