@@ -29,7 +29,8 @@
 # report's engine programs), orbit (the mapper against VTK's GPU mappers;
 # ORBIT_ARGS adds arguments), profile-build (ncu's time of every kernel of a
 # build of PROFILE_BUILD points, default 1e8, and by step of a build of 10 M
-# points), sass (the primary-ray render
+# points), profile-nested (Nsight Compute's details of the nested lists'
+# count and placement in the second of two builds of 10 M points), sass (the primary-ray render
 # kernel's machine code, from cuobjdump).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Benchmarks/gpu/).
@@ -131,6 +132,13 @@ if want profile-build; then
   done
   python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build.csv" 2 > "$out/profile-build.txt" 2>&1
   python3 scripts/gpu/ncu-kernel-times.py "$out/profile-build-10m.csv" 2 --steps > "$out/profile-build-10m.txt" 2>&1
+fi
+if want profile-nested; then
+  # The two passes over the sorted points that give every level's run
+  # starts, below the memory's speed (profile-build-10m.txt): what stalls them.
+  step profile-nested scripts/gpu/ncu-details.sh 'Nested(Count|Place)Kernel' 2 2 "$out/profile-nested.csv" \
+    $build/bin/octoray_bench_cuda --profile-build 1e7
+  python3 scripts/gpu/ncu-summary.py "$out/profile-nested.csv" > "$out/profile-nested.txt" 2>&1
 fi
 if want sass; then
   # The render kernel's machine code (primary rays), to count what one
