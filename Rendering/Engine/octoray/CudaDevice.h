@@ -78,8 +78,13 @@ __global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int t
 // its items (NestedPlaceKernel). Lane l keeps list l's count or place; a
 // round's items go to a list by one ballot, and a round visits the lists
 // from the first of any of its items on: in sorted points, the few levels
-// nearest the leaves.
-constexpr int kNestedItemsPerLane = 16;
+// nearest the leaves. The placement, at 48 registers, waits mostly on its
+// loads (ncu's long-scoreboard stalls); tiles of 8 rounds, twice as many
+// warps, took it from 72.8 to 56.5 us at 10 M points and from 536 to 389
+// at 100 M on an H100, where 16 rounds were and 32 were slower; the count's
+// scan, twice as long, cost 28 us at 100 M
+// (Benchmarks/gpu/variants-nested-tiles.txt).
+constexpr int kNestedItemsPerLane = 8;
 constexpr std::size_t kNestedWarpTile = 32 * std::size_t(kNestedItemsPerLane);
 static_assert(NestedLists::kMaxLists <= 32, "a warp's lane l holds list l's count");
 static_assert(kBlock % 32 == 0, "whole warps a block");
@@ -159,13 +164,14 @@ struct FirstListFields
   __device__ unsigned Of(int f) const { return (word[f / kPerWord] >> (kBits * (f % kPerWord))) & 31u; }
 };
 static_assert(kNestedItemsPerLane < 32, "a lane's count of one list fits FirstListFields' 5 bits");
+static_assert(kNestedWarpTile < (1u << 16), "a tile's count of one list fits a 16-bit half");
 static_assert(NestedLists::kMaxLists < 2 * FirstListFields::kPerWord, "every first list, none too, has a field");
 
 // counts[l * tiles + tile]: warp tile `tile`'s items in list l (those of
 // first list l and less); then one 0, so that the scan's last entry is the
 // size of every list together. histogram[f] += the items of first list f,
 // added up in the block first. The warp adds its lanes' fields up two
-// lists at a time, in 16-bit halves (512 items a tile at most).
+// lists at a time, in 16-bit halves (kNestedWarpTile items a tile at most).
 template <typename FirstList>
 __global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, FirstList firstList,
   std::uint32_t* counts, unsigned long long* histogram)
