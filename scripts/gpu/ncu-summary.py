@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A short table from Nsight Compute's CSV details pages (ncu --csv --page
-details): per profiled kernel, its time, memory and compute throughput,
+details): per profiled launch, its time, memory and compute throughput,
 cache hit rates, occupancy, registers and the top stall reasons (warp cycles
 per issued instruction spent in each). Used by gpu-check.sh's profile part
 and variants-check.sh's render section (ncu-render.sh makes the CSV).
@@ -51,6 +51,14 @@ def summarise(path):
     if not table:
         print(f"{path}: no kernel profiled")
         return
+    launches = {}  # each profiled launch's rows, by its ID, in order
+    for r in table:
+        launches.setdefault(r["ID"], []).append(r)
+    for launch in launches.values():
+        summarise_launch(path, launch)
+
+
+def summarise_launch(path, table):
     kernel = table[0]["Kernel Name"]
     values = {r["Metric Name"]: (r["Metric Value"], r["Metric Unit"]) for r in table}
     print(f"{path.rsplit('/', 1)[-1]}: {kernel[:100]}")
