@@ -79,11 +79,11 @@ __global__ void __launch_bounds__(kSmallLevelThreads, 1) SmallLevelsKernel(int t
 // round's items go to a list by one ballot, and a round visits the lists
 // from the first of any of its items on: in sorted points, the few levels
 // nearest the leaves. The placement, at 48 registers, waits mostly on its
-// loads (ncu's long-scoreboard stalls); tiles of 8 rounds, twice as many
-// warps, took it from 72.8 to 56.5 us at 10 M points and from 536 to 389
-// at 100 M on an H100, where 16 rounds were and 32 were slower; the count's
-// scan, twice as long, cost 28 us at 100 M
-// (Benchmarks/gpu/variants-nested-tiles.txt).
+// loads (ncu's long-scoreboard stalls). Tiles of 8 rounds, twice as many
+// warps as 16 rounds make, took it from 72.8 to 56.5 us at 10 M points and
+// from 536 to 389 at 100 M on an H100, and the count's scan of twice as
+// many tiles 28 us longer at 100 M (Benchmarks/gpu/variants-nested-tiles.txt);
+// 32 rounds were slower than 16 (variants-nested-levels.txt).
 constexpr int kNestedItemsPerLane = 8;
 constexpr std::size_t kNestedWarpTile = 32 * std::size_t(kNestedItemsPerLane);
 static_assert(NestedLists::kMaxLists <= 32, "a warp's lane l holds list l's count");
