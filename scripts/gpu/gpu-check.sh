@@ -30,8 +30,8 @@
 # ORBIT_ARGS adds arguments), profile-build (ncu's time of every kernel of a
 # build of PROFILE_BUILD points, default 1e8, and by step of a build of 10 M
 # points), profile-nested (Nsight Compute's details of the nested lists'
-# count and placement in the second of two builds of 10 M points), sass (the primary-ray render
-# kernel's machine code, from cuobjdump).
+# count and placement in the second of two builds of 10 M points), sass
+# (the primary-ray render kernel's machine code, from cuobjdump).
 # Logs and files go to OUTDIR; OUTDIR/report-files.tgz holds what `make
 # report` reads (unpack it into Benchmarks/gpu/).
 set -uo pipefail
