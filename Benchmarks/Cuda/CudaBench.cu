@@ -297,8 +297,7 @@ public:
     Threads.Run(octoray::cuda::StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int stripe) {
       octoray::cuda::ForEachPiece(run, octoray::cuda::StripeBytes(first, last, run.Length()),
         [&](std::size_t array, std::size_t offset, std::size_t n, int b) {
-          octoray::cuda::CopyToStaging(
-            Buffers[2 * stripe + b], static_cast<const char*>(arrays[array].data) + offset, n);
+          std::memcpy(Buffers[2 * stripe + b], static_cast<const char*>(arrays[array].data) + offset, n);
         });
     });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <numeric>
 #include <random>
 #include <thread>
@@ -209,42 +208,6 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
       }
     }
   }
-}
-
-// CopyToStaging copies every byte of any length from any alignment into any
-// alignment of the buffer (its non-temporal stores need 16-byte aligned
-// destinations, so it copies a head and a tail apart), and nothing past
-// the `n` bytes: a buffer of random bytes, copied at every pair of
-// alignments mod 16 with lengths around the 16- and 64-byte steps, against
-// the same copy by std::memcpy.
-TEST(StagingPieces, CopyToStagingCopiesEveryByteAndNoMore)
-{
-  using namespace octoray::cuda;
-  std::mt19937 rng(11);
-  std::vector<unsigned char> source(4096 + 64);
-  for (unsigned char& byte : source)
-  {
-    byte = static_cast<unsigned char>(rng());
-  }
-  const std::size_t lengths[] = { 0, 1, 15, 16, 17, 63, 64, 65, 127, 128, 200, 1000, 4096 };
-  alignas(64) unsigned char buffer[4096 + 128];
-  alignas(64) unsigned char expected[4096 + 128];
-  int wrong = 0;
-  for (std::size_t from = 0; from < 16; ++from)
-  {
-    for (std::size_t to = 0; to < 16; ++to)
-    {
-      for (std::size_t n : lengths)
-      {
-        std::memset(buffer, 0xA5, sizeof buffer);
-        std::memset(expected, 0xA5, sizeof expected);
-        CopyToStaging(buffer + to, source.data() + from, n);
-        std::memcpy(expected + to, source.data() + from, n);
-        wrong += std::memcmp(buffer, expected, sizeof buffer) != 0;
-      }
-    }
-  }
-  EXPECT_EQ(wrong, 0) << "of " << 16 * 16 * std::size(lengths) << " copies";
 }
 
 TEST(CpuDevice, SelectKeepsOrderAndCounts)

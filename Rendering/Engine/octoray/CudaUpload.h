@@ -150,7 +150,7 @@ private:
       const CopyPart& part = parts[array];
       what = part.what.c_str();
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
-      CopyToStaging(lane.pinned[b], static_cast<const char*>(part.source) + offset, n);
+      std::memcpy(lane.pinned[b], static_cast<const char*>(part.source) + offset, n);
       CudaCheck(cudaMemcpyAsync(static_cast<char*>(part.device) + offset, lane.pinned[b], n,
                   cudaMemcpyHostToDevice, lane.stream),
         what);

@@ -7,14 +7,8 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <cstdint>
-#include <cstring>
 #include <utility>
 #include <vector>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace octoray
 {
@@ -109,39 +103,6 @@ struct StagingRun
 inline std::size_t MaxPieces(std::size_t bytes)
 {
   return bytes / kStagingPiece + kMaxStagingThreads * (2 * kEdgePieces + 2);
-}
-
-// Copies `n` bytes of a caller's array into a page-locked staging buffer.
-// The buffer is written here and read only by the copy engine: ordinary
-// stores would first read each of its lines into the cache (the write
-// allocate), a third stream of the host memory's traffic beside the
-// source's read and the DMA's, and that memory's bandwidth is what bounds
-// the staging (octoray_bench_cuda's host half and pinned copy at once). So
-// where the host has them (x86-64's SSE2) whole lines go with non-temporal
-// stores, and a store fence ends the copy: those stores are weakly ordered,
-// and the DMA queued after it must read them.
-inline void CopyToStaging(void* buffer, const void* source, std::size_t n)
-{
-#if defined(__SSE2__)
-  char* to = static_cast<char*>(buffer);
-  const char* from = static_cast<const char*>(source);
-  const std::size_t head = std::min(n, (16 - reinterpret_cast<std::uintptr_t>(to) % 16) % 16);
-  std::memcpy(to, from, head);
-  to += head, from += head, n -= head;
-  for (; n >= 64; to += 64, from += 64, n -= 64)
-  {
-    const __m128i* in = reinterpret_cast<const __m128i*>(from);
-    const __m128i a = _mm_loadu_si128(in), b = _mm_loadu_si128(in + 1);
-    const __m128i c = _mm_loadu_si128(in + 2), d = _mm_loadu_si128(in + 3);
-    __m128i* out = reinterpret_cast<__m128i*>(to);
-    _mm_stream_si128(out, a), _mm_stream_si128(out + 1, b);
-    _mm_stream_si128(out + 2, c), _mm_stream_si128(out + 3, d);
-  }
-  std::memcpy(to, from, n);
-  _mm_sfence();
-#else
-  std::memcpy(buffer, source, n);
-#endif
 }
 
 // fn(array, offset, bytes, buffer) for each piece of the run's stripe, in
