@@ -17,48 +17,6 @@ namespace octoray::test
 {
 using Matrix = std::array<double, 16>;
 
-inline Matrix Multiply(const Matrix& a, const Matrix& b)
-{
-  Matrix m{};
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      for (int k = 0; k < 4; ++k)
-        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
-  return m;
-}
-
-// OpenGL-style camera, as VTK's composite projection transform gives it.
-// Parallel projection: parallelScale is half the viewport's height.
-inline Matrix ViewProjection(const double eye[3], const double target[3], const double up[3], double fovyDegrees,
-  double aspect, double zNear, double zFar, bool parallel = false, double parallelScale = 1.0)
-{
-  double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
-  const double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  for (double& v : f)
-    v /= fl;
-  double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
-  const double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-  for (double& v : s)
-    v /= sl;
-  const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
-  const Matrix view = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
-    -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2],
-    f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 0, 0, 0, 1 };
-  Matrix proj{};
-  if (parallel)
-  {
-    proj = { 1 / (parallelScale * aspect), 0, 0, 0, 0, 1 / parallelScale, 0, 0, 0, 0, -2 / (zFar - zNear),
-      -(zFar + zNear) / (zFar - zNear), 0, 0, 0, 1 };
-  }
-  else
-  {
-    const double t = 1.0 / std::tan(fovyDegrees * M_PI / 360.0);
-    proj = { t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, -(zFar + zNear) / (zFar - zNear),
-      -2 * zFar * zNear / (zFar - zNear), 0, 0, -1, 0 };
-  }
-  return Multiply(proj, view);
-}
-
 inline RenderSettings Settings(const Matrix& vp, int w, int h)
 {
   RenderSettings s;

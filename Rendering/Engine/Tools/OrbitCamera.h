@@ -44,34 +44,8 @@ struct OrbitCamera
     const double zNear = std::max(distance - 1.01 * radius, 1e-3 * distance);
     const double zFar = distance + 1.01 * radius;
     const std::array<double, 16> vp =
-      LookAtPerspective(eye, centre, up, double(settings.width) / settings.height, zNear, zFar);
+      ViewProjection(eye, centre, up, fovy, double(settings.width) / settings.height, zNear, zFar);
     return Invert4x4(vp.data(), settings.inverseViewProjection);
-  }
-
-  std::array<double, 16> LookAtPerspective(const double eye[3], const double target[3], const double up[3],
-    double aspect, double zNear, double zFar) const
-  {
-    double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
-    const double fl = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    for (double& v : f)
-      v /= fl;
-    double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
-    const double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    for (double& v : s)
-      v /= sl;
-    const double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
-    const double view[16] = { s[0], s[1], s[2], -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), u[0], u[1], u[2],
-      -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]), -f[0], -f[1], -f[2],
-      f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 0, 0, 0, 1 };
-    const double t = 1.0 / std::tan(fovy * M_PI / 360.0);
-    const double proj[16] = { t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, -(zFar + zNear) / (zFar - zNear),
-      -2 * zFar * zNear / (zFar - zNear), 0, 0, -1, 0 };
-    std::array<double, 16> m{};
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < 4; ++k)
-          m[4 * r + c] += proj[4 * r + k] * view[4 * k + c];
-    return m;
   }
 };
 

@@ -1,5 +1,6 @@
 #include "Frame.h"
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -180,5 +181,65 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   }
   f.depthBuffer = s.depthBuffer.empty() ? nullptr : s.depthBuffer.data();
   return f;
+}
+namespace
+{
+using Matrix = std::array<double, 16>;
+
+Matrix Multiply(const Matrix& a, const Matrix& b)
+{
+  Matrix m{};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k)
+        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
+  return m;
+}
+
+void Normalise(double v[3])
+{
+  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  for (int k = 0; k < 3; ++k)
+    v[k] /= length;
+}
+
+void Cross(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+double Dot(const double a[3], const double b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+}
+
+Matrix ViewProjection(const double eye[3], const double target[3], const double up[3], double fovyDegrees,
+  double aspect, double zNear, double zFar, bool parallel, double parallelScale)
+{
+  double forward[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
+  Normalise(forward);
+  double side[3], trueUp[3];
+  Cross(forward, up, side);
+  Normalise(side);
+  Cross(side, forward, trueUp);
+  const Matrix view = { side[0], side[1], side[2], -Dot(side, eye), trueUp[0], trueUp[1], trueUp[2],
+    -Dot(trueUp, eye), -forward[0], -forward[1], -forward[2], Dot(forward, eye), 0, 0, 0, 1 };
+  const double depth = zFar - zNear;
+  Matrix projection{};
+  if (parallel)
+  {
+    projection = { 1 / (parallelScale * aspect), 0, 0, 0, 0, 1 / parallelScale, 0, 0, 0, 0, -2 / depth,
+      -(zFar + zNear) / depth, 0, 0, 0, 1 };
+  }
+  else
+  {
+    const double t = 1.0 / std::tan(fovyDegrees * M_PI / 360.0);
+    projection = { t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, -(zFar + zNear) / depth, -2 * zFar * zNear / depth, 0, 0,
+      -1, 0 };
+  }
+  return Multiply(projection, view);
 }
 }

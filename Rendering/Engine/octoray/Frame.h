@@ -5,6 +5,8 @@
 #include "RenderKernels.h"
 #include "RootCube.h"
 
+#include <array>
+
 namespace octoray
 {
 // Throws Error for settings that cannot make a picture (empty viewport, a
@@ -17,4 +19,13 @@ FrameConstants MakeFrame(const RenderSettings& settings, const OctreeView& tree)
 
 // Inverse of a row-major 4x4 matrix; false when it is singular.
 bool Invert4x4(const double m[16], double inverse[16]);
+
+// The row-major view-projection matrix of an OpenGL-style camera, as VTK's
+// composite projection transform gives it: at `eye`, looking at `target`,
+// with `up`, a vertical field of view of fovyDegrees (with `parallel`, a
+// viewport half parallelScale high) and the clipping range [zNear, zFar].
+// The command-line tool, the benchmarks and the tests set their cameras
+// with it, so that they drive the engine as the VTK layer does.
+std::array<double, 16> ViewProjection(const double eye[3], const double target[3], const double up[3],
+  double fovyDegrees, double aspect, double zNear, double zFar, bool parallel = false, double parallelScale = 1.0);
 }
