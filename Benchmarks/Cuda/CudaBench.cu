@@ -254,9 +254,9 @@ private:
 };
 
 // The host's half of the engine's staging alone (CudaUpload.h): the
-// caller's arrays, laid end to end and cut as the staging cuts them
-// (StagingPieces.h), copied piece by piece into each thread's two
-// page-locked buffers in turn; no DMA. No upload through such buffers takes
+// caller's arrays, laid end to end, cut and dealt to the threads as the
+// staging does it (StagingPieces.h), copied piece by piece into each
+// thread's two page-locked buffers in turn; no DMA. No upload through such buffers takes
 // less than the longer of this and the pinned copy.
 class HostHalfOfStaging
 {
@@ -294,11 +294,12 @@ public:
     const std::array<HostArray, 3> arrays = InputArrays(c);
     const octoray::cuda::StagingRun run({ arrays[0].bytes, arrays[1].bytes, arrays[2].bytes });
     const auto t0 = std::chrono::steady_clock::now();
-    Threads.Run(octoray::cuda::StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int stripe) {
-      octoray::cuda::ForEachPiece(run, octoray::cuda::StripeBytes(first, last, run.Length()),
-        [&](std::size_t array, std::size_t offset, std::size_t n, int b) {
-          std::memcpy(Buffers[2 * stripe + b], static_cast<const char*>(arrays[array].data) + offset, n);
-        });
+    octoray::cuda::PieceDealer dealer(octoray::cuda::CutPieces(run, Threads.Chunks()));
+    Threads.Run(Threads.Chunks(), [&](std::size_t thread, std::size_t, int) {
+      dealer.Take([&](const octoray::cuda::Piece& piece, int b) {
+        std::memcpy(Buffers[2 * thread + b], static_cast<const char*>(arrays[piece.array].data) + piece.offset,
+          piece.bytes);
+      });
     });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -144,22 +144,22 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
   }
 }
 
-// The CUDA backend's staged copy lays a copy's arrays end to end and cuts
-// the run into a stripe a thread and each stripe into pieces
+// The CUDA backend's staged copy lays a copy's arrays end to end, cuts the
+// run into pieces and deals them to its threads as each becomes free
 // (StagingPieces.h). For runs of one to four arrays of many sizes (empty
-// ones among them) on 1 to kMaxStagingThreads threads, split as
-// ChunkWorkers splits them: the pieces cover every array once, each
-// stripe's in order; none is empty, larger than a page-locked buffer, or
-// past its array; each starts at a whole multiple of kStripeAlignment into
-// its array, so that no piece splits a point; the buffers alternate; and no
-// array gets more pieces than MaxPieces, which sizes the partial bounds of
-// its pieces.
+// ones among them), cut for 1 to kMaxStagingThreads threads: the pieces
+// cover every array once, in order; none is empty or larger than a
+// page-locked buffer; each starts at a whole multiple of kPieceAlignment
+// into its array, so that no piece splits a point; and no array gets more
+// pieces than MaxPieces, which sizes the partial bounds of its pieces.
+// Dealt to as many threads (ChunkWorkers), every piece is taken once, and
+// each thread's buffers alternate.
 TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
 {
   using namespace octoray::cuda;
   std::mt19937_64 rng(7);
-  std::vector<std::vector<std::size_t>> runs = { { 1 }, { kStripeAlignment }, { kEdgePiece + 1 }, { kStagingPiece },
-    { 3 * kStagingPiece + 5 }, { 0, 5 }, { 120000000, 30000000, 40000000 } };
+  std::vector<std::vector<std::size_t>> runs = { { 1 }, { kPieceAlignment }, { kEdgePiece + 1 }, { kStagingPiece },
+    { 3 * kStagingPiece + 5 }, { 0, 5 }, { 5, 0 }, { 120000000, 30000000, 40000000 } };
   for (int i = 0; i < 300; ++i)
   {
     std::vector<std::size_t> run(1 + rng() % 4);
@@ -174,38 +174,50 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
     ChunkWorkers workers(threads);
     for (const std::vector<std::size_t>& arrays : runs)
     {
-      const StagingRun run(arrays);
       SCOPED_TRACE("first array " + std::to_string(arrays[0]) + " bytes of " + std::to_string(arrays.size()) +
         ", threads " + std::to_string(threads));
-      std::vector<std::vector<std::size_t>> pieces(threads, std::vector<std::size_t>(arrays.size(), 0));
-      std::vector<std::vector<std::size_t>> covered = pieces;
-      std::vector<int> bad(threads, 0);
-      workers.Run(StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int t) {
-        const Stripe stripe = StripeBytes(first, last, run.Length());
-        std::size_t next = stripe.begin; // in the run
-        int count = 0;
-        ForEachPiece(run, stripe, [&](std::size_t array, std::size_t offset, std::size_t n, int buffer) {
-          const std::size_t at = run.start[array] + offset;
-          bad[t] += at < next || n == 0 || n > kStagingPiece || offset + n > arrays[array] ||
-            offset % kStripeAlignment != 0 || buffer != count++ % 2;
-          next = at + n;
-          ++pieces[t][array];
-          covered[t][array] += n;
-        });
-        bad[t] += next > stripe.end;
-      });
-      EXPECT_EQ(std::accumulate(bad.begin(), bad.end(), 0), 0);
+      const std::vector<Piece> pieces = CutPieces(StagingRun(arrays), threads);
+      std::vector<std::size_t> covered(arrays.size(), 0), count(arrays.size(), 0);
+      int bad = 0;
+      for (std::size_t k = 0; k < pieces.size(); ++k)
+      {
+        const Piece& p = pieces[k];
+        const bool inOrder = k == 0 || p.array > pieces[k - 1].array ||
+          (p.array == pieces[k - 1].array && p.offset == pieces[k - 1].offset + pieces[k - 1].bytes);
+        bad += !inOrder || p.array >= arrays.size() || p.bytes == 0 || p.bytes > kStagingPiece ||
+          p.offset + p.bytes > arrays[p.array] || p.offset % kPieceAlignment != 0;
+        covered[p.array] += p.bytes;
+        ++count[p.array];
+      }
+      EXPECT_EQ(bad, 0);
       for (std::size_t a = 0; a < arrays.size(); ++a)
       {
-        std::size_t bytes = 0, count = 0;
-        for (int t = 0; t < threads; ++t)
-        {
-          bytes += covered[t][a];
-          count += pieces[t][a];
-        }
-        EXPECT_EQ(bytes, arrays[a]) << "array " << a;
-        EXPECT_LE(count, MaxPieces(arrays[a])) << "array " << a;
+        EXPECT_EQ(covered[a], arrays[a]) << "array " << a;
+        EXPECT_LE(count[a], MaxPieces(arrays[a])) << "array " << a;
       }
+
+      PieceDealer dealer(pieces);
+      std::vector<std::vector<std::pair<std::size_t, std::size_t>>> taken(threads);
+      std::vector<int> badBuffers(threads, 0);
+      workers.Run(threads, [&](std::size_t t, std::size_t, int) {
+        int turn = 0;
+        dealer.Take([&](const Piece& p, int buffer) {
+          badBuffers[t] += buffer != turn++ % 2;
+          taken[t].emplace_back(p.array, p.offset);
+        });
+      });
+      std::vector<std::pair<std::size_t, std::size_t>> all, expected;
+      for (const auto& mine : taken)
+      {
+        all.insert(all.end(), mine.begin(), mine.end());
+      }
+      for (const Piece& p : pieces)
+      {
+        expected.emplace_back(p.array, p.offset);
+      }
+      std::sort(all.begin(), all.end());
+      EXPECT_EQ(all, expected);
+      EXPECT_EQ(std::accumulate(badBuffers.begin(), badBuffers.end(), 0), 0);
     }
   }
 }

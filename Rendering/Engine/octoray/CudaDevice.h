@@ -521,7 +521,7 @@ public:
   {
     Fills along;
     const std::size_t itemBytes = stride * sizeof(T);
-    if (cuda::kStripeAlignment % itemBytes != 0)
+    if (cuda::kPieceAlignment % itemBytes != 0)
     {
       throw Error(std::string("octoray: the staged copy's pieces would split items of ") + what);
     }

@@ -3,16 +3,16 @@
 // cudaMemcpy goes through the driver's own small bounce buffer at a
 // fraction of what the bus carries (octoray_bench_cuda measures both
 // beside the engine's own upload). The arrays of one copy are laid end
-// to end (StagingPieces.h) and cut into stripes, one per host thread, so
-// that one pass of the threads serves them all; each thread copies its
-// stripe through two pinned buffers of its own, filling one while the
-// copy engine reads the other, so the host copies and the DMA overlap and
-// several host threads keep the bus busy; the threads and buffers are
-// made at the first such copy and kept. Arrays already in device memory (a
-// CUDA simulation's) and page-locked host arrays are copied directly. A
-// caller may queue work on each piece as it lands (Landed), which then
-// runs while the rest of the array is still on its way. Only compiled by
-// nvcc.
+// to end and cut into pieces (StagingPieces.h), which a team of host
+// threads take in turn, so that one pass of the threads serves them all;
+// each thread copies its pieces through two pinned buffers of its own,
+// filling one while the copy engine reads the other, so the host copies and
+// the DMA overlap and several host threads keep the bus busy; the threads
+// and buffers are made at the first such copy and kept. Arrays already in
+// device memory (a CUDA simulation's) and page-locked host arrays are
+// copied directly. A caller may queue work on each piece as it lands
+// (Landed), which then runs while the rest of the array is still on its
+// way. Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"
@@ -108,9 +108,10 @@ public:
     int current = 0;
     CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
     CudaCheck(cudaStreamSynchronize(0), staged.front().what.c_str());
-    Workers->Run(StripeUnits(run.Length()), [&](std::size_t first, std::size_t last, int stripe) {
+    PieceDealer dealer(CutPieces(run, Workers->Chunks()));
+    Workers->Run(Lanes.size(), [&](std::size_t lane, std::size_t, int) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
-      CopyStripe(Lanes[stripe], staged, run, StripeBytes(first, last, run.Length()));
+      CopyPieces(Lanes[lane], staged, dealer);
     });
   }
 
@@ -135,10 +136,10 @@ private:
     }
   }
 
-  // A stripe of the run, through the lane's two pinned buffers in turn.
-  // Returns, or throws, once the lane has finished what it queued: the
-  // destinations may be freed right after.
-  static void CopyStripe(Lane& lane, const std::vector<CopyPart>& parts, const StagingRun& run, Stripe stripe)
+  // The pieces this lane's thread takes, through the lane's two pinned
+  // buffers in turn. Returns, or throws, once the lane has finished what it
+  // queued: the destinations may be freed right after.
+  static void CopyPieces(Lane& lane, const std::vector<CopyPart>& parts, PieceDealer& dealer)
   {
     struct Drain
     {
@@ -146,8 +147,9 @@ private:
       ~Drain() { cudaStreamSynchronize(stream); }
     } drain{ lane.stream };
     const char* what = parts.front().what.c_str();
-    ForEachPiece(run, stripe, [&](std::size_t array, std::size_t offset, std::size_t n, int b) {
-      const CopyPart& part = parts[array];
+    dealer.Take([&](const Piece& piece, int b) {
+      const CopyPart& part = parts[piece.array];
+      const std::size_t offset = piece.offset, n = piece.bytes;
       what = part.what.c_str();
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
       std::memcpy(lane.pinned[b], static_cast<const char*>(part.source) + offset, n);
@@ -218,7 +220,7 @@ private:
   }
 
   std::vector<Lane> Lanes;
-  std::unique_ptr<ChunkWorkers> Workers; // one stripe each
+  std::unique_ptr<ChunkWorkers> Workers; // one a lane
 };
 }
 }
