@@ -9,6 +9,8 @@ the last host copy, and the staging threads' end spread and time blocked
 waiting for their buffers' DMAs. Medians over the copies of a size and kind.
 
     staging-timeline.py TIMELINE [RATE_GB_S]   (RATE: the pinned copy's, 54.8 by default)
+    staging-timeline.py --lanes TIMELINE       (each copy's threads: when their last host
+                                                copy ended / how long they copied, ms)
 """
 import re
 import statistics
@@ -69,7 +71,21 @@ def analyse(copy, rate):
     }
 
 
+def print_lanes(copies):
+    for copy in copies:
+        lanes = defaultdict(list)
+        for p in copy["pieces"]:
+            lanes[p["lane"]].append(p)
+        cells = [f"{max(q['copied'] for q in ps) / 1e3:.1f}/{sum(q['copied'] - q['w1'] for q in ps) / 1e3:.1f}"
+                 for _, ps in sorted(lanes.items())]
+        print(f"{copy['bytes'] / 1e6:.0f} MB {'build' if copy['landed'] else 'alone'} "
+              f"{copy['total'] / 1e3:.2f} ms: " + " ".join(cells))
+
+
 def main():
+    if sys.argv[1] == "--lanes":
+        print_lanes(read(sys.argv[2]))
+        return
     path = sys.argv[1]
     rate = float(sys.argv[2]) if len(sys.argv) > 2 else 54.8
     groups = defaultdict(list)
