@@ -256,8 +256,8 @@ private:
 // The host's half of the engine's staging alone (CudaUpload.h): the
 // caller's arrays, laid end to end, cut and dealt to the threads as the
 // staging does it (StagingPieces.h), copied piece by piece into each
-// thread's two page-locked buffers in turn; no DMA. No upload through such buffers takes
-// less than the longer of this and the pinned copy.
+// thread's two page-locked buffers in turn; no DMA. No upload through such
+// buffers takes less than the longer of this and the pinned copy.
 class HostHalfOfStaging
 {
 public:

@@ -23,7 +23,8 @@ constexpr std::size_t kPieceAlignment = 768;
 // enough that a DMA's setup and the calls that queue it are small beside
 // its transfer.
 constexpr std::size_t kStagingPiece = (std::size_t(4) << 20) / kPieceAlignment * kPieceAlignment;
-// The run's first and last pieces (about 512 kB): see PieceBytes.
+// The smallest pieces, at the run's start and end (about 512 kB): see
+// PieceBytes.
 constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kPieceAlignment * kPieceAlignment;
 // One host thread copies from pageable memory at a fraction of the bus's
 // speed, and several share the host's memory bandwidth: on the 16-core
@@ -110,9 +111,9 @@ inline std::vector<Piece> CutPieces(const StagingRun& run, int threads)
   return pieces;
 }
 
-// The most pieces that fall in one array of `bytes`: all but its last and
-// the run's last hold kEdgePiece or more (the StagingPieces test checks it).
-// It sizes the partial results of the pieces' reductions.
+// The most pieces that fall in one array of `bytes`: all but its last hold
+// kEdgePiece or more (the StagingPieces test checks the bound). It sizes the
+// partial results of the pieces' reductions.
 inline std::size_t MaxPieces(std::size_t bytes)
 {
   return bytes / kEdgePiece + 1;
@@ -123,7 +124,10 @@ inline std::size_t MaxPieces(std::size_t bytes)
 // with another, takes fewer. With one stripe of the run a thread, the
 // threads' copies ended up to 3 ms apart in a 4.9-6.5 ms copy of 190 MB,
 // some of them copying at half the others' speed
-// (Benchmarks/gpu/variants-staging-timeline.txt).
+// (Benchmarks/gpu/variants-staging-timeline.txt). Dealt, the host's half
+// of a 1.9 GB copy took 22-25 ms against 33-34; the whole copy, which waits
+// for the copy engine, took as long as before
+// (Benchmarks/gpu/variants-staging-dealt.txt).
 class PieceDealer
 {
 public:
@@ -131,7 +135,6 @@ public:
     : Pieces(std::move(pieces))
   {
   }
-  std::size_t Count() const { return Pieces.size(); }
 
   // fn(piece, buffer) for each piece this thread takes, in the order it
   // takes them; `buffer` (0 or 1) is the thread's page-locked buffer it
