@@ -638,7 +638,8 @@ def _cuda(ctx):
         text += [
             "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
             + ("1 MB and more through page-locked buffers on up to 16 host threads, started once and kept, in "
-               "pieces that grow from 0.5 to 4 MB at the start of a thread's stripe and shrink toward its end "
+               "pieces of 0.5 to 4 MB (small at the run's start and end), which the threads take in turn as each "
+               "becomes free "
                if host_copy else "16 MB and more through page-locked buffers on up to 8 host threads ")
             + "(Rendering/Engine/octoray/"
             "CudaUpload.h), " + ("all the arrays of a build in one pass, laid end to end (StagingPieces.h); "
@@ -705,6 +706,24 @@ def _cuda(ctx):
                 "in one launch after the copy, or every four pieces, the whole call at 100 M points took 1.57–1.59 "
                 "and 1.50–1.56 times the pinned copy against 1.56–1.60 (call 5), within the host's spread (the "
                 "staged copy alone moved between 38.7 and 49.2 ms from run to run).",
+                "",
+                "Where the staging's pass loses, timed piece by piece (a diagnostic build of CudaUpload.h, "
+                "Benchmarks/gpu/variants-staging-timeline.txt, read by scripts/gpu/staging-timeline.py): with one "
+                "stripe of the run a thread, most threads copied theirs of 190 MB in 2.1–2.8 ms and one or two in "
+                "4–6 ms, at half the others' speed, as two threads sharing a core do; the threads' last host copies "
+                "ended a median 3.1 ms apart in copies of 4.9–6.5 ms. Since c6857bf the run is cut into pieces in "
+                "order and each thread takes the next as it becomes free (StagingPieces.h's CutPieces and "
+                "PieceDealer). Built beside 522c9b1's staging and run in turn, three rounds, the host's half alone "
+                "took 2.15–2.46 ms at 10 M points against 2.23–2.94, and 22.0–25.1 ms at 100 M against 32.9–34.2; "
+                "but the staged copy alone took 4.58–4.67 ms against 4.44–4.60, and the whole call 1.75–1.80 times "
+                "the pinned copy against 1.73–2.08 at 10 M points, 1.40–1.46 against 1.43–1.44 at 100 M "
+                "(Benchmarks/gpu/variants-staging-dealt.txt): what the staged copy waits for is the copy engine, "
+                "reading the page-locked buffers while the host writes the next ones. Fewer, larger pieces (80 at "
+                "10 M points where the dealt staging cuts 146) changed nothing there, nor did three buffers a "
+                "thread (2.08–2.13 times at 10 M points; variants-staging-timeline.txt). Non-temporal stores into "
+                "the buffers, which spare the host's memory the write-allocate's reads, made the call slower: 1.78–1.80 "
+                "times at 10 M points against 1.69–1.77 with memcpy (variants-staging-stores.txt); that host's "
+                "300 MiB L3 holds the 128 MB of buffers, which the DMA then reads from the cache.",
                 "",
             ]
     r = named_record(records, "gpu bytes per point, every attribute")
