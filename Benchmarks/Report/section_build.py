@@ -722,8 +722,9 @@ def _cuda(ctx):
                 "10 M points where the dealt staging cuts 146) changed nothing there, nor did three buffers a "
                 "thread (2.08–2.13 times at 10 M points; variants-staging-timeline.txt). Non-temporal stores into "
                 "the buffers, which spare the host's memory the write-allocate's reads, made the call slower: 1.78–1.80 "
-                "times at 10 M points against 1.69–1.77 with memcpy (variants-staging-stores.txt); that host's "
-                "300 MiB L3 holds the 128 MB of buffers, which the DMA then reads from the cache.",
+                "times at 10 M points against 1.69–1.77 with memcpy (variants-staging-stores.txt); likely because "
+                "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
+                "wrote.",
                 "",
             ]
     r = named_record(records, "gpu bytes per point, every attribute")
