@@ -1,4 +1,5 @@
 #include "Frame.h"
+#include "VecMath.h"
 
 #include <array>
 #include <cmath>
@@ -182,6 +183,7 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   f.depthBuffer = s.depthBuffer.empty() ? nullptr : s.depthBuffer.data();
   return f;
 }
+
 namespace
 {
 using Matrix = std::array<double, 16>;
@@ -195,38 +197,17 @@ Matrix Multiply(const Matrix& a, const Matrix& b)
         m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
   return m;
 }
-
-void Normalise(double v[3])
-{
-  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  for (int k = 0; k < 3; ++k)
-    v[k] /= length;
-}
-
-void Cross(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-double Dot(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 }
 
 Matrix ViewProjection(const double eye[3], const double target[3], const double up[3], double fovyDegrees,
   double aspect, double zNear, double zFar, bool parallel, double parallelScale)
 {
-  double forward[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] };
-  Normalise(forward);
-  double side[3], trueUp[3];
-  Cross(forward, up, side);
-  Normalise(side);
-  Cross(side, forward, trueUp);
-  const Matrix view = { side[0], side[1], side[2], -Dot(side, eye), trueUp[0], trueUp[1], trueUp[2],
-    -Dot(trueUp, eye), -forward[0], -forward[1], -forward[2], Dot(forward, eye), 0, 0, 0, 1 };
+  const Vec3d from{ eye[0], eye[1], eye[2] };
+  const Vec3d forward = Normalize(Vec3d{ target[0], target[1], target[2] } - from);
+  const Vec3d side = Normalize(Cross(forward, Vec3d{ up[0], up[1], up[2] }));
+  const Vec3d trueUp = Cross(side, forward);
+  const Matrix view = { side.x, side.y, side.z, -Dot(side, from), trueUp.x, trueUp.y, trueUp.z, -Dot(trueUp, from),
+    -forward.x, -forward.y, -forward.z, Dot(forward, from), 0, 0, 0, 1 };
   const double depth = zFar - zNear;
   Matrix projection{};
   if (parallel)

@@ -35,7 +35,8 @@ constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kPieceAlignment * 
 constexpr int kMaxStagingThreads = 16;
 
 // The bytes of the piece at `offset` of a run of `length` bytes that
-// `threads` threads copy: a multiple of kPieceAlignment but the run's last.
+// `threads` threads copy, a multiple of kPieceAlignment, before CutPieces
+// cuts it at its array's end.
 // The threads start together: while they fill their first buffers the
 // copy engine has nothing to do, so the first pieces are small, and grow
 // with the bytes behind them. They should end together too: while the copy
@@ -45,8 +46,7 @@ inline std::size_t PieceBytes(std::size_t offset, std::size_t length, int thread
 {
   const std::size_t grown = std::max(offset / threads, kEdgePiece);
   const std::size_t shrunk = std::max((length - offset) / (2 * threads), kEdgePiece);
-  const std::size_t n = std::min({ kStagingPiece, grown, shrunk }) / kPieceAlignment * kPieceAlignment;
-  return std::min(n, length - offset);
+  return std::min({ kStagingPiece, grown, shrunk }) / kPieceAlignment * kPieceAlignment;
 }
 
 // `bytes` rounded up to whole multiples of kPieceAlignment.

@@ -61,6 +61,13 @@ OCTORAY_HD T Length(const Vec3<T>& v)
   return std::sqrt(Dot(v, v));
 }
 
+// a x b, each component as the two products' difference.
+template <typename T>
+OCTORAY_HD Vec3<T> Cross(const Vec3<T>& a, const Vec3<T>& b)
+{
+  return Vec3<T>{ a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
+}
+
 // v / |v|, each component divided; zero stays zero.
 template <typename T>
 OCTORAY_HD Vec3<T> Normalize(const Vec3<T>& v)
