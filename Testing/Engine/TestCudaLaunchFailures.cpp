@@ -75,17 +75,9 @@ Cloud Doubled(const Cloud& c)
   return d;
 }
 
-class CudaFaultsLaunch : public ::testing::Test
+class CudaFaultsLaunch : public CudaOnlyTest
 {
 protected:
-  void SetUp() override
-  {
-    std::string why;
-    if (!CudaAvailable(&why))
-    {
-      GTEST_SKIP() << "CUDA backend not usable here: " << why;
-    }
-  }
   void TearDown() override { InjectCudaLaunchFailure(""); }
 };
 }

@@ -1,8 +1,11 @@
 // The shared pieces under the driver and the renderer, against plain
-// references: the CPU device's primitives (whatever the thread count, the
-// same results), the driver's run starts, first-failure search and level
+// references: the CPU device's primitives and the driver's run starts and
+// first-failure search (DeviceChecks.h, which TestCudaDevice.cu runs on the
+// GPU; here whatever the thread count, the same results), the level
 // sizes, the attribute list's slots, the kept threads of ChunkWorkers, the
 // CUDA backend's staged pieces, and the vector vocabulary's rounding.
+#include "DeviceChecks.h"
+
 #include <octoray/CpuDevice.h>
 #include <octoray/OctreeDriver.h>
 #include <octoray/RenderKernels.h>
@@ -40,55 +43,11 @@ void OnEverySplit(Check&& check)
     }
   }
 }
-
-std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint64_t seed)
-{
-  std::mt19937_64 rng(seed);
-  std::vector<std::uint64_t> keys(n);
-  for (auto& k : keys)
-  {
-    k = rng() & ((std::uint64_t(1) << bits) - 1);
-  }
-  return keys;
-}
 }
 
 TEST(CpuDevice, ForEachReduceAndHistogramCoverEveryItemOnce)
 {
-  OnEverySplit([](std::size_t n, CpuDevice& d) {
-    std::vector<int> seen(n, 0);
-    int* out = seen.data();
-    d.ForEach("test", n, OCTORAY_LAMBDA(std::size_t i) { out[i] += 1; });
-    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
-
-    const std::uint64_t sum = d.Reduce(
-      n, std::uint64_t(0), OCTORAY_LAMBDA(std::size_t i) { return std::uint64_t(i * i); },
-      OCTORAY_LAMBDA(std::uint64_t a, std::uint64_t b) { return a + b; });
-    std::uint64_t expected = 0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      expected += i * i;
-    }
-    EXPECT_EQ(sum, expected);
-
-    std::uint64_t counts[7] = { 5, 0, 0, 0, 0, 0, 0 }; // added to, not replaced
-    d.Histogram<7>("test", n, OCTORAY_LAMBDA(std::size_t i) {
-      return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
-    }, counts);
-    std::uint64_t reference[7] = { 5, 0, 0, 0, 0, 0, 0 };
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      ++reference[i % 3];
-      if (i % 2 == 0)
-      {
-        ++reference[3 + i % 4];
-      }
-    }
-    for (int b = 0; b < 7; ++b)
-    {
-      EXPECT_EQ(counts[b], reference[b]) << "bin " << b;
-    }
-  });
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectLoopsCoverEveryItemOnce(d, n); });
 }
 
 // The kept threads split each pass as ParallelChunks does, call every
@@ -224,233 +183,22 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
 
 TEST(CpuDevice, SelectKeepsOrderAndCounts)
 {
-  OnEverySplit([](std::size_t n, CpuDevice& d) {
-    std::vector<std::uint32_t> out(n + 1, 0xDEADBEEFu);
-    std::uint64_t count = 12345;
-    d.Select(n, OCTORAY_LAMBDA(std::size_t i) { return (i * 7919) % 5 < 2; }, out.data(), &count);
-    std::vector<std::uint32_t> expected;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      if ((i * 7919) % 5 < 2)
-      {
-        expected.push_back(static_cast<std::uint32_t>(i));
-      }
-    }
-    ASSERT_EQ(count, expected.size());
-    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), out.begin()));
-  });
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectSelectKeepsOrderAndCounts(d, n); });
 }
 
-// Nested lists against their definition, item by item: list l holds, in
-// order, the items whose first list is l or less (the last list the items
-// themselves, each other list an item's place in the next), then the size
-// of the next list; the counts are those of each first list. First lists
-// past the last (an item in no list) come too. The lists before the last
-// go end to end, and only where they fit: with one entry too few, the last
-// list alone.
 TEST(CpuDevice, NestedListsHoldEachItemFromItsFirstListOn)
 {
-  OnEverySplit([](std::size_t n, CpuDevice& d) {
-    const int lists = 5;
-    const auto firstList = OCTORAY_LAMBDA(std::size_t i) { return static_cast<int>((i * 7919 + i / 3) % 7); };
-    CpuDevice::Buffer<std::uint32_t> tally;
-    std::uint64_t counts[lists] = {};
-    d.CountNested("test", n, lists, firstList, tally, counts);
-    std::vector<std::vector<std::uint32_t>> expected(lists);
-    std::uint64_t expectedCounts[lists] = {};
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const int first = firstList(i);
-      std::uint32_t below = static_cast<std::uint32_t>(i);
-      for (int l = lists - 1; l >= first; --l)
-      {
-        expected[l].push_back(below);
-        below = static_cast<std::uint32_t>(expected[l].size() - 1);
-      }
-      if (first < lists)
-      {
-        ++expectedCounts[first];
-      }
-    }
-    for (int l = lists - 1; l >= 0; --l) // after its items, the next list's size (without its own end)
-    {
-      expected[l].push_back(l + 1 < lists ? static_cast<std::uint32_t>(expected[l + 1].size() - 1)
-                                          : static_cast<std::uint32_t>(n));
-    }
-    std::vector<std::uint32_t> packed;
-    for (int l = 0; l + 1 < lists; ++l)
-    {
-      packed.insert(packed.end(), expected[l].begin(), expected[l].end());
-    }
-    for (const std::size_t room : { packed.size(), packed.size() - 1 })
-    {
-      std::vector<std::uint32_t> last(n + 1, 0xDEADBEEFu);
-      std::vector<std::uint32_t> packedOut(packed.size(), 0xDEADBEEFu);
-      NestedLists out{ lists, last.data(), packedOut.data(), room };
-      d.PlaceNested("test", n, firstList, tally, out);
-      EXPECT_TRUE(std::equal(expected[lists - 1].begin(), expected[lists - 1].end(), last.begin())) << room;
-      EXPECT_EQ(packedOut == packed, room == packed.size()) << room;
-    }
-    for (int l = 0; l < lists; ++l)
-    {
-      EXPECT_EQ(counts[l], expectedCounts[l]) << "list " << l;
-    }
-  });
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectNestedListsHoldEachItemFromItsFirstListOn(d, n); });
 }
 
-// Stable, for both key widths with 32-bit values and for 32-bit keys with
-// 64-bit ones (a leaf key with a record of two words), keys below 2^bits
-// (the passes cover `bits`), with the result where the return value says.
-template <typename Key, typename Value = std::uint32_t>
-void ExpectStableSort(int bits)
+TEST(CpuDevice, SortsAreStable)
 {
-  SCOPED_TRACE("bits " + std::to_string(bits) + ", values of " + std::to_string(8 * sizeof(Value)) + " bits");
-  OnEverySplit([bits](std::size_t n, CpuDevice& d) {
-    const std::vector<std::uint64_t> random = RandomKeys(n, bits, n + d.threads);
-    std::vector<Key> k0(random.begin(), random.end()), k1(n);
-    std::vector<Value> v0(n), v1(n);
-    std::vector<std::pair<std::uint64_t, Value>> reference;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      v0[i] = static_cast<Value>(i);
-      if constexpr (sizeof(Value) == 8)
-      {
-        v0[i] |= ~static_cast<Value>(i) << 32; // both halves travel
-      }
-      reference.emplace_back(k0[i], v0[i]);
-    }
-    std::stable_sort(reference.begin(), reference.end(),
-      [](const auto& a, const auto& b) { return a.first < b.first; });
-    Key* keys[2] = { k0.data(), k1.data() };
-    Value* values[2] = { v0.data(), v1.data() };
-    const int result = d.SortPairs(keys, values, n, bits, "test");
-    ASSERT_TRUE(result == 0 || result == 1);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      ASSERT_EQ(values[result][i], reference[i].second) << "position " << i;
-      ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
-    }
-  });
-}
-
-TEST(CpuDevice, SortPairsIsStable)
-{
-  ExpectStableSort<std::uint64_t>(63);
-  ExpectStableSort<std::uint64_t>(30);
-  ExpectStableSort<std::uint32_t>(29);
-  ExpectStableSort<std::uint32_t>(5);
-  ExpectStableSort<std::uint32_t, std::uint64_t>(30);
-  ExpectStableSort<std::uint32_t, std::uint64_t>(6);
-}
-
-// SortPairsFrom: the same order as a stable sort, the values written to
-// their own array and their input left as it is; keys of `keyBits` random
-// bits sorted by `bits`, so that passes over all-zero digits are skipped
-// (which changes where the passes end).
-template <typename Key, typename Value>
-void ExpectSortFromLeavesItsInput(int bits, int keyBits)
-{
-  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(keyBits));
-  OnEverySplit([=](std::size_t n, CpuDevice& d) {
-    const std::vector<std::uint64_t> random = RandomKeys(n, keyBits, n + d.threads);
-    std::vector<Key> k0(random.begin(), random.end()), k1(n);
-    std::vector<Value> in(n), out(n);
-    std::vector<std::pair<Key, Value>> reference;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      in[i] = static_cast<Value>(~i);
-      reference.emplace_back(k0[i], in[i]);
-    }
-    const std::vector<Value> input = in;
-    std::stable_sort(reference.begin(), reference.end(),
-      [](const auto& a, const auto& b) { return a.first < b.first; });
-    Key* keys[2] = { k0.data(), k1.data() };
-    const int result = d.SortPairsFrom(keys, in.data(), out.data(), n, bits, "test");
-    ASSERT_TRUE(result == 0 || result == 1);
-    EXPECT_EQ(in, input) << "the input values changed";
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      ASSERT_EQ(keys[result][i], reference[i].first) << "position " << i;
-      ASSERT_EQ(out[i], reference[i].second) << "position " << i;
-    }
-  });
-}
-
-TEST(CpuDevice, SortPairsFromLeavesItsInput)
-{
-  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(30, 30); // 3 passes
-  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(30, 20); // the third skipped
-  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(24, 24); // 3 passes
-  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(12, 12); // 2 passes
-  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(12, 0);  // none moves
-}
-
-// Keys alone, by their low `bits`, other bits set above them: stable (the
-// last pass masks its digit at `bits`).
-template <typename Key>
-void ExpectStableKeySort(int bits)
-{
-  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(8 * sizeof(Key)));
-  OnEverySplit([=](std::size_t n, CpuDevice& d) {
-    // Random bits above the range tell apart keys that the sort sees equal.
-    const std::vector<std::uint64_t> random = RandomKeys(n, 8 * sizeof(Key) - 1, n + d.threads);
-    std::vector<Key> k0(random.begin(), random.end()), k1(n);
-    const Key mask = static_cast<Key>((std::uint64_t(1) << bits) - 1);
-    std::vector<Key> reference = k0;
-    std::stable_sort(
-      reference.begin(), reference.end(), [mask](Key a, Key b) { return (a & mask) < (b & mask); });
-    Key* keys[2] = { k0.data(), k1.data() };
-    const int result = d.SortKeys(keys, n, bits, "test");
-    ASSERT_TRUE(result == 0 || result == 1);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      ASSERT_EQ(keys[result][i], reference[i]) << "position " << i;
-    }
-  });
-}
-
-TEST(CpuDevice, SortKeysByTheirLowBitsIsStable)
-{
-  ExpectStableKeySort<std::uint64_t>(30);
-  ExpectStableKeySort<std::uint64_t>(3);
-  ExpectStableKeySort<std::uint64_t>(29);
-  ExpectStableKeySort<std::uint32_t>(30);
-  ExpectStableKeySort<std::uint32_t>(5);
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectSortsStable(d, n, n + d.threads); });
 }
 
 TEST(CpuDevice, RunStartsAndFirstFailedStep)
 {
-  CpuDevice d;
-  d.threads = 2;
-  DriverScratch<CpuDevice> scratch;
-  d.Reserve(scratch.counters, kCounterSlots, "counters");
-  for (std::size_t n : kSizes)
-  {
-    SCOPED_TRACE("n " + std::to_string(n));
-    std::vector<std::uint64_t> keys = RandomKeys(n, 12, n);
-    std::sort(keys.begin(), keys.end());
-    std::vector<std::uint32_t> starts(n + 1);
-    RunStarts(d, scratch, keys.data(), n, starts.data());
-    std::vector<std::uint32_t> expected;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      if (i == 0 || keys[i] != keys[i - 1])
-      {
-        expected.push_back(static_cast<std::uint32_t>(i));
-      }
-    }
-    expected.push_back(static_cast<std::uint32_t>(n));
-    EXPECT_EQ(scratch.counters.Get()[kCounterSelected], expected.size());
-    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), starts.begin()));
-    const std::size_t bad = n / 3 + 1;
-    std::uint64_t first = kNoIndex;
-    for (std::size_t i = n; i-- > 0;)
-    {
-      first = i >= bad && i % 2 == 0 ? i : first;
-    }
-    EXPECT_EQ(FirstFailedStep(d, scratch, "test", n, OCTORAY_LAMBDA(std::size_t i) { return i < bad || i % 2; }),
-      first);
-  }
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectRunStartsAndFirstFailedStep(d, n); });
 }
 
 // Level sizes from a newNode histogram; past the 32-bit node index, an

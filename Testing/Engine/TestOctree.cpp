@@ -458,15 +458,14 @@ TEST_P(OctreeBuild, WithoutItsPointsHoldsOnlyTheNodes)
 
 INSTANTIATE_TEST_SUITE_P(Backends, OctreeBuild, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);
 
+// Suites that only the CUDA backend has: skipped, saying why, without a GPU.
+using CudaFaults = CudaOnlyTest;
+using OctreeCUDA = CudaOnlyTest;
+
 // Out of device memory: a clear error naming what did not fit, the previous
 // octree intact and still drawable, and a later build within budget works.
-TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
+TEST_F(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
 {
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    GTEST_SKIP() << "CUDA backend not usable here: " << why;
-  }
   auto engine = CreateEngine(Backend::CUDA);
   const Cloud small = UniformCloud(1000, 51);
   BuildOptions options;
@@ -504,13 +503,8 @@ TEST(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
 // what a build, an update and a render need. At each step the call either
 // succeeds or fails with the documented error, gives back what it took (the
 // engine holds no more than before) and leaves the previous octree intact.
-TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
+TEST_F(CudaFaults, OutOfMemoryAtEveryAllocationSite)
 {
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    GTEST_SKIP() << "CUDA backend not usable here: " << why;
-  }
   const Cloud first = UniformCloud(2000, 53);
   const Cloud second = GaussianClusters(30000, 54);
   BuildOptions options;
@@ -580,13 +574,8 @@ TEST(CudaFaults, OutOfMemoryAtEveryAllocationSite)
 // The CUDA octree equals the CPU one bit for bit, after a build (fixed and
 // automatic depth) and after each update path: both run the same steps in
 // the same order (OctreeDriver.h), and CUDA rounds like the CPU.
-TEST(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
+TEST_F(OctreeCUDA, EqualsTheCpuOctreeBitForBit)
 {
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    GTEST_SKIP() << "CUDA backend not usable here: " << why;
-  }
   auto cpu = CreateEngine(Backend::CPU);
   auto gpu = CreateEngine(Backend::CUDA);
   auto expectSame = [&](const char* what) {

@@ -710,14 +710,12 @@ TEST(PacketTraversal, CpuPicturesAreThePixelByPixelOnes)
   }
 }
 
+// Suites that only the CUDA backend has: skipped, saying why, without a GPU.
+using RenderCUDA = CudaOnlyTest;
+
 // The CUDA picture against the CPU one (the reference), per mode.
-TEST(RenderCUDA, ImagesEqualTheCpuBackend)
+TEST_F(RenderCUDA, ImagesEqualTheCpuBackend)
 {
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    GTEST_SKIP() << "CUDA backend not usable here: " << why;
-  }
   Cloud c = GaussianClusters(20000, 46);
   BuildOptions options;
   options.depth = 8;
@@ -765,13 +763,8 @@ TEST(RenderCUDA, ImagesEqualTheCpuBackend)
 
 // A viewport taller than the CUDA grid's y limit (65535 blocks of 8 rows):
 // every row is still traced, and equals the CPU's.
-TEST(RenderCUDA, ViewportTallerThanTheGridEqualsTheCpu)
+TEST_F(RenderCUDA, ViewportTallerThanTheGridEqualsTheCpu)
 {
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    GTEST_SKIP() << "CUDA backend not usable here: " << why;
-  }
   const Cloud c = GaussianClusters(5000, 48);
   BuildOptions options;
   options.depth = 6;

@@ -2,6 +2,8 @@
 // and a brute-force reference octree written independently of the engine.
 #pragma once
 
+#include "CudaOnlyTest.h"
+
 #include <octoray/Engine.h>
 
 #include <gtest/gtest.h>
@@ -147,10 +149,10 @@ class BackendTest : public ::testing::TestWithParam<Backend>
 protected:
   void SetUp() override
   {
-    std::string why;
-    if (GetParam() == Backend::CUDA && !CudaAvailable(&why))
+    const std::string why = GetParam() == Backend::CUDA ? CudaSkipReason() : std::string();
+    if (!why.empty())
     {
-      GTEST_SKIP() << "CUDA backend not usable here: " << why;
+      GTEST_SKIP() << why;
     }
     engine = CreateEngine(GetParam());
   }

@@ -17,6 +17,14 @@ if(NOT OCTORAY_ENABLE_CUDA STREQUAL "OFF")
     endif()
     enable_language(CUDA)
     set(OCTORAY_HAVE_CUDA ON)
+    # The options of nvcc for code that runs the build driver's loops (the
+    # engine, and the tests of its CUDA device). --fmad=false: no fused
+    # multiply-add contraction, so that device float arithmetic rounds
+    # exactly like the CPU backend's and the two backends make the same
+    # pictures (the CPU backend is the reference in tests).
+    # --extended-lambda: the loops of the shared build driver are lambdas
+    # that run on the GPU (OCTORAY_LAMBDA, Config.h).
+    set(OCTORAY_CUDA_OPTIONS --expt-relaxed-constexpr --extended-lambda -lineinfo --fmad=false)
   elseif(OCTORAY_ENABLE_CUDA STREQUAL "ON")
     message(FATAL_ERROR "OCTORAY_ENABLE_CUDA=ON but no CUDA compiler was found")
   endif()

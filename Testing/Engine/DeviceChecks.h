@@ -1,0 +1,339 @@
+// The device primitives under the build driver (OctreeDriver.h's device
+// interface) against plain references, written once for both devices:
+// TestDevice.cpp runs each check on the CPU device split over one to three
+// threads, TestCudaDevice.cu on the GPU, at sizes that span its blocks and
+// warp tiles. The arrays a primitive reads and writes live where the
+// device's loops read them (DeviceArray) and come back to the host to be
+// compared.
+#pragma once
+
+#include <octoray/OctreeDriver.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace octoray
+{
+namespace checks
+{
+// An array in the device's memory, made from a host vector and read back.
+template <class Device, typename T>
+class DeviceArray
+{
+public:
+  DeviceArray(Device& d, const std::vector<T>& host)
+    : D(d)
+  {
+    D.Upload(Data, host.data(), host.size(), "test array");
+  }
+  DeviceArray(Device& d, std::size_t n, T fill)
+    : DeviceArray(d, std::vector<T>(n, fill))
+  {
+  }
+  T* Get() { return Data.Get(); }
+  std::vector<T> Host() const
+  {
+    std::vector<T> host;
+    D.Download(Data, host);
+    return host;
+  }
+
+private:
+  Device& D;
+  typename Device::template Buffer<T> Data;
+};
+
+// n random keys below 2^bits.
+inline std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint64_t seed)
+{
+  std::mt19937_64 rng(seed);
+  std::vector<std::uint64_t> keys(n);
+  for (auto& k : keys)
+  {
+    k = rng() & ((std::uint64_t(1) << bits) - 1);
+  }
+  return keys;
+}
+
+// ForEach calls every item once, Reduce combines every item, Histogram adds
+// each item to its two bins (or one: -1 is none) on top of what the counts
+// held.
+template <class Device>
+void ExpectLoopsCoverEveryItemOnce(Device& d, std::size_t n)
+{
+  DeviceArray<Device, int> seen(d, n, 0);
+  int* out = seen.Get();
+  d.ForEach("test", n, OCTORAY_LAMBDA(std::size_t i) { out[i] += 1; });
+  const std::vector<int> calls = seen.Host();
+  EXPECT_EQ(std::count(calls.begin(), calls.end(), 1), static_cast<long>(n));
+
+  const std::uint64_t sum = d.Reduce(
+    n, std::uint64_t(0), OCTORAY_LAMBDA(std::size_t i) { return std::uint64_t(i * i); },
+    OCTORAY_LAMBDA(std::uint64_t a, std::uint64_t b) { return a + b; });
+  std::uint64_t expected = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    expected += i * i;
+  }
+  EXPECT_EQ(sum, expected);
+
+  constexpr int kBins = 7;
+  std::vector<std::uint64_t> reference(kBins, 0);
+  reference[0] = 5; // added to, not replaced
+  DeviceArray<Device, std::uint64_t> counts(d, reference);
+  d.template Histogram<kBins>("test", n, OCTORAY_LAMBDA(std::size_t i) {
+    return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
+  }, counts.Get());
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    ++reference[i % 3];
+    if (i % 2 == 0)
+    {
+      ++reference[3 + i % 4];
+    }
+  }
+  EXPECT_EQ(counts.Host(), reference);
+}
+
+// Select keeps the selected items in order and writes their count.
+template <class Device>
+void ExpectSelectKeepsOrderAndCounts(Device& d, std::size_t n)
+{
+  DeviceArray<Device, std::uint32_t> out(d, n + 1, 0xDEADBEEFu);
+  DeviceArray<Device, std::uint64_t> count(d, 1, 12345);
+  const auto selected = OCTORAY_LAMBDA(std::size_t i) { return (i * 7919) % 5 < 2; };
+  d.Select(n, selected, out.Get(), count.Get());
+  std::vector<std::uint32_t> expected;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (selected(i))
+    {
+      expected.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  ASSERT_EQ(count.Host()[0], expected.size());
+  const std::vector<std::uint32_t> kept = out.Host();
+  EXPECT_TRUE(std::equal(expected.begin(), expected.end(), kept.begin()));
+}
+
+// Nested lists against their definition, item by item: list l holds, in
+// order, the items whose first list is l or less (the last list the items
+// themselves, each other list an item's place in the next), then the size
+// of the next list; the counts are those of each first list. First lists
+// past the last (an item in no list) come too. The lists before the last
+// go end to end, and only where they fit: with one entry too few, the last
+// list alone.
+template <class Device>
+void ExpectNestedListsHoldEachItemFromItsFirstListOn(Device& d, std::size_t n)
+{
+  constexpr int kLists = 5;
+  const auto firstList = OCTORAY_LAMBDA(std::size_t i) { return static_cast<int>((i * 7919 + i / 3) % 7); };
+  typename Device::template Buffer<std::uint32_t> tally;
+  DeviceArray<Device, std::uint64_t> counts(d, kLists, 0);
+  d.CountNested("test", n, kLists, firstList, tally, counts.Get());
+  std::vector<std::vector<std::uint32_t>> expected(kLists);
+  std::vector<std::uint64_t> expectedCounts(kLists, 0);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const int first = firstList(i);
+    std::uint32_t below = static_cast<std::uint32_t>(i);
+    for (int l = kLists - 1; l >= first; --l)
+    {
+      expected[l].push_back(below);
+      below = static_cast<std::uint32_t>(expected[l].size() - 1);
+    }
+    if (first < kLists)
+    {
+      ++expectedCounts[first];
+    }
+  }
+  for (int l = kLists - 1; l >= 0; --l) // after its items, the next list's size (without its own end)
+  {
+    expected[l].push_back(l + 1 < kLists ? static_cast<std::uint32_t>(expected[l + 1].size() - 1)
+                                         : static_cast<std::uint32_t>(n));
+  }
+  std::vector<std::uint32_t> packed;
+  for (int l = 0; l + 1 < kLists; ++l)
+  {
+    packed.insert(packed.end(), expected[l].begin(), expected[l].end());
+  }
+  for (const std::size_t room : { packed.size(), packed.size() - 1 })
+  {
+    DeviceArray<Device, std::uint32_t> last(d, n + 1, 0xDEADBEEFu);
+    DeviceArray<Device, std::uint32_t> packedOut(d, packed.size(), 0xDEADBEEFu);
+    d.PlaceNested("test", n, firstList, tally, NestedLists{ kLists, last.Get(), packedOut.Get(), room });
+    const std::vector<std::uint32_t> lastOut = last.Host();
+    EXPECT_TRUE(std::equal(expected[kLists - 1].begin(), expected[kLists - 1].end(), lastOut.begin())) << room;
+    EXPECT_EQ(packedOut.Host() == packed, room == packed.size()) << room;
+  }
+  EXPECT_EQ(counts.Host(), expectedCounts);
+}
+
+// Keys and values sorted stably by the key's low `bits` bits: the
+// reference the sorts are held to.
+template <typename Key, typename Value>
+std::vector<std::pair<Key, Value>> StablySorted(const std::vector<Key>& keys, const std::vector<Value>& values,
+  int bits)
+{
+  const Key mask = static_cast<Key>(bits >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << bits) - 1);
+  std::vector<std::pair<Key, Value>> pairs;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+  {
+    pairs.emplace_back(keys[i], values[i]);
+  }
+  std::stable_sort(pairs.begin(), pairs.end(),
+    [mask](const auto& a, const auto& b) { return (a.first & mask) < (b.first & mask); });
+  return pairs;
+}
+
+// The sorted arrays against the reference, position by position.
+template <typename Key, typename Value>
+void ExpectPairsEqual(const std::vector<Key>& keys, const std::vector<Value>& values,
+  const std::vector<std::pair<Key, Value>>& reference)
+{
+  for (std::size_t i = 0; i < reference.size(); ++i)
+  {
+    ASSERT_EQ(keys[i], reference[i].first) << "position " << i;
+    ASSERT_EQ(values[i], reference[i].second) << "position " << i;
+  }
+}
+
+// SortPairs: stable, for both key widths with 32-bit values and for 32-bit
+// keys with 64-bit ones (a leaf key with a record of two words), keys below
+// 2^bits (the passes cover `bits`), with the result where the return value
+// says.
+template <typename Key, typename Value, class Device>
+void ExpectStableSort(Device& d, std::size_t n, int bits, std::uint64_t seed)
+{
+  SCOPED_TRACE("bits " + std::to_string(bits) + ", values of " + std::to_string(8 * sizeof(Value)) + " bits");
+  const std::vector<std::uint64_t> random = RandomKeys(n, bits, seed);
+  const std::vector<Key> k(random.begin(), random.end());
+  std::vector<Value> v(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    v[i] = static_cast<Value>(i);
+    if constexpr (sizeof(Value) == 8)
+    {
+      v[i] |= ~static_cast<Value>(i) << 32; // both halves travel
+    }
+  }
+  DeviceArray<Device, Key> k0(d, k), k1(d, n, 0);
+  DeviceArray<Device, Value> v0(d, v), v1(d, n, 0);
+  Key* keys[2] = { k0.Get(), k1.Get() };
+  Value* values[2] = { v0.Get(), v1.Get() };
+  const int result = d.SortPairs(keys, values, n, bits, "test");
+  ASSERT_TRUE(result == 0 || result == 1);
+  ExpectPairsEqual((result ? k1 : k0).Host(), (result ? v1 : v0).Host(), StablySorted(k, v, bits));
+}
+
+// SortPairsFrom: the same order as a stable sort, the values written to
+// their own array and their input left as it is; keys of `keyBits` random
+// bits sorted by `bits`, so that passes over all-zero digits are skipped
+// (which changes where the passes end).
+template <typename Key, typename Value, class Device>
+void ExpectSortFromLeavesItsInput(Device& d, std::size_t n, int bits, int keyBits, std::uint64_t seed)
+{
+  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(keyBits));
+  const std::vector<std::uint64_t> random = RandomKeys(n, keyBits, seed);
+  const std::vector<Key> k(random.begin(), random.end());
+  std::vector<Value> v(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    v[i] = static_cast<Value>(~i);
+  }
+  DeviceArray<Device, Key> k0(d, k), k1(d, n, 0);
+  DeviceArray<Device, Value> in(d, v), out(d, n, 0);
+  Key* keys[2] = { k0.Get(), k1.Get() };
+  const int result = d.SortPairsFrom(keys, in.Get(), out.Get(), n, bits, "test");
+  ASSERT_TRUE(result == 0 || result == 1);
+  EXPECT_EQ(in.Host(), v) << "the input values changed";
+  ExpectPairsEqual((result ? k1 : k0).Host(), out.Host(), StablySorted(k, v, bits));
+}
+
+// SortKeys: the keys alone, by their low `bits`, with random bits above
+// them that tell apart keys the sort sees as equal: stable (the last pass
+// masks its digit at `bits`).
+template <typename Key, class Device>
+void ExpectStableKeySort(Device& d, std::size_t n, int bits, std::uint64_t seed)
+{
+  SCOPED_TRACE("bits " + std::to_string(bits) + " of keys of " + std::to_string(8 * sizeof(Key)));
+  const std::vector<std::uint64_t> random = RandomKeys(n, 8 * sizeof(Key) - 1, seed);
+  const std::vector<Key> k(random.begin(), random.end());
+  DeviceArray<Device, Key> k0(d, k), k1(d, n, 0);
+  Key* keys[2] = { k0.Get(), k1.Get() };
+  const int result = d.SortKeys(keys, n, bits, "test");
+  ASSERT_TRUE(result == 0 || result == 1);
+  const std::vector<std::pair<Key, Key>> reference = StablySorted(k, k, bits);
+  const std::vector<Key> sorted = (result ? k1 : k0).Host();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    ASSERT_EQ(sorted[i], reference[i].first) << "position " << i;
+  }
+}
+
+// Every sort, both key widths and both value widths, over full and
+// partial key bits.
+template <class Device>
+void ExpectSortsStable(Device& d, std::size_t n, std::uint64_t seed)
+{
+  ExpectStableSort<std::uint64_t, std::uint32_t>(d, n, 63, seed);
+  ExpectStableSort<std::uint64_t, std::uint32_t>(d, n, 30, seed);
+  ExpectStableSort<std::uint32_t, std::uint32_t>(d, n, 29, seed);
+  ExpectStableSort<std::uint32_t, std::uint32_t>(d, n, 5, seed);
+  ExpectStableSort<std::uint32_t, std::uint64_t>(d, n, 30, seed);
+  ExpectStableSort<std::uint32_t, std::uint64_t>(d, n, 6, seed);
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(d, n, 30, 30, seed); // 3 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint64_t>(d, n, 30, 20, seed); // the third skipped
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(d, n, 24, 24, seed); // 3 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(d, n, 12, 12, seed); // 2 passes
+  ExpectSortFromLeavesItsInput<std::uint32_t, std::uint32_t>(d, n, 12, 0, seed);  // none moves
+  ExpectStableKeySort<std::uint64_t>(d, n, 30, seed);
+  ExpectStableKeySort<std::uint64_t>(d, n, 3, seed);
+  ExpectStableKeySort<std::uint64_t>(d, n, 29, seed);
+  ExpectStableKeySort<std::uint32_t>(d, n, 30, seed);
+  ExpectStableKeySort<std::uint32_t>(d, n, 5, seed);
+}
+
+// The driver's run starts (a Select) and first failing step (a loop and an
+// atomic minimum), against their definitions.
+template <class Device>
+void ExpectRunStartsAndFirstFailedStep(Device& d, std::size_t n)
+{
+  DriverScratch<Device> scratch;
+  d.Reserve(scratch.counters, kCounterSlots, "counters");
+  std::vector<std::uint64_t> keys = RandomKeys(n, 12, n);
+  std::sort(keys.begin(), keys.end());
+  DeviceArray<Device, std::uint64_t> deviceKeys(d, keys);
+  DeviceArray<Device, std::uint32_t> starts(d, n + 1, 0);
+  RunStarts(d, scratch, deviceKeys.Get(), n, starts.Get());
+  std::vector<std::uint32_t> expected;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (i == 0 || keys[i] != keys[i - 1])
+    {
+      expected.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  expected.push_back(static_cast<std::uint32_t>(n));
+  std::uint64_t selected = 0;
+  d.ToHost(scratch.counters.Get() + kCounterSelected, 1, &selected, "test");
+  EXPECT_EQ(selected, expected.size());
+  const std::vector<std::uint32_t> found = starts.Host();
+  EXPECT_TRUE(std::equal(expected.begin(), expected.end(), found.begin()));
+  const std::size_t bad = n / 3 + 1;
+  std::uint64_t first = kNoIndex;
+  for (std::size_t i = n; i-- > 0;)
+  {
+    first = i >= bad && i % 2 == 0 ? i : first;
+  }
+  EXPECT_EQ(FirstFailedStep(d, scratch, "test", n, OCTORAY_LAMBDA(std::size_t i) { return i < bad || i % 2; }),
+    first);
+}
+}
+}

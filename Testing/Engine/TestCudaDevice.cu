@@ -1,0 +1,61 @@
+// The CUDA device's primitives under the build driver, held to the same
+// checks as the CPU device's (DeviceChecks.h), at sizes that take one to
+// thousands of blocks: the whole-octree tests compare the two backends'
+// results, and these say which primitive differs. Compiled by nvcc with the
+// engine's CUDA options where the CUDA backend is built.
+#include "CudaOnlyTest.h"
+#include "DeviceChecks.h"
+
+#include <octoray/CudaDevice.h>
+
+// In octoray's namespace, not with a using-directive: nvcc's generated host
+// code names CUDA's own `cuda` namespace, which octoray::cuda would hide.
+namespace octoray::test
+{
+namespace
+{
+// Empty, one item, less than a block, part of a nested-list warp tile, one
+// tile and one item more, and enough items for every histogram block and
+// for several passes of the CUB kernels' tiles.
+const std::size_t kSizes[] = { 0, 1, 5, 200, cuda::kNestedWarpTile + 1, 100003, 1000003 };
+
+// check(n, device) for every size, on a fresh device each.
+template <typename Check>
+void OnEverySize(Check&& check)
+{
+  for (std::size_t n : kSizes)
+  {
+    SCOPED_TRACE("n " + std::to_string(n));
+    CudaDevice d(-1);
+    check(n, d);
+  }
+}
+}
+
+using CudaDeviceCUDA = CudaOnlyTest;
+
+TEST_F(CudaDeviceCUDA, ForEachReduceAndHistogramCoverEveryItemOnce)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectLoopsCoverEveryItemOnce(d, n); });
+}
+
+TEST_F(CudaDeviceCUDA, SelectKeepsOrderAndCounts)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectSelectKeepsOrderAndCounts(d, n); });
+}
+
+TEST_F(CudaDeviceCUDA, NestedListsHoldEachItemFromItsFirstListOn)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectNestedListsHoldEachItemFromItsFirstListOn(d, n); });
+}
+
+TEST_F(CudaDeviceCUDA, SortsAreStable)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectSortsStable(d, n, n); });
+}
+
+TEST_F(CudaDeviceCUDA, RunStartsAndFirstFailedStep)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectRunStartsAndFirstFailedStep(d, n); });
+}
+}
