@@ -166,6 +166,69 @@ def repeated_call_ratios(ctx, n):
         return [float(m.group(1)) for m in map(pattern.search, f) if m]
 
 
+# The twenty-seventh session's runs on an NVIDIA H200 (COMMAND.md): the
+# benchmark, and two variants built beside main and run in turn. Their
+# "summary n=..." lines are scripts/gpu/build-ratios.py's, under a line
+# "== source-NAME" for each variant of a variants file.
+H200_BENCH_FILE = "bench-h200.txt"
+H200_VARIANTS = (
+    ("variants-staging-one-stream.txt", "one",
+     "every staging thread's DMA queued on one copy stream, where each thread has its own"),
+    ("variants-nested-tiles4.txt", "tiles4", "the nested lists in warp tiles of 4 rounds, where they hold 8"),
+)
+
+
+def summary_ratios(path, n):
+    """{variant: {"phases", "floor" (ms), "ratio" (phases / floor), "call"
+    (whole call / pinned copy): [one a summary line]}} of the summary lines
+    at n points; the variant None before any "== source-" line."""
+    variant, found = None, {}
+    pattern = re.compile(r"summary n=%d: phases ([0-9.]+) ms, floor ([0-9.]+) ms, phases / floor ([0-9.]+), "
+                         r"call / pinned copy ([0-9.]+)" % n)
+    with open(path) as f:
+        for line in f:
+            header = re.match(r"^== source-(\S+)", line)
+            if header:
+                variant = header.group(1)
+            m = pattern.search(line)
+            if m:
+                figures = found.setdefault(variant, {k: [] for k in ("phases", "floor", "ratio", "call")})
+                for k, value in zip(("phases", "floor", "ratio", "call"), m.groups()):
+                    figures[k].append(float(value))
+    return found
+
+
+def spread(values, form="%.2f"):
+    return (form + "–" + form) % (min(values), max(values)) if values else "–"
+
+
+def _h200(ctx):
+    """The H200's rounds beside the report's H100 run, from their files."""
+    bench = ctx.gpu_file(H200_BENCH_FILE)
+    if not bench:
+        return []
+    none = {k: [] for k in ("phases", "floor", "ratio", "call")}
+    runs = {n: summary_ratios(bench, n).get(None, none) for n in (10000000, 100000000)}
+    ten, hundred = runs[10000000], runs[100000000]
+    text = ("**On an NVIDIA H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): over "
+            "%d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
+            "read %s times the sort (%s at 100 M points); the whole call %s times the pinned copy at 10 M points "
+            "and %s at 100 M." % (
+                H200_BENCH_FILE, H200_BENCH_FILE, len(ten["ratio"]), spread(ten["phases"], "%.3f"),
+                spread(ten["floor"], "%.3f"), spread(ten["ratio"]), spread(hundred["ratio"]), spread(ten["call"]),
+                spread(hundred["call"])))
+    for name, variant, tried in H200_VARIANTS:
+        path = ctx.gpu_file(name)
+        if not path:
+            continue
+        main, other = (summary_ratios(path, 10000000).get(v, none) for v in ("main", variant))
+        text += (" Built beside main and run in turn there, %s: at 10 M points %s times the sort against %s, the "
+                 "whole call %s times the pinned copy against %s; not kept ([gpu/%s](gpu/%s))." % (
+                     tried, spread(other["ratio"]), spread(main["ratio"]), spread(other["call"]),
+                     spread(main["call"]), name, name))
+    return [text, ""]
+
+
 STEPS_FILE = "profile-build-10m.txt"
 
 
@@ -726,7 +789,7 @@ def _cuda(ctx):
                 "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
                 "wrote.",
                 "",
-            ]
+            ] + _h200(ctx)
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")

@@ -43,6 +43,51 @@ def test_counts(xml_path):
 
 RACECHECK_SUMMARY = "summary-racecheck.txt"
 
+# The CUDA device's primitives against the CPU device's checks, on an H200
+# (the twenty-seventh session's calls, COMMAND.md): a part "== call N, what"
+# of the file each.
+DEVICE_CHECKS_FILE = "engine-tests-cuda-device.txt"
+
+
+def file_parts(path):
+    """{header: [lines]} of a file whose parts start with "== header"."""
+    parts, current = {}, None
+    with open(path) as f:
+        for line in f:
+            if line.startswith("== "):
+                current = parts.setdefault(line[3:].strip(), [])
+            elif current is not None:
+                current.append(line.rstrip("\n"))
+    return parts
+
+
+def _device_checks(ctx):
+    """What the file says of the CUDA device's primitive tests."""
+    path = ctx.gpu_file(DEVICE_CHECKS_FILE)
+    if not path:
+        return []
+    parts = file_parts(path)
+    lines = [line for part in parts.values() for line in part]
+    tests = [line for line in parts.get("call 1, engine tests (CudaDeviceCUDA)", []) if "] CudaDeviceCUDA." in line]
+    passed = sum("OK ] CudaDeviceCUDA." in line for line in tests)
+    sabotaged = sum("FAILED  ] CudaDeviceCUDA." in line for line in parts.get("call 2, the sabotaged copy", []))
+    tools = []
+    for tool in ("memcheck", "initcheck", "synccheck"):
+        found = next((re.search(r"ERROR SUMMARY: (.*)$", line) for line in lines if line.startswith(tool + ":")), None)
+        tools.append("%s %s" % (tool, found.group(1) if found else "not run"))
+    race = next((re.search(r"RACECHECK SUMMARY: (.*)$", line) for line in parts.get("call 5, racecheck", [])
+                 if "RACECHECK SUMMARY" in line), None)
+    tools.append("racecheck %s" % (race.group(1) if race else "not run"))
+    return [
+        "The CUDA device's primitives under the build driver (ForEach, Reduce, Histogram, Select, the nested "
+        "lists, every sort, the run starts and the first failing step) are held to the CPU device's checks "
+        "(Testing/Engine/DeviceChecks.h, suite `CudaDeviceCUDA`). On an NVIDIA H200 (the twenty-seventh "
+        "session's calls, [gpu/%s](gpu/%s)): %d of %d passed; compute-sanitizer over them: %s; built against "
+        "a CudaDevice.h that drops an item or a key bit in each primitive, %d of %d failed."
+        % (DEVICE_CHECKS_FILE, DEVICE_CHECKS_FILE, passed, len(tests), "; ".join(tools), sabotaged, len(tests)),
+        "",
+    ]
+
 
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
@@ -106,6 +151,7 @@ def render(ctx):
         *steps,
         "```",
         "",
+        *_device_checks(ctx),
         "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",
         "plugin (ParaView is not built there); its CPU backend runs in `make test`.",
     ]
