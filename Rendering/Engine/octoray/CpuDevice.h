@@ -363,7 +363,7 @@ public:
   template <typename Key, typename Value>
   int SortPairs(Key* const keys[2], Value* const values[2], std::size_t n, int bits, const char*)
   {
-    return RadixSort(keys[0], values[0], n, 0, bits, threads, keys[1], values[1]);
+    return RadixSort(keys[0], values[0], n, bits, threads, keys[1], values[1]);
   }
 
   // SortPairs with the values read from valuesIn, which stays as it is,
@@ -375,7 +375,7 @@ public:
     // The values end beside their keys: in valuesOut where the passes end
     // in the keys' second array.
     const bool odd = RadixSortPasses(bits) % 2 == 1;
-    const int result = RadixSort(keys[0], odd ? second : valuesOut, n, 0, bits, threads, keys[1],
+    const int result = RadixSort(keys[0], odd ? second : valuesOut, n, bits, threads, keys[1],
       odd ? valuesOut : second, valuesIn);
     if ((result == 1) != odd) // a pass was skipped
     {
@@ -387,7 +387,7 @@ public:
   template <typename Key>
   int SortKeys(Key* const keys[2], std::size_t n, int bits, const char*)
   {
-    return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, 0, bits, threads, keys[1], nullptr);
+    return RadixSort<Key, std::uint32_t>(keys[0], nullptr, n, bits, threads, keys[1], nullptr);
   }
 
 private:

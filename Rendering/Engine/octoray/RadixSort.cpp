@@ -17,10 +17,9 @@ int RadixSortPasses(int bits)
 }
 
 template <typename Key, typename Value>
-int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit, int threads, Key* scratchKeys,
-  Value* scratchValues, const Value* valuesIn)
+int RadixSort(Key* keys, Value* values, std::size_t n, int bits, int threads, Key* scratchKeys, Value* scratchValues,
+  const Value* valuesIn)
 {
-  const int bits = endBit - beginBit;
   if (n < 2 || bits <= 0)
   {
     if (valuesIn)
@@ -46,9 +45,9 @@ int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit,
 
   for (int pass = 0; pass < passes; ++pass)
   {
-    const int shift = beginBit + pass * digitBits;
-    // The last digit may be narrower: bits from endBit on do not count.
-    const std::uint64_t digitMask = (std::uint64_t(1) << std::min(digitBits, endBit - shift)) - 1;
+    const int shift = pass * digitBits;
+    // The last digit may be narrower: bits from `bits` on do not count.
+    const std::uint64_t digitMask = (std::uint64_t(1) << std::min(digitBits, bits - shift)) - 1;
     std::fill(histogram.begin(), histogram.end(), 0);
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::size_t* h = histogram.data() + c * buckets;
@@ -113,10 +112,10 @@ int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit,
   return srcK == keys ? 0 : 1;
 }
 
-template int RadixSort(std::uint64_t*, std::uint32_t*, std::size_t, int, int, int, std::uint64_t*, std::uint32_t*,
+template int RadixSort(std::uint64_t*, std::uint32_t*, std::size_t, int, int, std::uint64_t*, std::uint32_t*,
   const std::uint32_t*);
-template int RadixSort(std::uint32_t*, std::uint32_t*, std::size_t, int, int, int, std::uint32_t*, std::uint32_t*,
+template int RadixSort(std::uint32_t*, std::uint32_t*, std::size_t, int, int, std::uint32_t*, std::uint32_t*,
   const std::uint32_t*);
-template int RadixSort(std::uint32_t*, std::uint64_t*, std::size_t, int, int, int, std::uint32_t*, std::uint64_t*,
+template int RadixSort(std::uint32_t*, std::uint64_t*, std::size_t, int, int, std::uint32_t*, std::uint64_t*,
   const std::uint64_t*);
 }

@@ -1,5 +1,5 @@
 // CPU least-significant-digit radix sort of keys, alone or with a value
-// each, by the bits [beginBit, endBit) of the keys; multi-threaded, stable.
+// each, by the keys' low `bits` bits; multi-threaded, stable.
 #pragma once
 
 #include <cstddef>
@@ -19,6 +19,6 @@ int RadixSortPasses(int bits);
 // std::uint32_t, or std::uint64_t with 32-bit keys (a leaf key and a point's
 // record of two words, OctreeKernels.h's SortedKeys).
 template <typename Key, typename Value = std::uint32_t>
-int RadixSort(Key* keys, Value* values, std::size_t n, int beginBit, int endBit, int threads, Key* scratchKeys,
-  Value* scratchValues, const Value* valuesIn = nullptr);
+int RadixSort(Key* keys, Value* values, std::size_t n, int bits, int threads, Key* scratchKeys, Value* scratchValues,
+  const Value* valuesIn = nullptr);
 }
