@@ -189,6 +189,20 @@ class Context:
         return "\n".join(lines)
 
 
+def file_parts(path):
+    """{header: [lines]} of a GPU record whose parts start with "== header"
+    (Benchmarks/gpu's tests and variants files); lines before the first
+    header are left out."""
+    parts, current = {}, None
+    with open(path) as f:
+        for line in f:
+            if line.startswith("== "):
+                current = parts.setdefault(line[3:].strip(), [])
+            elif current is not None:
+                current.append(line.rstrip("\n"))
+    return parts
+
+
 def load_section(name):
     try:
         return importlib.import_module("section_" + name)

@@ -5,7 +5,7 @@ import json
 import os
 import re
 
-from make_report import Section
+from make_report import Section, file_parts
 import scenes
 
 TITLE = "Octree build"
@@ -178,23 +178,23 @@ H200_VARIANTS = (
 )
 
 
-def summary_ratios(path, n):
-    """{variant: {"phases", "floor" (ms), "ratio" (phases / floor), "call"
-    (whole call / pinned copy): [one a summary line]}} of the summary lines
-    at n points; the variant None before any "== source-" line."""
-    variant, found = None, {}
-    pattern = re.compile(r"summary n=%d: phases ([0-9.]+) ms, floor ([0-9.]+) ms, phases / floor ([0-9.]+), "
-                         r"call / pinned copy ([0-9.]+)" % n)
-    with open(path) as f:
-        for line in f:
-            header = re.match(r"^== source-(\S+)", line)
-            if header:
-                variant = header.group(1)
-            m = pattern.search(line)
-            if m:
-                figures = found.setdefault(variant, {k: [] for k in ("phases", "floor", "ratio", "call")})
-                for k, value in zip(("phases", "floor", "ratio", "call"), m.groups()):
-                    figures[k].append(float(value))
+SUMMARY_FIGURES = ("phases", "floor", "ratio", "call")
+
+
+def summary_figures(path):
+    """{(variant, n): {figure: [one a summary line]}} of a GPU record's
+    summary lines: "phases" and "floor" in ms, "ratio" (phases / floor) and
+    "call" (whole call / pinned copy); the variant is NAME under a part
+    "== source-NAME", else None."""
+    pattern = re.compile(r"summary n=(\d+): phases ([0-9.]+) ms, floor ([0-9.]+) ms, phases / floor ([0-9.]+), "
+                         r"call / pinned copy ([0-9.]+)")
+    found = {}
+    for header, lines in file_parts(path).items():
+        variant = header[len("source-"):] if header.startswith("source-") else None
+        for m in filter(None, map(pattern.search, lines)):
+            figures = found.setdefault((variant, int(m.group(1))), {k: [] for k in SUMMARY_FIGURES})
+            for k, value in zip(SUMMARY_FIGURES, m.groups()[1:]):
+                figures[k].append(float(value))
     return found
 
 
@@ -207,9 +207,9 @@ def _h200(ctx):
     bench = ctx.gpu_file(H200_BENCH_FILE)
     if not bench:
         return []
-    none = {k: [] for k in ("phases", "floor", "ratio", "call")}
-    runs = {n: summary_ratios(bench, n).get(None, none) for n in (10000000, 100000000)}
-    ten, hundred = runs[10000000], runs[100000000]
+    none = {k: [] for k in SUMMARY_FIGURES}
+    runs = summary_figures(bench)
+    ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
     text = ("**On an NVIDIA H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): over "
             "%d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
             "read %s times the sort (%s at 100 M points); the whole call %s times the pinned copy at 10 M points "
@@ -221,7 +221,8 @@ def _h200(ctx):
         path = ctx.gpu_file(name)
         if not path:
             continue
-        main, other = (summary_ratios(path, 10000000).get(v, none) for v in ("main", variant))
+        rounds = summary_figures(path)
+        main, other = (rounds.get((v, 10000000), none) for v in ("main", variant))
         text += (" Built beside main and run in turn there, %s: at 10 M points %s times the sort against %s, the "
                  "whole call %s times the pinned copy against %s; not kept ([gpu/%s](gpu/%s))." % (
                      tried, spread(other["ratio"]), spread(main["ratio"]), spread(other["call"]),

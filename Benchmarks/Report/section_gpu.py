@@ -6,7 +6,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section
+from make_report import Section, file_parts
 
 TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
 
@@ -47,18 +47,6 @@ RACECHECK_SUMMARY = "summary-racecheck.txt"
 # (the twenty-seventh session's calls, COMMAND.md): a part "== call N, what"
 # of the file each.
 DEVICE_CHECKS_FILE = "engine-tests-cuda-device.txt"
-
-
-def file_parts(path):
-    """{header: [lines]} of a file whose parts start with "== header"."""
-    parts, current = {}, None
-    with open(path) as f:
-        for line in f:
-            if line.startswith("== "):
-                current = parts.setdefault(line[3:].strip(), [])
-            elif current is not None:
-                current.append(line.rstrip("\n"))
-    return parts
 
 
 def _device_checks(ctx):
