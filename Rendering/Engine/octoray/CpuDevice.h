@@ -114,7 +114,8 @@ public:
   };
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* host, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr)
+    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
+    const std::function<void(const R&, const T*)>& whenReduced = nullptr)
   {
     if (prepareAlong)
     {
@@ -122,6 +123,10 @@ public:
       prepareAlong(none);
     }
     result = Reduce(n / stride, identity, [&](std::size_t i) { return map(i, host); }, combine);
+    if (host && whenReduced)
+    {
+      whenReduced(result, host);
+    }
     return Stage(host, n, what);
   }
   template <typename T>

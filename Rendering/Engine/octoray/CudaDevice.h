@@ -514,10 +514,14 @@ public:
   // taken first, it left the build's level phase at 10 M points 0.15 ms
   // slower in two calls, though not with other piece sizes
   // (Benchmarks/gpu/variants-one-pass.txt; the pool's layout, not
-  // explained).
+  // explained). whenReduced(result, staged), if given, runs on the host
+  // once this array has landed and been reduced, while the arrays
+  // prepareAlong added may still be on their way (HostStaging::Copy's
+  // afterFirst): loops it queues over the array overlap their copies.
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
-    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr)
+    Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
+    const std::function<void(const R&, const T*)>& whenReduced = nullptr)
   {
     Fills along;
     const std::size_t itemBytes = stride * sizeof(T);
@@ -537,24 +541,35 @@ public:
     {
       prepareAlong(along);
     }
-    if (source)
+    if (!source)
     {
-      Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
-        "partial reductions");
-      const T* data = staged.Get();
-      R* partials = partial.Get();
-      along.insert(along.begin(), cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what,
-        [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
-          const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
-          const std::size_t slot = used.fetch_add(blocks);
-          LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
-            data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
-        } });
+      Staging.Copy(along);
+      return staged;
     }
-    Staging.Copy(along);
-    if (source)
+    Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
+      "partial reductions");
+    const T* data = staged.Get();
+    R* partials = partial.Get();
+    along.insert(along.begin(), cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what,
+      [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
+        const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
+        const std::size_t slot = used.fetch_add(blocks);
+        LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
+          data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
+      } });
+    // Every piece's partial result is queued once the array is.
+    const auto reduce = [&] { result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine); };
+    if (whenReduced)
     {
-      result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partial.Get() }, combine);
+      Staging.Copy(along, [&] {
+        reduce();
+        whenReduced(result, data);
+      });
+    }
+    else
+    {
+      Staging.Copy(along);
+      reduce();
     }
     return staged;
   }

@@ -20,6 +20,7 @@
 #include "StagingPieces.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <functional>
 #include <memory>
@@ -83,18 +84,27 @@ public:
   // staging streams do not wait for them by themselves); returns once the
   // copies and the work queued on their pieces are complete. Parts CUDA
   // copies directly go so; the others are staged in one pass.
-  void Copy(const std::vector<CopyPart>& parts)
+  // afterFirst(), if given, runs on the host as soon as the first part and
+  // the work on its pieces are queued, with the default stream waiting for
+  // them, while the other parts may still be on their way: it can queue
+  // loops over the first part that overlap the rest of the copy. It may run
+  // on a staging thread; what it throws reaches the caller once every part
+  // is copied.
+  void Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
   {
     std::vector<CopyPart> staged;
     std::vector<std::size_t> stagedBytes;
+    bool firstStaged = false;
     for (const CopyPart& part : parts)
     {
       if (DirectlyCopyable(part.source))
       {
         CopyDirectly(part);
+        RunIfFirst(part, parts, afterFirst);
       }
       else
       {
+        firstStaged = firstStaged || &part == &parts.front();
         staged.push_back(part);
         stagedBytes.push_back(part.bytes);
       }
@@ -102,16 +112,22 @@ public:
     const StagingRun run(stagedBytes);
     if (run.Length() < kStagingThreshold || !Allocate())
     {
-      std::for_each(staged.begin(), staged.end(), CopyDirectly);
+      for (const CopyPart& part : staged)
+      {
+        CopyDirectly(part);
+        RunIfFirst(part, staged, firstStaged ? afterFirst : nullptr);
+      }
       return;
     }
     int current = 0;
     CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
     CudaCheck(cudaStreamSynchronize(0), staged.front().what.c_str());
-    PieceDealer dealer(CutPieces(run, Workers->Chunks()));
+    std::vector<Piece> pieces = CutPieces(run, Workers->Chunks());
+    FirstPartWatch watch(Lanes, pieces, firstStaged ? afterFirst : nullptr);
+    PieceDealer dealer(std::move(pieces));
     Workers->Run(Lanes.size(), [&](std::size_t lane, std::size_t, int) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
-      CopyPieces(Lanes[lane], staged, dealer);
+      CopyPieces(Lanes[lane], staged, dealer, watch);
     });
   }
 
@@ -122,6 +138,49 @@ private:
     cudaStream_t stream = nullptr;
     void* pinned[2] = { nullptr, nullptr };
     cudaEvent_t copied[2] = { nullptr, nullptr };
+    cudaEvent_t firstQueued = nullptr; // after this lane's last piece of a copy's first part
+  };
+
+  // Runs a copy's afterFirst once the lanes have queued every piece of
+  // its first part: each lane marks its stream after each such piece, and
+  // the lane that queues the last one makes the default stream wait for
+  // every lane's mark. A lane that took none in this copy holds a mark
+  // long passed, or none, which the default stream does not wait for.
+  class FirstPartWatch
+  {
+  public:
+    FirstPartWatch(const std::vector<Lane>& lanes, const std::vector<Piece>& pieces, std::function<void()> then)
+      : Lanes(lanes)
+      , Then(std::move(then))
+      , Left(std::count_if(pieces.begin(), pieces.end(), [](const Piece& p) { return p.array == 0; }))
+    {
+      if (Then && Left == 0)
+      {
+        Then();
+      }
+    }
+    // After `lane` queued a piece of array `array`.
+    void Queued(const Lane& lane, std::size_t array, const char* what)
+    {
+      if (!Then || array != 0)
+      {
+        return;
+      }
+      CudaCheck(cudaEventRecord(lane.firstQueued, lane.stream), what);
+      if (Left.fetch_sub(1) == 1)
+      {
+        for (const Lane& other : Lanes)
+        {
+          CudaCheck(cudaStreamWaitEvent(0, other.firstQueued, 0), what);
+        }
+        Then();
+      }
+    }
+
+  private:
+    const std::vector<Lane>& Lanes;
+    const std::function<void()> Then;
+    std::atomic<std::ptrdiff_t> Left;
   };
 
   // cudaMemcpy, which goes from pageable memory through the driver's own
@@ -136,10 +195,20 @@ private:
     }
   }
 
+  // afterFirst() once `part`, copied directly, is the first of `parts`.
+  static void RunIfFirst(const CopyPart& part, const std::vector<CopyPart>& parts,
+    const std::function<void()>& afterFirst)
+  {
+    if (afterFirst && &part == &parts.front())
+    {
+      afterFirst();
+    }
+  }
+
   // The pieces this lane's thread takes, through the lane's two pinned
   // buffers in turn. Returns, or throws, once the lane has finished what it
   // queued: the destinations may be freed right after.
-  static void CopyPieces(Lane& lane, const std::vector<CopyPart>& parts, PieceDealer& dealer)
+  static void CopyPieces(Lane& lane, const std::vector<CopyPart>& parts, PieceDealer& dealer, FirstPartWatch& watch)
   {
     struct Drain
     {
@@ -161,6 +230,7 @@ private:
       {
         part.landed(offset, offset + n, lane.stream);
       }
+      watch.Queued(lane, piece.array, what);
     });
     CudaCheck(cudaStreamSynchronize(lane.stream), what);
   }
@@ -184,6 +254,7 @@ private:
           cudaEventCreateWithFlags(&lane.copied[b], cudaEventDisableTiming) == cudaSuccess &&
           cudaEventRecord(lane.copied[b], lane.stream) == cudaSuccess;
       }
+      made = made && cudaEventCreateWithFlags(&lane.firstQueued, cudaEventDisableTiming) == cudaSuccess;
       if (!made)
       {
         cudaGetLastError();
@@ -210,6 +281,10 @@ private:
         {
           cudaFreeHost(lane.pinned[b]);
         }
+      }
+      if (lane.firstQueued)
+      {
+        cudaEventDestroy(lane.firstQueued);
       }
       if (lane.stream)
       {

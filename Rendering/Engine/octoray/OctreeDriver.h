@@ -98,21 +98,49 @@ struct StagedPositions
   }
 };
 
+// Work on a caller's positions once they have landed, with their bounds.
+using WhenBounded = std::function<void(const Bounds&, const PointArraysView& positions)>;
+
+// WhenBounded as Device::StageReduced's whenReduced of positions of type T.
+template <typename T>
+std::function<void(const Bounds&, const T*)> WhenStagedBounded(const WhenBounded& whenBounded, std::size_t n)
+{
+  if (!whenBounded)
+  {
+    return nullptr;
+  }
+  return [&whenBounded, n](const Bounds& b, const T* xyz) {
+    PointArraysView positions;
+    positions.count = n;
+    if constexpr (std::is_same<T, float>::value)
+    {
+      positions.xyzFloat = xyz;
+    }
+    else
+    {
+      positions.xyzDouble = xyz;
+    }
+    whenBounded(b, positions);
+  };
+}
+
 // A caller's positions staged, with their bounds (PositionBounds, and the
 // first non-finite point) reduced as the copy lands: on CUDA they cost
 // nothing beyond the upload. prepareAlong adds copies (Device::Prepare's)
-// to make in the positions' pass, once their memory is taken.
+// to make in the positions' pass, once their memory is taken, after the
+// positions; whenBounded, if given, runs once the positions have landed,
+// while those copies may still be on their way.
 template <class Device>
 StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
   std::size_t n, const char* what, Bounds& bounds,
-  const std::function<void(typename Device::Fills&)>& prepareAlong = nullptr)
+  const std::function<void(typename Device::Fills&)>& prepareAlong = nullptr, const WhenBounded& whenBounded = nullptr)
 {
   Bounds fromFloat, fromDouble;
   StagedPositions<Device> staged{
     d.StageReduced(xyzFloat, xyzFloat ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(), fromFloat,
-      xyzFloat ? prepareAlong : nullptr),
+      xyzFloat ? prepareAlong : nullptr, WhenStagedBounded<float>(whenBounded, n)),
     d.StageReduced(xyzDouble, xyzDouble ? 3 * n : 0, 3, what, EmptyBounds(), XyzPointBounds(), BoundsUnion(),
-      fromDouble, xyzFloat ? nullptr : prepareAlong)
+      fromDouble, xyzFloat ? nullptr : prepareAlong, WhenStagedBounded<double>(whenBounded, n))
   };
   bounds = BoundsUnion()(fromFloat, fromDouble);
   return staged;
@@ -481,11 +509,11 @@ SortInput ReserveSortInput(Device& d, DriverScratch<Device>& scratch, std::size_
 // record array (the state's records stay as they are); returns the sorted
 // keys and the key array the sort left free.
 template <class Device>
-SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, int bits,
+SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, int bits,
   std::uint32_t*& spare)
 {
-  const std::size_t n = s.count;
-  const int stride = s.points.layout.stride;
+  const std::size_t n = pts.count;
+  const int stride = pts.layout.stride;
   std::uint32_t* keys[2] = { scratch.narrowKey[0].Get(), scratch.narrowKey[1].Get() };
   int result = 0;
   std::uint32_t* sortedRecords = nullptr;
@@ -497,7 +525,7 @@ SortedKeys SortNarrowKeys(Device& d, DriverScratch<Device>& scratch, OctreeState
   else
   {
     d.Reserve(scratch.sortRecords, n * stride, "sort records");
-    const std::uint32_t* records = s.points.records.Get();
+    const std::uint32_t* records = pts.records;
     sortedRecords = scratch.sortRecords.Get();
     if (stride == 1)
     {
@@ -536,6 +564,41 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
     sorted.wideKey = keys[result];
   }
   return sorted;
+}
+
+// Where a sort queued before the points' records had landed sorted their
+// indices (QueueSort) and the records would have travelled with the keys,
+// copies the records in sorted order into the sort's record array, which
+// is what the travelling sort leaves: SortedKeys with records, no index.
+// One read at a random place a point, beside a sort that moved 4 more bytes
+// a point in each of its passes.
+template <class Device>
+void GatherSortedRecords(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, SortedKeys& keys)
+{
+  const int stride = pts.layout.stride;
+  if (!keys.index || !keys.narrowKey || stride == 0 || !SortedKeys::RecordsFit(stride))
+  {
+    return;
+  }
+  d.Reserve(scratch.sortRecords, pts.count * stride, "sort records");
+  std::uint32_t* sorted = scratch.sortRecords.Get();
+  const std::uint32_t* index = keys.index;
+  d.ForEach("GatherRecordsKernel", pts.count, OCTORAY_LAMBDA(std::size_t j) {
+    const std::uint32_t* record = pts.Record(index[j]);
+    for (int w = 0; w < stride; ++w)
+    {
+      sorted[j * stride + w] = record[w];
+    }
+  });
+  keys.records = sorted;
+  keys.index = nullptr;
+  for (auto& buffer : scratch.sortIndex) // the other holds the leaves' run starts (SortedPoints::spare)
+  {
+    if (buffer.Get() == index)
+    {
+      d.Release(buffer);
+    }
+  }
 }
 
 // fn(words) with the sorted keys as the sort stored them: 32-bit words
@@ -600,25 +663,25 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
   return n <= kInvalidIndex / static_cast<std::size_t>(depth + 1);
 }
 
-// Queues the sort of the state's points by their keys at `sortDepth`
+// Queues the sort of the points `pts` by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys, computed from the positions, the
-// sort, and the histogram of neighbouring sorted keys. beforeSort(), if
-// given, runs on the host between the keys and the sort; the points'
-// records must exist after it. chooseDepth: the histograms the automatic
-// depth reads, else the levels' run starts counted (CountLevelStarts),
-// their sizes in the histogram, and placed where they fit. Marks on
-// `clock`: marks[0] after the keys, marks[1] before the sort, marks[2]
-// after the histograms or the run starts.
+// sort, and the histogram of neighbouring sorted keys. Records that fit
+// travel with the keys (SortedKeys::RecordsTravel); where a record layout
+// is given but its records have not landed (pts.records null), the points'
+// indices do, for GatherSortedRecords. chooseDepth: the histograms the
+// automatic depth reads, else the levels' run starts counted
+// (CountLevelStarts), their sizes in the histogram, and placed where they
+// fit. Marks on `clock`: marks[0] after the keys, marks[1] before the
+// sort, marks[2] after the histograms or the run starts.
 template <class Device>
-SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[3],
-  const std::function<void()>& beforeSort)
+SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
+  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[3])
 {
-  const std::size_t n = s.count;
+  const std::size_t n = pts.count;
   const bool narrow = SortedKeys::Narrow(sortDepth);
-  const bool travel = SortedKeys::RecordsTravel(sortDepth, s.points.layout.stride);
+  const int stride = pts.layout.stride;
+  const bool travel = SortedKeys::RecordsTravel(sortDepth, stride) && (stride == 0 || pts.records);
   const SortInput input = ReserveSortInput(d, scratch, n, narrow, !travel);
-  const PointArraysView pts = s.Points();
   // Only the bits down to sortDepth need sorting. The keys are computed
   // from the positions each time, not kept: kept full-depth keys took 8
   // bytes a point, and without writing them this kernel took 73 us at 10 M
@@ -635,10 +698,6 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
     input.Enter(i, key);
   });
   marks[0] = clock.Mark();
-  if (beforeSort)
-  {
-    beforeSort();
-  }
   marks[1] = clock.Mark();
 
   SortedPoints sorted;
@@ -646,7 +705,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   const int bits = 3 * sortDepth;
   if (travel)
   {
-    sorted.keys = SortNarrowKeys(d, scratch, s, bits, sorted.spare);
+    sorted.keys = SortNarrowKeys(d, scratch, pts, bits, sorted.spare);
   }
   else if (narrow)
   {
@@ -704,37 +763,58 @@ void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
   std::copy_n(report, 2 * kDepthHistogramBins, sorted.histogram);
 }
 
-// Sorted points of the state inside `cube` at the requested depth, or at
-// the automatic one (requestedDepth 0), with every level's node count.
-// beforeSort() runs on the host between the keys and the sort (QueueSort),
-// then one copy brings the histogram. The automatic depth sorts 32-bit keys
-// at kProvisionalDepth first; only where the levels down to it do not
-// settle the depth rule are the full-depth keys sorted too, with the
-// points' indices. Marks on `clock`: phases[0..3] around the keys and the
-// sort (QueueSort's marks after the first), phases[4..7] around those of
-// the full-depth sort (-1: none).
-// (A std::function: nvcc does not let a host lambda's type be a template
-// argument of a function that holds device lambdas.)
+// A build's sort, queued (QueueBuildSort) from the positions alone,
+// while the points' records may still be on their way, and finished
+// (FinishBuild) once they are in the state. Marks on `clock`: the keys
+// [0, 1] and the sort [1, 2]; the automatic depth's full-depth sort, keys
+// [3, 4] and sort [4, 5]; the records gathered in sorted order [6, 7]; -1:
+// none.
 template <class Device>
-SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, typename Device::Clock& clock, int phases[8], const std::function<void()>& beforeSort)
+struct QueuedBuild
 {
-  std::fill_n(phases, 8, -1);
-  phases[0] = clock.Mark();
+  typename Device::Clock clock;
+  int marks[8];
+  FirstFailure outside;
+  int requestedDepth;
+  SortedPoints sorted;
+};
+
+// Queues the sort of the points `pts` inside `cube` at the requested
+// depth, or, for the automatic one (requestedDepth 0), 32-bit keys at
+// kProvisionalDepth first: the levels down to it settle the depth rule for
+// most scenes (ChooseDepthWithin).
+template <class Device>
+void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
+  int requestedDepth, QueuedBuild<Device>& q)
+{
+  std::fill_n(q.marks, 8, -1);
+  q.marks[0] = q.clock.Mark();
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
-  const FirstFailure outside = ArmFirstFailure(d, scratch);
-  const int sortDepth = requestedDepth > 0 ? requestedDepth : kProvisionalDepth;
+  q.outside = ArmFirstFailure(d, scratch);
+  q.requestedDepth = requestedDepth;
   const bool chooseDepth = requestedDepth == 0;
-  SortedPoints sorted = QueueSort(d, scratch, s, cube, sortDepth, chooseDepth, outside, clock, phases + 1, beforeSort);
+  q.sorted = QueueSort(d, scratch, pts, cube, chooseDepth ? kProvisionalDepth : requestedDepth, chooseDepth,
+    q.outside, q.clock, q.marks + 1);
+}
+
+// The state's points sorted as QueueBuildSort queued, with every level's
+// node count; for the automatic depth, where the levels down to
+// kProvisionalDepth do not settle the depth rule, the full-depth keys
+// sorted too, with the points' indices. One copy brings each histogram.
+template <class Device>
+void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  QueuedBuild<Device>& q)
+{
+  SortedPoints& sorted = q.sorted;
   ReadHistogram(d, s, sorted);
-  if (chooseDepth)
+  if (q.requestedDepth == 0)
   {
-    int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
+    int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sorted.depth);
     if (depth == 0)
     {
-      phases[4] = clock.Mark();
-      sorted = QueueSort(d, scratch, s, cube, kMaxLevel, true, outside, clock, phases + 5, nullptr);
+      q.marks[3] = q.clock.Mark();
+      sorted = QueueSort(d, scratch, s.Points(), cube, kMaxLevel, true, q.outside, q.clock, q.marks + 4);
       ReadHistogram(d, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
     }
@@ -742,7 +822,9 @@ SortedPoints SortPoints(Device& d, DriverScratch<Device>& scratch, OctreeState<D
     sorted.keys.keyShift += 3 * (sorted.depth - depth);
     sorted.depth = depth;
   }
-  return sorted;
+  q.marks[6] = q.clock.Mark();
+  GatherSortedRecords(d, scratch, s.Points(), sorted.keys);
+  q.marks[7] = q.clock.Mark();
 }
 
 // levelBegin[l]: the first node of level l, from the newNode histogram;
@@ -853,32 +935,26 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   }
 }
 
-// Keys, sort and levels of the state's points inside `cube`: the octree.
-// beforeSort(), if given, runs on the host while the device computes the
-// keys; the points' records must exist after it. The phases' times are the
-// device's (Device::Clock); the time between the keys and the sort (the
-// device waiting for beforeSort) counts in none.
+// The octree of a queued build (QueueBuildSort) of the state's points:
+// the sort finished and the levels. The phases' times are the device's
+// (Device::Clock).
 template <class Device>
-BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
-  int requestedDepth, const std::function<void()>& beforeSort = nullptr)
+BuildStats FinishBuild(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
+  QueuedBuild<Device>& q)
 {
   BuildStats stats;
   stats.points = s.count;
-  typename Device::Clock clock;
-  int phases[8];
-  const SortedPoints sorted = SortPoints(d, scratch, s, cube, requestedDepth, clock, phases, beforeSort);
-  const int levelsBegin = clock.Mark();
-  LinkLevels(d, scratch, s, sorted, cube);
-  const int levelsEnd = clock.Mark();
+  FinishSort(d, scratch, s, cube, q);
+  const int levelsBegin = q.clock.Mark();
+  LinkLevels(d, scratch, s, q.sorted, cube);
+  const int levelsEnd = q.clock.Mark();
   d.Synchronize("octree build");
-  stats.keySeconds = clock.Seconds(phases[0], phases[1]);
-  stats.sortSeconds = clock.Seconds(phases[2], phases[3]);
-  if (phases[4] >= 0) // the automatic depth's full-depth sort
-  {
-    stats.keySeconds += clock.Seconds(phases[4], phases[5]);
-    stats.sortSeconds += clock.Seconds(phases[6], phases[7]);
-  }
-  stats.levelSeconds = clock.Seconds(levelsBegin, levelsEnd);
+  const auto span = [&](int from, int to) {
+    return q.marks[from] >= 0 ? q.clock.Seconds(q.marks[from], q.marks[to]) : 0.0;
+  };
+  stats.keySeconds = span(0, 1) + span(3, 4);
+  stats.sortSeconds = span(1, 2) + span(4, 5) + span(6, 7);
+  stats.levelSeconds = q.clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
   stats.cube = cube;
   stats.nodes = s.levelBegin[s.depth + 1];
@@ -887,6 +963,16 @@ BuildStats BuildLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<De
     stats.nodesPerLevel.push_back(s.levelBegin[l + 1] - s.levelBegin[l]);
   }
   return stats;
+}
+
+// Keys, sort and levels of the state's points inside `cube`: the octree.
+template <class Device>
+BuildStats BuildLevels(
+  Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube, int requestedDepth)
+{
+  QueuedBuild<Device> q;
+  QueueBuildSort(d, scratch, s.Points(), cube, requestedDepth, q);
+  return FinishBuild(d, scratch, s, cube, q);
 }
 
 // What only updates read, freed once the nodes are built without
@@ -915,33 +1001,42 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   ValidateDepth(options.depth);
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
+  const PointRecordLayout layout = RecordLayoutOf(points); // the sort's shape depends on it
   auto phase = std::chrono::steady_clock::now();
   StagedAttributes<Device> attributes;
   Bounds bounds;
-  StagedPositions<Device> staged = StageBoundedPositions(d, points.xyzFloat, points.xyzDouble, n, "point positions",
-    bounds, [&](typename Device::Fills& fills) { attributes = PrepareAttributes(d, points, fills); });
-  double uploadSeconds = SecondsSince(phase);
-  phase = std::chrono::steady_clock::now();
-  const RootCube cube = CheckedCube(d, scratch, staged.View(n), bounds, options);
-  const double cubeSeconds = SecondsSince(phase);
+  RootCube cube;
+  double cubeSeconds = 0.0;
+  QueuedBuild<Device> queued;
+  // The keys and the sort of the positions are queued as soon as these
+  // have landed, and run while the attributes are on their way, which
+  // then become records in sorted order (FinishSort).
+  StagedPositions<Device> staged = StageBoundedPositions(
+    d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds,
+    [&](typename Device::Fills& fills) { attributes = PrepareAttributes(d, points, fills); },
+    [&](const Bounds& b, const PointArraysView& positions) {
+      const auto checked = std::chrono::steady_clock::now();
+      cube = CheckedCube(d, scratch, positions, b, options);
+      cubeSeconds = SecondsSince(checked);
+      PointArraysView keyed = positions;
+      keyed.layout = layout;
+      QueueBuildSort(d, scratch, keyed, cube, options.depth, queued);
+    });
 
   std::unique_ptr<OctreeState<Device>> fresh;
   OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
   s.count = n;
   s.attributes = points.Attributes();
   s.keepPoints = options.keepPoints;
-  s.points.layout = RecordLayoutOf(points); // the sort's shape depends on it
+  s.points.layout = layout;
   d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
   d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
-  BuildStats stats = BuildLevels(d, scratch, s, cube, options.depth, [&] {
-    // The attributes become records that the sort moves.
-    phase = std::chrono::steady_clock::now();
-    const float* scalar = attributes.values[kAttributeScalar].Get();
-    s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
-    IngestAttributes(d, points, attributes, s.scalarRange, s.points);
-    attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
-    uploadSeconds += SecondsSince(phase);
-  });
+  const float* scalar = attributes.values[kAttributeScalar].Get();
+  s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
+  IngestAttributes(d, points, attributes, s.scalarRange, s.points);
+  attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
+  const double uploadSeconds = SecondsSince(phase);
+  BuildStats stats = FinishBuild(d, scratch, s, cube, queued);
   stats.uploadSeconds = uploadSeconds;
   stats.keySeconds += cubeSeconds;
   if (!s.keepPoints)

@@ -139,7 +139,8 @@ struct SortedKeys
   int keyShift;                   // bits of the sorted keys below the leaf level
 
   static constexpr OCTORAY_HD bool Narrow(int depth) { return KeysFitWord(depth); }
-  static constexpr OCTORAY_HD bool RecordsTravel(int depth, int stride) { return Narrow(depth) && stride <= 2; }
+  static constexpr OCTORAY_HD bool RecordsFit(int stride) { return stride <= 2; }
+  static constexpr OCTORAY_HD bool RecordsTravel(int depth, int stride) { return Narrow(depth) && RecordsFit(stride); }
 
   OCTORAY_HD std::uint64_t LeafKey(std::size_t s) const
   {
