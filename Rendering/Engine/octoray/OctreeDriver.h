@@ -671,11 +671,11 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 // indices do, for GatherSortedRecords. chooseDepth: the histograms the
 // automatic depth reads, else the levels' run starts counted
 // (CountLevelStarts), their sizes in the histogram, and placed where they
-// fit. Marks on `clock`: marks[0] after the keys, marks[1] before the
-// sort, marks[2] after the histograms or the run starts.
+// fit. Marks on `clock`: marks[0] after the keys, marks[1] after the
+// histograms or the run starts.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
-  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[3])
+  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
 {
   const std::size_t n = pts.count;
   const bool narrow = SortedKeys::Narrow(sortDepth);
@@ -698,7 +698,6 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
     input.Enter(i, key);
   });
   marks[0] = clock.Mark();
-  marks[1] = clock.Mark();
 
   SortedPoints sorted;
   sorted.depth = sortDepth;
@@ -743,7 +742,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
       sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
     });
   }
-  marks[2] = clock.Mark();
+  marks[1] = clock.Mark();
   return sorted;
 }
 
