@@ -354,13 +354,75 @@ double StagedCopySeconds(Cloud& c)
 // The timed builds are what rebuilding at one size costs.
 constexpr int kWarmUpBuilds = 4;
 
+// The cloud's arrays in device memory, as a CUDA simulation would hand
+// them over: a build from them copies them on the device and then sorts,
+// with nothing on its way to overlap, so that its phases are the device's
+// own time, which the build's goal against the sort is about. (From host
+// arrays, the keys and the sort run while the attributes upload, and share
+// the device with the staged copy.)
+class DeviceCloud
+{
+public:
+  explicit DeviceCloud(Cloud& c)
+  {
+    for (std::size_t a = 0; a < Arrays.size(); ++a)
+    {
+      const HostArray host = InputArrays(c)[a];
+      if (cudaMalloc(&Arrays[a], host.bytes) != cudaSuccess ||
+        cudaMemcpy(Arrays[a], host.data, host.bytes, cudaMemcpyHostToDevice) != cudaSuccess)
+      {
+        cudaGetLastError();
+        Complete = false;
+      }
+    }
+    Points = c.View();
+    Points.xyzFloat = static_cast<const float*>(Arrays[0]);
+    Points.color8 = static_cast<const std::uint8_t*>(Arrays[1]);
+    Points.reflectivity = static_cast<const float*>(Arrays[2]);
+  }
+  ~DeviceCloud()
+  {
+    for (void* a : Arrays)
+    {
+      cudaFree(a);
+    }
+  }
+  DeviceCloud(const DeviceCloud&) = delete;
+  DeviceCloud& operator=(const DeviceCloud&) = delete;
+
+  bool Ok() const { return Complete; }
+  const PointCloudView& View() const { return Points; }
+
+private:
+  std::array<void*, 3> Arrays{};
+  PointCloudView Points;
+  bool Complete = true;
+};
+
+// The medians of builds' own upload and phase times (one build's may be a
+// stray), with the last build's node count.
+BuildStats MedianPhases(const std::vector<BuildStats>& stats)
+{
+  BuildStats median = stats.back();
+  for (double BuildStats::*phase :
+    { &BuildStats::uploadSeconds, &BuildStats::keySeconds, &BuildStats::sortSeconds, &BuildStats::levelSeconds })
+  {
+    std::vector<double> times;
+    for (const BuildStats& s : stats)
+    {
+      times.push_back(s.*phase);
+    }
+    median.*phase = Median(times);
+  }
+  return median;
+}
+
 // A build's whole call against the pinned copy, measured pair by pair
 // (build, then copy, `repeats` times after the warm-up builds): the medians of
 // each and the median of the pairs' ratios, which a drift of the host's
 // copy speed moves less than it moves either median (both halves of a pair
 // copy through the same host at nearly the same time). `phases` holds the
-// medians of the builds' own upload and phase times (one build's may be a
-// stray), and the last build's node count.
+// builds' MedianPhases.
 struct PairedBuild
 {
   double seconds = 0.0;
@@ -386,18 +448,7 @@ PairedBuild TimeBuildAgainstCopy(int repeats, PinnedCopy& copy, const std::funct
     copies.push_back(copy.Seconds());
     ratios.push_back(copies.back() > 0 ? builds.back() / copies.back() : 0.0);
   }
-  PairedBuild paired{ Median(builds), Median(copies), Median(ratios), stats.back() };
-  for (double BuildStats::*phase :
-    { &BuildStats::uploadSeconds, &BuildStats::keySeconds, &BuildStats::sortSeconds, &BuildStats::levelSeconds })
-  {
-    std::vector<double> times;
-    for (const BuildStats& s : stats)
-    {
-      times.push_back(s.*phase);
-    }
-    paired.phases.*phase = Median(times);
-  }
-  return paired;
+  return PairedBuild{ Median(builds), Median(copies), Median(ratios), MedianPhases(stats) };
 }
 
 // The same input arrays copied as a caller's pageable arrays go without the
@@ -695,6 +746,7 @@ int Run(int argc, char** argv)
     peers.hostStaging = MedianOfRuns(5, [&] { return hostHalf.Seconds(c); });
     peers.hostBesideCopy = MedianOfRuns(5, [&] { return HostHalfBesidePinnedCopy(hostHalf, pinned, c); });
     peers.staged = StagedCopySeconds(c);
+    const DeviceCloud onDevice(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "
                 "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms\n",
@@ -711,8 +763,19 @@ int Run(int argc, char** argv)
       BuildOptions o;
       o.depth = depth;
       const int repeats = 7;
+      // From device arrays first: the memory below is a build's from host arrays.
+      std::vector<BuildStats> fromDevice;
+      for (int r = 0; onDevice.Ok() && r < kWarmUpBuilds + repeats; ++r)
+      {
+        const BuildStats stats = engine->Build(onDevice.View(), o);
+        if (r >= kWarmUpBuilds)
+        {
+          fromDevice.push_back(stats);
+        }
+      }
       const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { return engine->Build(c.View(), o); });
-      const BuildStats& phases = paired.phases; // medians
+      const BuildStats& whole = paired.phases; // medians
+      const BuildStats phases = fromDevice.empty() ? whole : MedianPhases(fromDevice);
       const double t = paired.seconds;
       const double floor = SortFloorSeconds(n, 3 * depth);
       const double buildSort = BuildSortSeconds(n, depth);
@@ -723,20 +786,23 @@ int Run(int argc, char** argv)
       lean.keepPoints = false;
       const double leanSeconds = TimeMedian(repeats, [&] { engine->Build(c.View(), lean); });
       const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
-      std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
+      std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms; from device "
+                  "arrays keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
                   "sort %.3f ms (of 32-bit keys with 8-byte records %.3f ms), ratio %.2f, %zu nodes, %.1f GPU "
                   "bytes/point (%.1f in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input "
                   "%.3f ms beside it, "
                   "whole call %.2fx that (median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
-        n, depth, t * 1e3, phases.uploadSeconds * 1e3, phases.keySeconds * 1e3, phases.sortSeconds * 1e3,
-        phases.levelSeconds * 1e3, floor * 1e3, buildSort * 1e3, t / floor, phases.nodes, bytesPerPoint,
-        arrayBytesPerPoint, uploadMegabytes, paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3,
-        leanBytesPerPoint);
+        n, depth, t * 1e3, whole.uploadSeconds * 1e3, whole.keySeconds * 1e3, whole.sortSeconds * 1e3,
+        whole.levelSeconds * 1e3, phases.keySeconds * 1e3, phases.sortSeconds * 1e3, phases.levelSeconds * 1e3,
+        floor * 1e3, buildSort * 1e3, t / floor, whole.nodes, bytesPerPoint, arrayBytesPerPoint, uploadMegabytes,
+        paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3, leanBytesPerPoint);
       records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
-        { { "upload_seconds", phases.uploadSeconds }, { "key_seconds", phases.keySeconds },
+        { { "upload_seconds", whole.uploadSeconds }, { "key_seconds", phases.keySeconds },
           { "sort_seconds", phases.sortSeconds }, { "level_seconds", phases.levelSeconds },
+          { "host_input_key_seconds", whole.keySeconds }, { "host_input_sort_seconds", whole.sortSeconds },
+          { "host_input_level_seconds", whole.levelSeconds },
           { "build_sort_seconds", buildSort },
-          { "nodes", double(phases.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
+          { "nodes", double(whole.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
           { "call_over_pinned_copy", paired.ratio },
           { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
           { "host_staging_copy_seconds", peers.hostStaging },

@@ -73,10 +73,13 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 
 // The sort moves each point's record with its key where the record is one
 // or two words and the leaf keys fit 32 bits, and gathers the records by
-// index otherwise (SortedKeys, OctreeKernels.h). Every record width, at
-// depths that sort 32-bit and 64-bit keys and at the automatic depth, with
-// and without kept points, against the brute-force octree; then an update
-// of every point reads the kept records again.
+// index otherwise (SortedKeys, OctreeKernels.h). Where CUDA sorts the
+// positions while the attributes are still on their way (a staged copy of
+// more than 1 MB: CudaUpload.h), it sorts the indices and gathers those
+// records in sorted order after the copy (GatherSortedRecords). Every
+// record width, at depths that sort 32-bit and 64-bit keys and at the
+// automatic depth, with and without kept points, against the brute-force
+// octree; then an update of every point reads the kept records again.
 TEST_P(OctreeBuild, RecordsOfEveryWidth)
 {
   const Cloud every = GaussianClusters(4000, 23);
@@ -105,7 +108,11 @@ TEST_P(OctreeBuild, RecordsOfEveryWidth)
     // Its automatic depth lies beyond the provisional sort's: the full-depth
     // sort reads the records again.
     { "deep clusters, colours and reflectivity (2 words)",
-      only(TightClusters(300, 1e-5, 47), true, false, true, false, false) } };
+      only(TightClusters(300, 1e-5, 47), true, false, true, false, false) },
+    // 1.6 and 1.9 MB of input: staged on CUDA, the positions first.
+    { "staged, colours (1 word)", only(GaussianClusters(60000, 24), true, false, false, false, false) },
+    { "staged, colours and reflectivity (2 words)",
+      only(GaussianClusters(60000, 25), true, false, true, false, false) } };
   for (const auto& [label, cloud] : clouds)
   {
     for (int depth : { 7, 0, 14 })

@@ -115,7 +115,7 @@ public:
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* host, std::size_t n, int stride, const char* what, R identity, Map map,
     Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
-    const std::function<void(const R&, const T*)>& whenReduced = nullptr)
+    const std::function<void(const R&, const T*)>& = nullptr) // nothing is on its way: whenReduced never runs
   {
     if (prepareAlong)
     {
@@ -123,10 +123,6 @@ public:
       prepareAlong(none);
     }
     result = Reduce(n / stride, identity, [&](std::size_t i) { return map(i, host); }, combine);
-    if (host && whenReduced)
-    {
-      whenReduced(result, host);
-    }
     return Stage(host, n, what);
   }
   template <typename T>

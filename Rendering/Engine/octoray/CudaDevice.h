@@ -514,10 +514,12 @@ public:
   // taken first, it left the build's level phase at 10 M points 0.15 ms
   // slower in two calls, though not with other piece sizes
   // (Benchmarks/gpu/variants-one-pass.txt; the pool's layout, not
-  // explained). whenReduced(result, staged), if given, runs on the host
-  // once this array has landed and been reduced, while the arrays
-  // prepareAlong added may still be on their way (HostStaging::Copy's
-  // afterFirst): loops it queues over the array overlap their copies.
+  // explained). Where this array is staged with those copies,
+  // whenReduced(result, staged), if given, runs on the host once it has
+  // landed and been reduced, while they are still on their way
+  // (HostStaging::Copy's afterFirst): loops it queues over the array
+  // overlap their copies. Elsewhere (nothing left on its way) it does not
+  // run, and the caller queues them after the copy.
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
     Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
@@ -559,16 +561,16 @@ public:
       } });
     // Every piece's partial result is queued once the array is.
     const auto reduce = [&] { result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine); };
+    std::function<void()> afterArray;
     if (whenReduced)
     {
-      Staging.Copy(along, [&] {
+      afterArray = [&] {
         reduce();
         whenReduced(result, data);
-      });
+      };
     }
-    else
+    if (!Staging.Copy(along, afterArray))
     {
-      Staging.Copy(along);
       reduce();
     }
     return staged;

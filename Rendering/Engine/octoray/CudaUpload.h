@@ -84,13 +84,14 @@ public:
   // staging streams do not wait for them by themselves); returns once the
   // copies and the work queued on their pieces are complete. Parts CUDA
   // copies directly go so; the others are staged in one pass.
-  // afterFirst(), if given, runs on the host as soon as the first part and
-  // the work on its pieces are queued, with the default stream waiting for
-  // them, while the other parts may still be on their way: it can queue
-  // loops over the first part that overlap the rest of the copy. It may run
-  // on a staging thread; what it throws reaches the caller once every part
-  // is copied.
-  void Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
+  // Where the first part is staged with others, afterFirst(), if given,
+  // runs on the host as soon as that part and the work on its pieces are
+  // queued, with the default stream waiting for them, while the others are
+  // still on their way: it can queue loops over the first part that overlap
+  // the rest of the copy. It may run on a staging thread; what it throws
+  // reaches the caller once every part is copied. Returns whether it ran:
+  // where nothing is left on its way, there is nothing to overlap.
+  bool Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
   {
     std::vector<CopyPart> staged;
     std::vector<std::size_t> stagedBytes;
@@ -100,7 +101,6 @@ public:
       if (DirectlyCopyable(part.source))
       {
         CopyDirectly(part);
-        RunIfFirst(part, parts, afterFirst);
       }
       else
       {
@@ -112,23 +112,21 @@ public:
     const StagingRun run(stagedBytes);
     if (run.Length() < kStagingThreshold || !Allocate())
     {
-      for (const CopyPart& part : staged)
-      {
-        CopyDirectly(part);
-        RunIfFirst(part, staged, firstStaged ? afterFirst : nullptr);
-      }
-      return;
+      std::for_each(staged.begin(), staged.end(), CopyDirectly);
+      return false;
     }
+    const bool overlap = afterFirst && firstStaged && staged.size() > 1;
     int current = 0;
     CudaCheck(cudaGetDevice(&current), "cudaGetDevice");
     CudaCheck(cudaStreamSynchronize(0), staged.front().what.c_str());
     std::vector<Piece> pieces = CutPieces(run, Workers->Chunks());
-    FirstPartWatch watch(Lanes, pieces, firstStaged ? afterFirst : nullptr);
+    FirstPartWatch watch(Lanes, pieces, overlap ? afterFirst : nullptr);
     PieceDealer dealer(std::move(pieces));
     Workers->Run(Lanes.size(), [&](std::size_t lane, std::size_t, int) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
       CopyPieces(Lanes[lane], staged, dealer, watch);
     });
+    return overlap;
   }
 
 private:
@@ -192,16 +190,6 @@ private:
     {
       part.landed(0, part.bytes, 0);
       CudaCheck(cudaStreamSynchronize(0), part.what.c_str());
-    }
-  }
-
-  // afterFirst() once `part`, copied directly, is the first of `parts`.
-  static void RunIfFirst(const CopyPart& part, const std::vector<CopyPart>& parts,
-    const std::function<void()>& afterFirst)
-  {
-    if (afterFirst && &part == &parts.front())
-    {
-      afterFirst();
     }
   }
 

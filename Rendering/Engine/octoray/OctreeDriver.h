@@ -1007,9 +1007,11 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   RootCube cube;
   double cubeSeconds = 0.0;
   QueuedBuild<Device> queued;
-  // The keys and the sort of the positions are queued as soon as these
-  // have landed, and run while the attributes are on their way, which
-  // then become records in sorted order (FinishSort).
+  bool sortQueued = false;
+  // Where the attributes are still on their way once the positions have
+  // landed (CUDA's staged copy of a caller's host arrays), the keys and the
+  // sort of the positions run meanwhile, with the points' indices, and the
+  // records are gathered in sorted order after the copy (FinishSort).
   StagedPositions<Device> staged = StageBoundedPositions(
     d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds,
     [&](typename Device::Fills& fills) { attributes = PrepareAttributes(d, points, fills); },
@@ -1020,7 +1022,14 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
       PointArraysView keyed = positions;
       keyed.layout = layout;
       QueueBuildSort(d, scratch, keyed, cube, options.depth, queued);
+      sortQueued = true;
     });
+  if (!sortQueued)
+  {
+    const auto checked = std::chrono::steady_clock::now();
+    cube = CheckedCube(d, scratch, staged.View(n), bounds, options);
+    cubeSeconds = SecondsSince(checked);
+  }
 
   std::unique_ptr<OctreeState<Device>> fresh;
   OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
@@ -1034,7 +1043,13 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
   IngestAttributes(d, points, attributes, s.scalarRange, s.points);
   attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
-  const double uploadSeconds = SecondsSince(phase);
+  // The host's time in the copies (the keys and the sort queued among
+  // them where they overlap it), not in the cube's check after them.
+  const double uploadSeconds = SecondsSince(phase) - (sortQueued ? 0.0 : cubeSeconds);
+  if (!sortQueued) // the records travel with the keys
+  {
+    QueueBuildSort(d, scratch, s.Points(), cube, options.depth, queued);
+  }
   BuildStats stats = FinishBuild(d, scratch, s, cube, queued);
   stats.uploadSeconds = uploadSeconds;
   stats.keySeconds += cubeSeconds;
