@@ -3,7 +3,9 @@
 //  - octree build of 1 M / 10 M / 100 M points beside a bare CUB radix sort
 //    of as many keys of 3 x depth bits with 32-bit indices (the build's
 //    floor), and at depth 10 and less beside the sort the build runs there:
-//    32-bit keys with the points' 8-byte records;
+//    32-bit keys with the points' 8-byte records; the whole call from host
+//    arrays beside the pinned copy of their bytes, and the device phases
+//    of builds from the same arrays in device memory;
 //  - update of 1% and 100% of 10 M points beside a full rebuild;
 //  - primary rays and shadow + one-bounce rays at 1920x1080, depth 10 and 16;
 //  - GPU bytes per point at depth 10 and 21, with the points kept for

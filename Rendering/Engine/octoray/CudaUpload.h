@@ -12,7 +12,8 @@
 // device memory (a CUDA simulation's) and page-locked host arrays are
 // copied directly. A caller may queue work on each piece as it lands
 // (Landed), which then runs while the rest of the array is still on its
-// way. Only compiled by nvcc.
+// way, and on the whole first array once it has landed, while the others
+// are (Copy's afterFirst). Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"

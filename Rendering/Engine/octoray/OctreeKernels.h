@@ -129,7 +129,9 @@ OCTORAY_HD bool ComputeLeafKey(const PointArraysView& pts, const RootCube::CellM
 // the leaf pass reads the records in order. Gathering them in sorted order
 // from the points' own records instead costs a random read each, which on
 // an H100 took longer than the sort (Benchmarks/gpu/variants-records.txt).
-// Other keys travel with their points' indices.
+// Other keys travel with their points' indices, and so do these where the
+// sort runs before the records have landed, which are then gathered in
+// sorted order once (OctreeDriver.h's GatherSortedRecords).
 struct SortedKeys
 {
   const std::uint64_t* wideKey;   // leaf keys deeper than 32 bits, else null
