@@ -80,6 +80,32 @@ class CudaFaultsLaunch : public CudaOnlyTest
 protected:
   void TearDown() override { InjectCudaLaunchFailure(""); }
 };
+
+// A build of `second` at the automatic depth whose launch of `kernel` the
+// runtime refuses: the error names the kernel, the octree of `first` and its
+// picture stay as they were, and the same build then succeeds.
+void ExpectRefusedBuildKeepsTheOctree(const Cloud& first, const Cloud& second, const char* kernel,
+  const BuildOptions& fixedDepth, const BuildOptions& automaticDepth)
+{
+  auto engine = CreateEngine(Backend::CUDA);
+  engine->Build(first.View(), fixedDepth);
+  HostOctree before;
+  engine->CopyToHost(before);
+  const std::vector<float> picture = Picture(*engine);
+
+  InjectCudaLaunchFailure(kernel);
+  EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Build(second.View(), automaticDepth); }), kernel));
+
+  HostOctree after;
+  engine->CopyToHost(after);
+  ExpectSameOctree(after, before, true);
+  EXPECT_EQ(Picture(*engine), picture);
+
+  // Nothing sticky: the same build now succeeds and is right.
+  engine->Build(second.View(), fixedDepth);
+  engine->CopyToHost(after);
+  ExpectMatchesReference(after, second);
+}
 }
 
 TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
@@ -94,35 +120,33 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   tight.refraction.clear();
   // Levels of more children than SmallLevelsKernel takes (InnerKernel).
   const Cloud wide = UniformCloud(50000, 62);
+  // Records of two words over 1 MB of input: staged, its keys and sort
+  // queued from a staging thread during the attributes' upload, its records
+  // gathered in sorted order after it (GatherRecordsKernel).
+  Cloud staged = UniformCloud(60000, 64);
+  staged.scalar.clear();
+  staged.normal.clear();
+  staged.refraction.clear();
   BuildOptions fixedDepth;
   fixedDepth.depth = 6;
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
+         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel",
+         "GatherRecordsKernel" })
   {
-    SCOPED_TRACE(kernel);
-    const Cloud& second = std::string(kernel) == "InnerKernel" ? wide : tight;
-    auto engine = CreateEngine(Backend::CUDA);
-    engine->Build(first.View(), fixedDepth);
-    HostOctree before;
-    engine->CopyToHost(before);
-    const std::vector<float> picture = Picture(*engine);
-
-    InjectCudaLaunchFailure(kernel);
-    EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Build(second.View(), automaticDepth); }), kernel));
-
-    HostOctree after;
-    engine->CopyToHost(after);
-    ExpectSameOctree(after, before, true);
-    EXPECT_EQ(Picture(*engine), picture);
-
-    // Nothing sticky: the same build now succeeds and is right.
-    engine->Build(second.View(), fixedDepth);
-    engine->CopyToHost(after);
-    ExpectMatchesReference(after, second);
+    const std::string name = kernel;
+    const std::vector<const Cloud*> seconds = name == "InnerKernel" ? std::vector<const Cloud*>{ &wide }
+      : name == "GatherRecordsKernel"                                 ? std::vector<const Cloud*>{ &staged }
+                                                                      : std::vector<const Cloud*>{ &tight, &staged };
+    for (const Cloud* second : seconds)
+    {
+      SCOPED_TRACE(name + (second == &staged ? ", staged" : ""));
+      ExpectRefusedBuildKeepsTheOctree(first, *second, kernel, fixedDepth, automaticDepth);
+    }
   }
 }
+
 
 TEST_F(CudaFaultsLaunch, RenderKeepsTheOctreeAndTheNextFrame)
 {
