@@ -199,7 +199,11 @@ def summary_figures(path):
 
 
 def spread(values, form="%.2f"):
-    return (form + "–" + form) % (min(values), max(values)) if values else "–"
+    """min–max of the values, one value where they are one."""
+    if not values:
+        return "–"
+    low, high = form % min(values), form % max(values)
+    return low if low == high else low + "–" + high
 
 
 def _h200(ctx):
@@ -227,6 +231,50 @@ def _h200(ctx):
                  "whole call %s times the pinned copy against %s; not kept ([gpu/%s](gpu/%s))." % (
                      tried, spread(other["ratio"]), spread(main["ratio"]), spread(other["call"]),
                      spread(main["call"]), name, name))
+    return [text, ""]
+
+
+# The twenty-eighth session's change on the H200 (COMMAND.md): the keys and
+# the sort during the attributes' upload, built beside the engine before and
+# run in turn in calls 2 and 3 (variants "main-79d9b9f" and "before-call2",
+# "main" and "before"), and the benchmark of the engine kept.
+OVERLAP_VARIANTS_FILE = "variants-sort-during-upload.txt"
+OVERLAP_BENCH_FILE = "bench-h200-sort-during-upload.txt"
+
+
+def _sort_during_upload(ctx):
+    """The keys and the sort during the upload, from their H200 files."""
+    variants, bench = ctx.gpu_file(OVERLAP_VARIANTS_FILE), ctx.gpu_file(OVERLAP_BENCH_FILE)
+    if not variants or not bench:
+        return []
+    none = {k: [] for k in SUMMARY_FIGURES}
+    rounds = summary_figures(variants)
+    at = lambda variants, n, figure: sum((rounds.get((v, n), none)[figure] for v in variants), [])
+    kept, before = ("main-79d9b9f", "main"), ("before-call2", "before")
+    runs = summary_figures(bench)
+    ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
+    text = ("**The keys and the sort during the upload** (the twenty-eighth session, on the H200, kept in 022a550): "
+            "where a build's attributes are still on their way once its positions have landed (the staged copy of "
+            "host arrays of 1 MB and more, the positions first), the cube's check, the keys, the sort of the "
+            "positions with their indices and the levels' run starts are queued then, from the staging thread that "
+            "queued the positions' last piece (CudaUpload.h's afterFirst), and run during the rest of the copy; "
+            "after it the records are gathered in sorted order, a random read a point (OctreeDriver.h's "
+            "GatherSortedRecords: 249 µs at 10 M points in ncu, 3.27 ms at 100 M). Built beside 823848b's engine "
+            "and run in turn in two calls, the whole call took %s times the pinned copy at 10 M points against %s, "
+            "and %s at 100 M against %s ([gpu/%s](gpu/%s)). Builds from device arrays, page-locked ones and the CPU "
+            "sort after the copy with the records travelling, as before: from device arrays the device phases "
+            "read %s times the sort at 10 M points against %s. From host arrays the keys and the sort now share "
+            "the device with the staged copy and take longer (0.13–0.18 and 0.85–0.95 ms at 10 M points against "
+            "0.06 and 0.57), out of the whole call's way; the benchmark gives both since, and the ratio to the sort "
+            "reads the builds from device arrays. The benchmark of the kept engine there "
+            "([gpu/%s](gpu/%s)): the whole call %s times the pinned copy at 10 M points and %s at 100 M, the build "
+            "%s times the sort at 10 M points and %s at 100 M." % (
+                spread(at(kept, 10000000, "call")), spread(at(before, 10000000, "call")),
+                spread(at(kept, 100000000, "call")), spread(at(before, 100000000, "call")),
+                OVERLAP_VARIANTS_FILE, OVERLAP_VARIANTS_FILE,
+                spread(at(("main",), 10000000, "ratio")), spread(at(("before",), 10000000, "ratio")),
+                OVERLAP_BENCH_FILE, OVERLAP_BENCH_FILE, spread(ten["call"]), spread(hundred["call"]),
+                spread(ten["ratio"]), spread(hundred["ratio"])))
     return [text, ""]
 
 
@@ -790,7 +838,7 @@ def _cuda(ctx):
                 "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
                 "wrote.",
                 "",
-            ] + _h200(ctx)
+            ] + _h200(ctx) + _sort_during_upload(ctx)
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")
