@@ -367,9 +367,10 @@ class DeviceCloud
 public:
   explicit DeviceCloud(Cloud& c)
   {
+    const std::array<HostArray, 3> arrays = InputArrays(c);
     for (std::size_t a = 0; a < Arrays.size(); ++a)
     {
-      const HostArray host = InputArrays(c)[a];
+      const HostArray& host = arrays[a];
       if (cudaMalloc(&Arrays[a], host.bytes) != cudaSuccess ||
         cudaMemcpy(Arrays[a], host.data, host.bytes, cudaMemcpyHostToDevice) != cudaSuccess)
       {

@@ -581,7 +581,7 @@ template <class Device>
 void GatherSortedRecords(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, SortedKeys& keys)
 {
   const int stride = pts.layout.stride;
-  if (!keys.index || !keys.narrowKey || stride == 0 || !SortedKeys::RecordsFit(stride))
+  if (!keys.index || !keys.narrowKey || !SortedKeys::RecordsFit(stride))
   {
     return;
   }
@@ -994,6 +994,55 @@ void ReleasePoints(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   d.ReleaseScratch();
 }
 
+// A build's input staged where the device's loops read it, and its cube
+// checked (CheckedCube) before anything of the state changes.
+template <class Device>
+struct StagedInput
+{
+  StagedPositions<Device> positions;
+  StagedAttributes<Device> attributes;
+  RootCube cube;
+  double cubeSeconds = 0.0; // the host's time in the cube's check
+  bool sortQueued = false;  // during the attributes' upload, into the QueuedBuild
+};
+
+// Stages a build's points. Where the attributes are still on their way
+// once the positions have landed (CUDA's staged copy of a caller's host
+// arrays), the cube is checked then and the keys and the sort of the
+// positions are queued into `queued`, with the points' indices, to run
+// meanwhile; the records are gathered in sorted order after the copy
+// (FinishSort). At 10 M points on an H200 the whole call took 1.61-1.65
+// times the pinned copy against 1.70-1.77 with the sort after the copy, at
+// 100 M 1.34-1.36 against 1.38-1.42
+// (Benchmarks/gpu/variants-sort-during-upload.txt).
+template <class Device>
+StagedInput<Device> StageInput(Device& d, DriverScratch<Device>& scratch, const PointCloudView& points,
+  const BuildOptions& options, const PointRecordLayout& layout, QueuedBuild<Device>& queued)
+{
+  StagedInput<Device> in;
+  const auto checkCube = [&](const Bounds& b, const PointArraysView& positions) {
+    const auto checked = std::chrono::steady_clock::now();
+    in.cube = CheckedCube(d, scratch, positions, b, options);
+    in.cubeSeconds = SecondsSince(checked);
+  };
+  Bounds bounds;
+  in.positions = StageBoundedPositions(
+    d, points.xyzFloat, points.xyzDouble, points.count, "point positions", bounds,
+    [&](typename Device::Fills& fills) { in.attributes = PrepareAttributes(d, points, fills); },
+    [&](const Bounds& b, const PointArraysView& positions) {
+      checkCube(b, positions);
+      PointArraysView keyed = positions;
+      keyed.layout = layout;
+      QueueBuildSort(d, scratch, keyed, in.cube, options.depth, queued);
+      in.sortQueued = true;
+    });
+  if (!in.sortQueued)
+  {
+    checkCube(bounds, in.positions.View(points.count));
+  }
+  return in;
+}
+
 // Engine::Build: checks the input, makes it the point state (`current`, or
 // a new one that replaces it once complete where the device builds aside)
 // and builds the octree.
@@ -1006,39 +1055,9 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   const std::size_t n = points.count;
   d.Reserve(scratch.counters, kCounterSlots, "counters");
   const PointRecordLayout layout = RecordLayoutOf(points); // the sort's shape depends on it
-  auto phase = std::chrono::steady_clock::now();
-  StagedAttributes<Device> attributes;
-  Bounds bounds;
-  RootCube cube;
-  double cubeSeconds = 0.0;
-  const auto checkCube = [&](const Bounds& b, const PointArraysView& positions) {
-    const auto checked = std::chrono::steady_clock::now();
-    cube = CheckedCube(d, scratch, positions, b, options);
-    cubeSeconds = SecondsSince(checked);
-  };
+  const auto phase = std::chrono::steady_clock::now();
   QueuedBuild<Device> queued;
-  bool sortQueued = false;
-  // Where the attributes are still on their way once the positions have
-  // landed (CUDA's staged copy of a caller's host arrays), the keys and the
-  // sort of the positions run meanwhile, with the points' indices, and the
-  // records are gathered in sorted order after the copy (FinishSort). At
-  // 10 M points on an H200 the whole call took 1.61-1.65 times the pinned
-  // copy against 1.70-1.77 with the sort after the copy, at 100 M 1.34-1.36
-  // against 1.38-1.42 (Benchmarks/gpu/variants-sort-during-upload.txt).
-  StagedPositions<Device> staged = StageBoundedPositions(
-    d, points.xyzFloat, points.xyzDouble, n, "point positions", bounds,
-    [&](typename Device::Fills& fills) { attributes = PrepareAttributes(d, points, fills); },
-    [&](const Bounds& b, const PointArraysView& positions) {
-      checkCube(b, positions);
-      PointArraysView keyed = positions;
-      keyed.layout = layout;
-      QueueBuildSort(d, scratch, keyed, cube, options.depth, queued);
-      sortQueued = true;
-    });
-  if (!sortQueued)
-  {
-    checkCube(bounds, staged.View(n));
-  }
+  StagedInput<Device> staged = StageInput(d, scratch, points, options, layout, queued);
 
   std::unique_ptr<OctreeState<Device>> fresh;
   OctreeState<Device>& s = Device::kBuildsAside ? *(fresh = std::make_unique<OctreeState<Device>>()) : *current;
@@ -1046,22 +1065,22 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   s.attributes = points.Attributes();
   s.keepPoints = options.keepPoints;
   s.points.layout = layout;
-  d.Adopt(std::move(staged.xyzFloat), s.points.xyzFloat, 3 * n);
-  d.Adopt(std::move(staged.xyzDouble), s.points.xyzDouble, 3 * n);
-  const float* scalar = attributes.values[kAttributeScalar].Get();
+  d.Adopt(std::move(staged.positions.xyzFloat), s.points.xyzFloat, 3 * n);
+  d.Adopt(std::move(staged.positions.xyzDouble), s.points.xyzDouble, 3 * n);
+  const float* scalar = staged.attributes.values[kAttributeScalar].Get();
   s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
-  IngestAttributes(d, points, attributes, s.scalarRange, s.points);
-  attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
+  IngestAttributes(d, points, staged.attributes, s.scalarRange, s.points);
+  staged.attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
   // The host's time in the copies (the keys and the sort queued among
   // them where they overlap it), not in the cube's check after them.
-  const double uploadSeconds = SecondsSince(phase) - (sortQueued ? 0.0 : cubeSeconds);
-  if (!sortQueued) // the records travel with the keys
+  const double uploadSeconds = SecondsSince(phase) - (staged.sortQueued ? 0.0 : staged.cubeSeconds);
+  if (!staged.sortQueued) // the records travel with the keys
   {
-    QueueBuildSort(d, scratch, s.Points(), cube, options.depth, queued);
+    QueueBuildSort(d, scratch, s.Points(), staged.cube, options.depth, queued);
   }
-  BuildStats stats = FinishBuild(d, scratch, s, cube, queued);
+  BuildStats stats = FinishBuild(d, scratch, s, staged.cube, queued);
   stats.uploadSeconds = uploadSeconds;
-  stats.keySeconds += cubeSeconds;
+  stats.keySeconds += staged.cubeSeconds;
   if (!s.keepPoints)
   {
     ReleasePoints(d, scratch, s);
