@@ -75,8 +75,9 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 // or two words and the leaf keys fit 32 bits, and gathers the records by
 // index otherwise (SortedKeys, OctreeKernels.h). Where CUDA sorts the
 // positions while the attributes are still on their way (a staged copy of
-// more than 1 MB: CudaUpload.h), it sorts the indices and gathers those
-// records in sorted order after the copy (GatherSortedRecords). Every
+// more than 1 MB: CudaUpload.h), it sorts the indices and stores the
+// records as they land, in the caller's order and ranked in sorted order,
+// the scalars' after the copy (StoreLandedRecords, RankSortedPoints). Every
 // record width, at depths that sort 32-bit and 64-bit keys and at the
 // automatic depth, with and without kept points, against the brute-force
 // octree; then an update of every point reads the kept records again.
@@ -112,7 +113,9 @@ TEST_P(OctreeBuild, RecordsOfEveryWidth)
     // 1.6 and 1.9 MB of input: staged on CUDA, the positions first.
     { "staged, colours (1 word)", only(GaussianClusters(60000, 24), true, false, false, false, false) },
     { "staged, colours and reflectivity (2 words)",
-      only(GaussianClusters(60000, 25), true, false, true, false, false) } };
+      only(GaussianClusters(60000, 25), true, false, true, false, false) },
+    { "staged, colours and scalars (2 words)", only(GaussianClusters(60000, 26), true, true, false, false, false) },
+    { "staged, every attribute (5 words)", GaussianClusters(60000, 27) } };
   for (const auto& [label, cloud] : clouds)
   {
     for (int depth : { 7, 0, 14 })

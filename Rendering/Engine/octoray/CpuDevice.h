@@ -126,7 +126,8 @@ public:
     return Stage(host, n, what);
   }
   template <typename T>
-  Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&)
+  Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&,
+    const std::function<void(std::size_t, std::size_t)>& = nullptr) // nothing lands: it never runs
   {
     return Stage(host, n, what);
   }
