@@ -120,9 +120,9 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   tight.refraction.clear();
   // Levels of more children than SmallLevelsKernel takes (InnerKernel).
   const Cloud wide = UniformCloud(50000, 62);
-  // Records of two words over 1 MB of input: staged, its keys, sort and
-  // ranks queued from a staging thread during the attributes' upload, its
-  // records stored as they land (RankKernel, StoreRecordsKernel).
+  // Records of two words over 1 MB of input: staged, its keys and sort
+  // queued from a staging thread during the attributes' upload, its records
+  // gathered in sorted order after it (GatherRecordsKernel).
   Cloud staged = UniformCloud(60000, 64);
   staged.scalar.clear();
   staged.normal.clear();
@@ -133,15 +133,11 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
          "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel",
-         "RankKernel", "StoreRecordsKernel" })
+         "GatherRecordsKernel" })
   {
     const std::string name = kernel;
-    // A staged build stores its records as they land, where the others
-    // make them in one loop after the copy.
-    const bool stagedOnly = name == "RankKernel" || name == "StoreRecordsKernel";
     const std::vector<const Cloud*> seconds = name == "InnerKernel" ? std::vector<const Cloud*>{ &wide }
-      : stagedOnly                                                    ? std::vector<const Cloud*>{ &staged }
-      : name == "PointRecordsKernel"                                  ? std::vector<const Cloud*>{ &tight }
+      : name == "GatherRecordsKernel"                                 ? std::vector<const Cloud*>{ &staged }
                                                                       : std::vector<const Cloud*>{ &tight, &staged };
     for (const Cloud* second : seconds)
     {

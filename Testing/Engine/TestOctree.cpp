@@ -75,9 +75,9 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 // or two words and the leaf keys fit 32 bits, and gathers the records by
 // index otherwise (SortedKeys, OctreeKernels.h). Where CUDA sorts the
 // positions while the attributes are still on their way (a staged copy of
-// more than 1 MB: CudaUpload.h), it sorts the indices and stores the
-// records as they land, in the caller's order and ranked in sorted order,
-// the scalars' after the copy (StoreLandedRecords, RankSortedPoints). Every
+// more than 1 MB: CudaUpload.h), it sorts the indices and gathers those
+// records in sorted order after the copy (GatherSortedRecords), or reads
+// wider ones through the indices. Every
 // record width, at depths that sort 32-bit and 64-bit keys and at the
 // automatic depth, with and without kept points, against the brute-force
 // octree; then an update of every point reads the kept records again.

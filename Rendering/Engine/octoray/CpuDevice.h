@@ -126,8 +126,7 @@ public:
     return Stage(host, n, what);
   }
   template <typename T>
-  Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&,
-    const std::function<void(std::size_t, std::size_t)>& = nullptr) // nothing lands: it never runs
+  Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&)
   {
     return Stage(host, n, what);
   }

@@ -577,26 +577,15 @@ public:
   }
   // Room for a caller's array where loops read it, whose copy a
   // StageReduced makes from `fills` (on the CPU, the array itself): arrays
-  // staged together share the staging's ramps (StagingPieces.h). Where the
-  // StageReduced's whenReduced runs, landedAfterFirst(begin, end), if
-  // given, queues loops over elements [begin, end) of each piece of this
-  // array after it, as the piece lands; elsewhere it does not run.
+  // staged together share the staging's ramps (StagingPieces.h).
   template <typename T>
-  Staged<T> Prepare(const T* source, std::size_t n, const char* what, Fills& fills,
-    const std::function<void(std::size_t, std::size_t)>& landedAfterFirst = nullptr)
+  Staged<T> Prepare(const T* source, std::size_t n, const char* what, Fills& fills)
   {
     Staged<T> staged;
     if (source)
     {
       Reserve(staged, n, what);
-      cuda::Landed onPiece;
-      if (landedAfterFirst)
-      {
-        onPiece = [landedAfterFirst](std::size_t begin, std::size_t end, cudaStream_t) {
-          landedAfterFirst(begin / sizeof(T), end / sizeof(T));
-        };
-      }
-      fills.push_back(cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what, nullptr, onPiece });
+      fills.push_back(cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what, nullptr });
     }
     return staged;
   }

@@ -12,9 +12,8 @@
 // device memory (a CUDA simulation's) and page-locked host arrays are
 // copied directly. A caller may queue work on each piece as it lands
 // (Landed), which then runs while the rest of the array is still on its
-// way, on the whole first array once it has landed, while the others
-// are (Copy's afterFirst), and, after that, on each piece of the others on
-// the default stream (CopyPart::landedAfterFirst). Only compiled by nvcc.
+// way, and on the whole first array once it has landed, while the others
+// are (Copy's afterFirst). Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"
@@ -26,9 +25,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 namespace octoray
@@ -58,10 +55,7 @@ inline bool DirectlyCopyable(const void* p)
 }
 
 // One array of a copy: `bytes` from `source` (host or device memory) to
-// `device`, and the work to queue on each of its pieces as it lands: on
-// the piece's stream (`landed`), and on the default stream once Copy's
-// afterFirst has run there (`landedAfterFirst`: work that needs both the
-// piece and what afterFirst queued; only where afterFirst runs).
+// `device`, and the work to queue on each of its pieces as it lands.
 struct CopyPart
 {
   void* device;
@@ -69,7 +63,6 @@ struct CopyPart
   std::size_t bytes;
   std::string what; // names the array in an error
   Landed landed;
-  Landed landedAfterFirst = nullptr;
 };
 
 class HostStaging
@@ -97,21 +90,18 @@ public:
   // queued, with the default stream waiting for them, while the others are
   // still on their way: it can queue loops over the first part that overlap
   // the rest of the copy. It may run on a staging thread; what it throws
-  // reaches the caller once every part is copied. The parts'
-  // landedAfterFirst work follows it on the default stream. Returns whether
-  // it ran: where nothing is left on its way, there is nothing to overlap.
+  // reaches the caller once every part is copied. Returns whether it ran:
+  // where nothing is left on its way, there is nothing to overlap.
   bool Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
   {
     std::vector<CopyPart> staged;
     std::vector<std::size_t> stagedBytes;
-    std::vector<const CopyPart*> direct;
     bool firstStaged = false;
     for (const CopyPart& part : parts)
     {
       if (DirectlyCopyable(part.source))
       {
         CopyDirectly(part);
-        direct.push_back(&part);
       }
       else
       {
@@ -132,10 +122,6 @@ public:
     CudaCheck(cudaStreamSynchronize(0), staged.front().what.c_str());
     std::vector<Piece> pieces = CutPieces(run, Workers->Chunks());
     FirstPartWatch watch(Lanes, pieces, overlap ? afterFirst : nullptr);
-    for (const CopyPart* part : direct) // landed already
-    {
-      watch.Landed(*part, 0, part->bytes, nullptr, nullptr);
-    }
     PieceDealer dealer(std::move(pieces));
     Workers->Run(Lanes.size(), [&](std::size_t lane, std::size_t, int) {
       CudaCheck(cudaSetDevice(current), "cudaSetDevice"); // the current device is per thread
@@ -159,10 +145,6 @@ private:
   // the lane that queues the last one makes the default stream wait for
   // every lane's mark. A lane that took none in this copy holds a mark
   // long passed, or none, which the default stream does not wait for.
-  // Then it queues the parts' landedAfterFirst work on the default stream:
-  // on each piece that had landed, or was on its way, before, each marked
-  // on its lane's stream as it was queued; on each later one as it is
-  // queued, behind its lane's own mark of its copy.
   class FirstPartWatch
   {
   public:
@@ -174,7 +156,6 @@ private:
       if (Then && Left == 0)
       {
         Then();
-        Open();
       }
     }
     // After `lane` queued a piece of array `array`.
@@ -192,73 +173,13 @@ private:
           CudaCheck(cudaStreamWaitEvent(0, other.firstQueued, 0), what);
         }
         Then();
-        Open();
       }
-    }
-    // After bytes [begin, end) of `part` were queued on `lane`'s stream,
-    // their copy marked by `copied`; a part CUDA copied directly has
-    // landed (no lane).
-    void Landed(const CopyPart& part, std::size_t begin, std::size_t end, const Lane* lane, cudaEvent_t copied)
-    {
-      if (!Then || !part.landedAfterFirst)
-      {
-        return;
-      }
-      std::lock_guard<std::mutex> lock(Mutex);
-      if (Opened)
-      {
-        Run(part, begin, end, copied);
-        return;
-      }
-      cudaEvent_t mark = nullptr;
-      if (lane)
-      {
-        CudaCheck(cudaEventCreateWithFlags(&mark, cudaEventDisableTiming), part.what.c_str());
-        Pending.push_back(PendingPiece{ &part, begin, end, EventHandle(mark) });
-        CudaCheck(cudaEventRecord(mark, lane->stream), part.what.c_str());
-        return;
-      }
-      Pending.push_back(PendingPiece{ &part, begin, end, nullptr });
     }
 
   private:
-    struct EventDestroyer
-    {
-      void operator()(cudaEvent_t e) const { cudaEventDestroy(e); }
-    };
-    using EventHandle = std::unique_ptr<std::remove_pointer_t<cudaEvent_t>, EventDestroyer>;
-    struct PendingPiece
-    {
-      const CopyPart* part;
-      std::size_t begin, end;
-      EventHandle copied; // null: landed already
-    };
-
-    void Open()
-    {
-      std::lock_guard<std::mutex> lock(Mutex);
-      Opened = true;
-      for (const PendingPiece& p : Pending)
-      {
-        Run(*p.part, p.begin, p.end, p.copied.get());
-      }
-      Pending.clear();
-    }
-    static void Run(const CopyPart& part, std::size_t begin, std::size_t end, cudaEvent_t copied)
-    {
-      if (copied)
-      {
-        CudaCheck(cudaStreamWaitEvent(0, copied, 0), part.what.c_str());
-      }
-      part.landedAfterFirst(begin, end, 0);
-    }
-
     const std::vector<Lane>& Lanes;
     const std::function<void()> Then;
     std::atomic<std::ptrdiff_t> Left;
-    std::mutex Mutex; // the default stream's work from several lanes, in turn
-    bool Opened = false;
-    std::vector<PendingPiece> Pending;
   };
 
   // cudaMemcpy, which goes from pageable memory through the driver's own
@@ -298,7 +219,6 @@ private:
       {
         part.landed(offset, offset + n, lane.stream);
       }
-      watch.Landed(part, offset, offset + n, &lane, lane.copied[b]);
       watch.Queued(lane, piece.array, what);
     });
     CudaCheck(cudaStreamSynchronize(lane.stream), what);

@@ -271,48 +271,27 @@ struct StagedAttributes
   typename Device::template Staged<float> values[kAttributeCount];
 };
 
-// Calls fn(attribute, staged array, caller's array, its length, label)
-// for each attribute, with the array it is made from: the 8-bit colours
-// or its float array.
+// Calls fn(staged array, caller's array, its length, label) for the 8-bit
+// colours and for each attribute's float array.
 template <class Device, class Fn>
 void ForEachStagedInput(const PointCloudView& points, StagedAttributes<Device>& staged, Fn&& fn)
 {
+  fn(staged.color8, points.color8, points.colorComponents * points.count, std::string("point colours"));
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
-    if constexpr (std::is_same<typename A::Input, ByteColorInput>::value)
-    {
-      fn(a, staged.color8, points.color8, points.colorComponents * points.count, std::string("point colours"));
-    }
-    else
-    {
-      const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
-      fn(a, staged.values[A::kIndex], in.data, in.count, std::string("point ") + A::kLabel);
-    }
+    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
+    fn(staged.values[A::kIndex], in.data, in.count, std::string("point ") + A::kLabel);
   });
 }
 
 // Room for the attributes' staged arrays, whose copies (added to `fills`)
 // go with the positions': one pass of the CUDA staging for all the arrays.
-// storeLanded(attribute, begin, end), where the device runs it (CUDA's
-// Prepare), queues the records of points [begin, end) of an attribute as
-// their piece of its array lands; not the scalars', whose 16 bits need
-// the whole array's range.
-template <class Device, class StoreLanded>
-StagedAttributes<Device> PrepareAttributes(
-  Device& d, const PointCloudView& points, typename Device::Fills& fills, const StoreLanded& storeLanded)
+template <class Device>
+StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points, typename Device::Fills& fills)
 {
   StagedAttributes<Device> staged;
-  ForEachStagedInput(points, staged, [&](auto a, auto& array, const auto* data, std::size_t count,
-                                       const std::string& label) {
-    std::function<void(std::size_t, std::size_t)> landed;
-    if (!std::is_same<typename decltype(a)::Input, ScalarInput>::value && points.count)
-    {
-      const std::size_t perPoint = count / points.count;
-      landed = [a, perPoint, &storeLanded](std::size_t begin, std::size_t end) {
-        storeLanded(a, begin / perPoint, end / perPoint);
-      };
-    }
-    array = d.Prepare(data, count, label.c_str(), fills, landed);
+  ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
+    array = d.Prepare(data, count, label.c_str(), fills);
   });
   return staged;
 }
@@ -334,7 +313,7 @@ inline PointRecordLayout RecordLayoutOf(const PointCloudView& points)
   return layout;
 }
 
-// The staged attribute arrays as plain pointers, for the record loops.
+// The staged attribute arrays as plain pointers, for the record loop.
 struct AttributeInputs
 {
   const std::uint8_t* color8;
@@ -343,51 +322,48 @@ struct AttributeInputs
   ScalarRange scalarRange;
 };
 
-template <class Device>
-AttributeInputs InputsOf(const StagedAttributes<Device>& staged, const PointCloudView& points, const ScalarRange& range)
-{
-  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents, range };
-  ForEachAttribute([&](auto a) { in.values[a.kIndex] = staged.values[a.kIndex].Get(); });
-  return in;
-}
-
-// What each kind of attribute input (Attributes.h names the kind of each)
-// makes of point i: the value its nodes store.
+// What each kind of attribute input stores in point i's words of the
+// record (Attributes.h names the kind of each).
 template <class A>
-OCTORAY_HD auto InputValue(CopiedInput, A, const AttributeInputs& in, std::size_t i)
+OCTORAY_HD void StoreInput(CopiedInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
   static_assert(std::is_same<typename A::Type, float>::value, "a copied attribute is stored as its float");
-  return in.values[A::kIndex][i];
+  StoreInRecord(records, layout, i, A::kIndex, in.values[A::kIndex][i]);
 }
 
 template <class A>
-OCTORAY_HD auto InputValue(ScalarInput, A, const AttributeInputs& in, std::size_t i)
+OCTORAY_HD void StoreInput(ScalarInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
-  return EncodeUnitScalar(in.scalarRange.ToUnit(in.values[A::kIndex][i]));
+  StoreInRecord(records, layout, i, A::kIndex, EncodeUnitScalar(in.scalarRange.ToUnit(in.values[A::kIndex][i])));
 }
 
 template <class A>
-OCTORAY_HD auto InputValue(UnitNormalInput, A, const AttributeInputs& in, std::size_t i)
+OCTORAY_HD void StoreInput(UnitNormalInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
   const float* n = in.values[A::kIndex] + 3 * i;
-  return EncodeNormal(UnitNormal(n[0], n[1], n[2]));
+  StoreInRecord(records, layout, i, A::kIndex, EncodeNormal(UnitNormal(n[0], n[1], n[2])));
 }
 
 // Colours become RGBA in their own precision; a missing alpha is opaque.
 template <class A>
-OCTORAY_HD auto InputValue(FloatColorInput, A, const AttributeInputs& in, std::size_t i)
+OCTORAY_HD void StoreInput(FloatColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
   const int cc = in.colorComponents;
   const float* c = in.values[A::kIndex] + cc * i;
-  return Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f };
+  StoreInRecord(records, layout, i, A::kIndex, Rgba{ c[0], c[1], c[2], cc == 4 ? c[3] : 1.0f });
 }
 
 template <class A>
-OCTORAY_HD auto InputValue(ByteColorInput, A, const AttributeInputs& in, std::size_t i)
+OCTORAY_HD void StoreInput(ByteColorInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
 {
   const int cc = in.colorComponents;
   const std::uint8_t* c = in.color8 + cc * i;
-  return Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) };
+  StoreInRecord(records, layout, i, A::kIndex, Rgba8{ c[0], c[1], c[2], cc == 4 ? c[3] : std::uint8_t(255) });
 }
 
 // The state's point records from the staged arrays: one loop writes each
@@ -402,61 +378,16 @@ void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttri
   {
     return;
   }
-  const AttributeInputs in = InputsOf(staged, points, scalarRange);
+  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents, scalarRange };
+  ForEachAttribute([&](auto a) { in.values[a.kIndex] = staged.values[a.kIndex].Get(); });
   std::uint32_t* records = s.records.Get();
   d.ForEach("PointRecordsKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
     ForEachAttribute([&](auto a) {
       if (layout.offset[decltype(a)::kIndex] >= 0)
       {
-        StoreInRecord(records, layout, i, a.kIndex, InputValue(typename decltype(a)::Input(), a, in, i));
+        StoreInput(typename decltype(a)::Input(), a, in, i, records, layout);
       }
     });
-  });
-}
-
-// Where a build whose sort ran during the attributes' upload stores its
-// points' records as their arrays land (StoreLandedRecords): in the
-// caller's order, the state's, and, where the sort's ranks are known,
-// also at each point's place in sorted order, which the leaf pass reads.
-struct RecordTargets
-{
-  std::uint32_t* records = nullptr;    // layout.stride words a point, in the caller's order
-  std::uint32_t* sorted = nullptr;     // the same in sorted order; null: none
-  const std::uint32_t* rank = nullptr; // each point's place in sorted order, where `sorted` is set
-};
-
-// Attribute `a` of points [begin, end) into their records (RecordTargets).
-// The copy into sorted order writes a word at a random place a point, as
-// each piece lands, where gathering the records after the copy read one.
-template <class Device, class A>
-void StoreLandedRecords(Device& d, A a, const AttributeInputs& in, const PointRecordLayout& layout,
-  const RecordTargets& to, std::size_t begin, std::size_t end)
-{
-  d.ForEach("StoreRecordsKernel", end - begin, OCTORAY_LAMBDA(std::size_t k) {
-    const std::size_t i = begin + k;
-    const auto value = InputValue(typename A::Input(), a, in, i);
-    StoreInRecord(to.records, layout, i, A::kIndex, value);
-    if (to.sorted)
-    {
-      StoreInRecord(to.sorted, layout, to.rank[i], A::kIndex, value);
-    }
-  });
-}
-
-// The scalars' records, which wait for the whole array's range
-// (PrepareAttributes), where the others were stored as they landed.
-template <class Device>
-void StoreScalarRecords(
-  Device& d, const AttributeInputs& in, const PointRecordLayout& layout, const RecordTargets& to, std::size_t n)
-{
-  ForEachAttribute([&](auto a) {
-    if constexpr (std::is_same<typename decltype(a)::Input, ScalarInput>::value)
-    {
-      if (layout.offset[a.kIndex] >= 0)
-      {
-        StoreLandedRecords(d, a, in, layout, to, 0, n);
-      }
-    }
   });
 }
 
@@ -640,52 +571,39 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
 }
 
 // Where a sort queued before the points' records had landed sorted their
-// indices (QueueSort) and the records would have travelled with the keys:
-// each point's place in sorted order (rank[index[j]] = j), and room for
-// the records in that order, which StoreLandedRecords fills as the
-// records land, so that the leaf pass reads them in order as where they
-// travelled. Nothing where the leaf pass reads the records through the
-// indices. Gathered after the copy instead, a random read a point, they
-// took 249 us at 10 M points in ncu on an H200, 3.27 ms at 100 M.
+// indices (QueueSort) and the records would have travelled with the keys,
+// copies the records in sorted order into the sort's record array, which
+// is what the travelling sort leaves: SortedKeys with records, no index.
+// A read at a random place a point: in ncu on an H200 its kernel took
+// 249 us at 10 M points, 3.27 ms at 100 M, after the copy, where the sort
+// it lets run during the copy took 0.39 and 3.09 ms.
 template <class Device>
-RecordTargets RankSortedPoints(
-  Device& d, DriverScratch<Device>& scratch, std::size_t n, const PointRecordLayout& layout, const SortedKeys& keys)
+void GatherSortedRecords(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, SortedKeys& keys)
 {
-  RecordTargets to;
-  if (!keys.index || !keys.narrowKey || !SortedKeys::RecordsFit(layout.stride))
-  {
-    return to;
-  }
-  d.Reserve(scratch.sortRecords, n * layout.stride, "sort records");
-  d.Reserve(scratch.sortRank, n, "sort ranks");
-  std::uint32_t* rank = scratch.sortRank.Get();
-  const std::uint32_t* index = keys.index;
-  d.ForEach("RankKernel", n, OCTORAY_LAMBDA(std::size_t j) { rank[index[j]] = static_cast<std::uint32_t>(j); });
-  to.sorted = scratch.sortRecords.Get();
-  to.rank = rank;
-  return to;
-}
-
-// The records in sorted order that StoreLandedRecords filled, for the
-// sorted keys in place of their indices (SortedKeys with records, no
-// index, as where they travelled); the indices and ranks freed.
-template <class Device>
-void UseRankedRecords(Device& d, DriverScratch<Device>& scratch, const std::uint32_t* ranked, SortedKeys& keys)
-{
-  d.Release(scratch.sortRank);
-  if (!ranked)
+  const int stride = pts.layout.stride;
+  if (!keys.index || !keys.narrowKey || !SortedKeys::RecordsFit(stride))
   {
     return;
   }
+  d.Reserve(scratch.sortRecords, pts.count * stride, "sort records");
+  std::uint32_t* sorted = scratch.sortRecords.Get();
+  const std::uint32_t* index = keys.index;
+  d.ForEach("GatherRecordsKernel", pts.count, OCTORAY_LAMBDA(std::size_t j) {
+    const std::uint32_t* record = pts.Record(index[j]);
+    for (int w = 0; w < stride; ++w)
+    {
+      sorted[j * stride + w] = record[w];
+    }
+  });
+  keys.records = sorted;
+  keys.index = nullptr;
   for (auto& buffer : scratch.sortIndex) // the other holds the leaves' run starts (SortedPoints::spare)
   {
-    if (buffer.Get() == keys.index)
+    if (buffer.Get() == index)
     {
       d.Release(buffer);
     }
   }
-  keys.records = ranked;
-  keys.index = nullptr;
 }
 
 // fn(words) with the sorted keys as the sort stored them: 32-bit words
@@ -755,7 +673,7 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 // sort, and the histogram of neighbouring sorted keys. Records that fit
 // travel with the keys (SortedKeys::RecordsTravel); where a record layout
 // is given but its records have not landed (pts.records null), the points'
-// indices do, for RankSortedPoints. chooseDepth: the histograms the
+// indices do, for GatherSortedRecords. chooseDepth: the histograms the
 // automatic depth reads, else the levels' run starts counted
 // (CountLevelStarts), their sizes in the histogram, and placed where they
 // fit. Marks on `clock`: marks[0] after the keys, marks[1] after the
@@ -853,7 +771,7 @@ void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
 // while the points' records may still be on their way, and finished
 // (FinishBuild) once they are in the state. Marks on `clock`: the keys
 // [0, 1] and the sort [1, 2]; the automatic depth's full-depth sort, keys
-// [3, 4] and sort [4, 5]; the points' ranks in sorted order [6, 7]; -1:
+// [3, 4] and sort [4, 5]; the records gathered in sorted order [6, 7]; -1:
 // none.
 template <class Device>
 struct QueuedBuild
@@ -863,7 +781,6 @@ struct QueuedBuild
   FirstFailure outside;
   int requestedDepth;
   SortedPoints sorted;
-  const std::uint32_t* ranked = nullptr; // the records in the sort's order, as they land (RankQueuedSort)
 };
 
 // Queues the sort of the points `pts` inside `cube` at the requested
@@ -885,19 +802,6 @@ void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArrays
     q.outside, q.clock, q.marks + 1);
 }
 
-// The ranks of a sort QueueBuildSort queued before the records landed
-// (RankSortedPoints), marked on the build's clock.
-template <class Device>
-RecordTargets RankQueuedSort(
-  Device& d, DriverScratch<Device>& scratch, std::size_t n, const PointRecordLayout& layout, QueuedBuild<Device>& q)
-{
-  q.marks[6] = q.clock.Mark();
-  const RecordTargets to = RankSortedPoints(d, scratch, n, layout, q.sorted.keys);
-  q.marks[7] = q.clock.Mark();
-  q.ranked = to.sorted;
-  return to;
-}
-
 // The state's points sorted as QueueBuildSort queued, with every level's
 // node count; for the automatic depth, where the levels down to
 // kProvisionalDepth do not settle the depth rule, the full-depth keys
@@ -914,7 +818,6 @@ void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     if (depth == 0)
     {
       q.marks[3] = q.clock.Mark();
-      q.ranked = nullptr; // in the first sort's order; this sort's leaf pass reads the state's records
       sorted = QueueSort(d, scratch, s.Points(), cube, kMaxLevel, true, q.outside, q.clock, q.marks + 4);
       ReadHistogram(d, s, sorted);
       depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
@@ -923,7 +826,9 @@ void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     sorted.keys.keyShift += 3 * (sorted.depth - depth);
     sorted.depth = depth;
   }
-  UseRankedRecords(d, scratch, q.ranked, sorted.keys);
+  q.marks[6] = q.clock.Mark();
+  GatherSortedRecords(d, scratch, s.Points(), sorted.keys);
+  q.marks[7] = q.clock.Mark();
 }
 
 // levelBegin[l]: the first node of level l, from the newNode histogram;
@@ -1096,10 +1001,6 @@ struct StagedInput
 {
   StagedPositions<Device> positions;
   StagedAttributes<Device> attributes;
-  // Where sortQueued: the points' records in the caller's order, all but
-  // the scalars' stored as they landed (StoreLandedRecords, into `targets`).
-  typename Device::template Buffer<std::uint32_t> records;
-  RecordTargets targets;
   RootCube cube;
   double cubeSeconds = 0.0; // the host's time in the cube's check
   bool sortQueued = false;  // during the attributes' upload, into the QueuedBuild
@@ -1109,13 +1010,11 @@ struct StagedInput
 // once the positions have landed (CUDA's staged copy of a caller's host
 // arrays), the cube is checked then and the keys and the sort of the
 // positions are queued into `queued`, with the points' indices, to run
-// meanwhile; at 10 M points on an H200 the whole call took 1.61-1.65
+// meanwhile; the records are gathered in sorted order after the copy
+// (FinishSort). At 10 M points on an H200 the whole call took 1.61-1.65
 // times the pinned copy against 1.70-1.77 with the sort after the copy, at
 // 100 M 1.34-1.36 against 1.38-1.42
-// (Benchmarks/gpu/variants-sort-during-upload.txt). Then, as each piece of
-// the attributes lands, its points' records are stored, in the caller's
-// order and, ranked by the sort, in sorted order (StoreLandedRecords),
-// where they were made and gathered after the copy.
+// (Benchmarks/gpu/variants-sort-during-upload.txt).
 template <class Device>
 StagedInput<Device> StageInput(Device& d, DriverScratch<Device>& scratch, const PointCloudView& points,
   const BuildOptions& options, const PointRecordLayout& layout, QueuedBuild<Device>& queued)
@@ -1126,21 +1025,15 @@ StagedInput<Device> StageInput(Device& d, DriverScratch<Device>& scratch, const 
     in.cube = CheckedCube(d, scratch, positions, b, options);
     in.cubeSeconds = SecondsSince(checked);
   };
-  const auto storeLanded = [&](auto a, std::size_t begin, std::size_t end) {
-    StoreLandedRecords(d, a, InputsOf(in.attributes, points, ScalarRange{}), layout, in.targets, begin, end);
-  };
   Bounds bounds;
   in.positions = StageBoundedPositions(
     d, points.xyzFloat, points.xyzDouble, points.count, "point positions", bounds,
-    [&](typename Device::Fills& fills) { in.attributes = PrepareAttributes(d, points, fills, storeLanded); },
+    [&](typename Device::Fills& fills) { in.attributes = PrepareAttributes(d, points, fills); },
     [&](const Bounds& b, const PointArraysView& positions) {
       checkCube(b, positions);
       PointArraysView keyed = positions;
       keyed.layout = layout;
       QueueBuildSort(d, scratch, keyed, in.cube, options.depth, queued);
-      in.targets = RankQueuedSort(d, scratch, points.count, layout, queued);
-      d.Reserve(in.records, points.count * layout.stride, "point attributes");
-      in.targets.records = in.records.Get();
       in.sortQueued = true;
     });
   if (!in.sortQueued)
@@ -1176,15 +1069,7 @@ BuildStats BuildOctree(Device& d, DriverScratch<Device>& scratch, std::unique_pt
   d.Adopt(std::move(staged.positions.xyzDouble), s.points.xyzDouble, 3 * n);
   const float* scalar = staged.attributes.values[kAttributeScalar].Get();
   s.scalarRange = scalar ? FiniteScalarRange(d, scalar, n) : ScalarRange{};
-  if (staged.sortQueued)
-  {
-    s.points.records = std::move(staged.records);
-    StoreScalarRecords(d, InputsOf(staged.attributes, points, s.scalarRange), layout, staged.targets, n);
-  }
-  else
-  {
-    IngestAttributes(d, points, staged.attributes, s.scalarRange, s.points);
-  }
+  IngestAttributes(d, points, staged.attributes, s.scalarRange, s.points);
   staged.attributes = StagedAttributes<Device>(); // freed before the build trims the device's cache
   // The host's time in the copies (the keys and the sort queued among
   // them where they overlap it), not in the cube's check after them.

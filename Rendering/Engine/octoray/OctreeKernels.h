@@ -130,8 +130,8 @@ OCTORAY_HD bool ComputeLeafKey(const PointArraysView& pts, const RootCube::CellM
 // from the points' own records instead costs a random read each, which on
 // an H100 took longer than the sort (Benchmarks/gpu/variants-records.txt).
 // Other keys travel with their points' indices, and so do these where the
-// sort runs before the records have landed, which are then stored in
-// sorted order as they land (OctreeDriver.h's RankSortedPoints).
+// sort runs before the records have landed, which are then gathered in
+// sorted order once (OctreeDriver.h's GatherSortedRecords).
 struct SortedKeys
 {
   const std::uint64_t* wideKey;   // leaf keys deeper than 32 bits, else null

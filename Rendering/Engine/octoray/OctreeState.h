@@ -60,7 +60,6 @@ struct DriverScratch
   Buffer<std::uint32_t> narrowKey[2];
   Buffer<std::uint32_t> sortIndex[2];
   Buffer<std::uint32_t> sortRecords;
-  Buffer<std::uint32_t> sortRank; // each point's place in sorted order, while its records land (RankSortedPoints)
   // The levels' run starts: what Device::CountNested counts for
   // PlaceNested, and the nested lists of the inner levels (the leaves' go
   // to the array the sort left free).
@@ -79,7 +78,6 @@ struct DriverScratch
       fn(scratch.sortIndex[b]);
     }
     fn(scratch.sortRecords);
-    fn(scratch.sortRank);
     fn(scratch.levelTally);
     fn(scratch.levelStarts);
   }
