@@ -23,8 +23,7 @@ constexpr std::size_t kPieceAlignment = 768;
 // enough that a DMA's setup and the calls that queue it are small beside
 // its transfer.
 constexpr std::size_t kStagingPiece = (std::size_t(4) << 20) / kPieceAlignment * kPieceAlignment;
-// The smallest pieces, at the run's start and end (about 512 kB): see
-// PieceBytes.
+// The smallest pieces, at the run's start (about 512 kB): see PieceBytes.
 constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kPieceAlignment * kPieceAlignment;
 // One host thread copies from pageable memory at a fraction of the bus's
 // speed, and several share the host's memory bandwidth: on the 16-core
@@ -34,19 +33,24 @@ constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kPieceAlignment * 
 // page-locked memory: 128 MB at most.
 constexpr int kMaxStagingThreads = 16;
 
-// The bytes of the piece at `offset` of a run of `length` bytes that
-// `threads` threads copy, a multiple of kPieceAlignment, before CutPieces
-// cuts it at its array's end.
-// The threads start together: while they fill their first buffers the
-// copy engine has nothing to do, so the first pieces are small, and grow
-// with the bytes behind them. They should end together too: while the copy
-// engine reads the last pieces the host waits, so the pieces shrink toward
-// the run's end, each at most a share of what is left.
-inline std::size_t PieceBytes(std::size_t offset, std::size_t length, int threads)
+// The bytes of the piece at `offset` of a run that `threads` threads copy,
+// a multiple of kPieceAlignment, before CutPieces cuts it at its array's end.
+// The threads start together: while they fill their first buffers the copy
+// engine has nothing to do, so the first pieces are small, and grow with the
+// bytes behind them. They do not shrink toward the run's end: the host's half
+// outruns the bus (190 MB in 1.7-2.9 ms against 3.45 for the pinned copy on
+// an H200's host), so the copy engine still has pieces queued when the
+// threads take their last ones, and each piece costs the copy time beyond
+// its bytes. With 1 MB buffers, 1848 pieces at 100 M points where 4 MB cut
+// 554, the staged copy took 42.4-43.2 ms against 36.7-37.0 (about 4.5 us a
+// piece); with 8 MB buffers (256 MB pinned) it was slower too. Without the
+// shrinking, 81 pieces at 10 M points where it cut 147, the whole call took
+// 1.59-1.68 times the pinned copy against 1.71-1.80 in the same call
+// (Benchmarks/gpu/variants-staging-pieces.txt).
+inline std::size_t PieceBytes(std::size_t offset, int threads)
 {
   const std::size_t grown = std::max(offset / threads, kEdgePiece);
-  const std::size_t shrunk = std::max((length - offset) / (2 * threads), kEdgePiece);
-  return std::min({ kStagingPiece, grown, shrunk }) / kPieceAlignment * kPieceAlignment;
+  return std::min(kStagingPiece, grown) / kPieceAlignment * kPieceAlignment;
 }
 
 // `bytes` rounded up to whole multiples of kPieceAlignment.
@@ -104,7 +108,7 @@ inline std::vector<Piece> CutPieces(const StagingRun& run, int threads)
       offset = run.start[array]; // past a gap
       continue;
     }
-    const std::size_t n = std::min(PieceBytes(offset, run.Length(), threads), run.End(array) - offset);
+    const std::size_t n = std::min(PieceBytes(offset, threads), run.End(array) - offset);
     pieces.push_back(Piece{ array, offset - run.start[array], n });
     offset += n;
   }
