@@ -175,6 +175,9 @@ H200_VARIANTS = (
     ("variants-staging-one-stream.txt", "one",
      "every staging thread's DMA queued on one copy stream, where each thread has its own"),
     ("variants-nested-tiles4.txt", "tiles4", "the nested lists in warp tiles of 4 rounds, where they hold 8"),
+    ("variants-staging-pieces.txt", "hook",
+     "the thirtieth session's cube check and sort queued from a thread of their own, where the staging thread "
+     "that queued the positions' last piece queues them"),
     ("variants-landed-records.txt", "landed",
      "the twenty-ninth session's records stored as each piece of the attributes lands, in the caller's order and "
      "ranked by the sort during the upload, where they are made and gathered in sorted order after the copy (the "
@@ -280,6 +283,56 @@ def _sort_during_upload(ctx):
                 spread(at(("main",), 10000000, "ratio")), spread(at(("before",), 10000000, "ratio")),
                 OVERLAP_BENCH_FILE, OVERLAP_BENCH_FILE, spread(ten["call"]), spread(hundred["call"]),
                 spread(ten["ratio"]), spread(hundred["ratio"])))
+    return [text, ""]
+
+
+# The thirtieth session's staging pieces on the H200 (COMMAND.md): piece
+# sizes and the pieces without their shrinking, each built beside the
+# engine before and run in turn (variants "piece1m" against "before-call1",
+# "flat8" and "flat-call2" against "before-call2", "main-call3" against
+# "before"), and the kept engine in a call of its own ("main").
+PIECES_FILE = "variants-staging-pieces.txt"
+
+
+def staged_copy_alone(path):
+    """{(variant, n): [ms]} of the benchmark's "the engine's staged copy
+    alone" under each part "== source-NAME" of a GPU record."""
+    pattern = re.compile(r"upload of (\d+) points' .* the engine's staged copy alone ([0-9.]+) ms")
+    found = {}
+    for header, lines in file_parts(path).items():
+        if header.startswith("source-"):
+            for m in filter(None, map(pattern.search, lines)):
+                found.setdefault((header[len("source-"):], int(m.group(1))), []).append(float(m.group(2)))
+    return found
+
+
+def _staging_pieces(ctx):
+    """Fewer staging pieces, from their H200 file."""
+    path = ctx.gpu_file(PIECES_FILE)
+    if not path:
+        return []
+    none = {k: [] for k in SUMMARY_FIGURES}
+    rounds, alone = summary_figures(path), staged_copy_alone(path)
+    call = lambda variants, n: sum((rounds.get((v, n), none)["call"] for v in variants), [])
+    copy = lambda variants, n: sum((alone.get((v, n), []) for v in variants), [])
+    kept, before = ("flat-call2", "main-call3"), ("before-call2", "before")
+    text = ("**Fewer staging pieces** (the thirtieth session, on the H200, kept in e3412b8): each piece of the "
+            "staged copy costs the copy time beyond its bytes. With 1 MB page-locked buffers where there are 4 MB, "
+            "1848 pieces at 100 M points where 554 were cut, the engine's staged copy alone took %s ms against %s "
+            "(about 4.5 µs a piece); with 8 MB buffers (256 MB pinned) it was slower too, %s ms. Since e3412b8 the "
+            "pieces grow from 0.5 MB as before but no longer shrink toward the run's end, which was to keep the "
+            "copy engine's last pieces short: the threads mostly wait for the copy engine, not it for them, so it "
+            "still has pieces queued when they take their last ones (StagingPieces.h's PieceBytes; 81 pieces at "
+            "10 M points where 147 were cut). Built beside the engine before and run in turn in two calls, the whole "
+            "call took %s times the pinned copy at 10 M points against %s, and the staged copy alone %s ms "
+            "against %s; at 100 M points %s against %s. In a later call the kept engine read %s at 10 M points "
+            "and %s at 100 M ([gpu/%s](gpu/%s))." % (
+                spread(copy(("piece1m",), 100000000), "%.1f"), spread(copy(("before-call1",), 100000000), "%.1f"),
+                spread(copy(("flat8",), 100000000), "%.1f"),
+                spread(call(kept, 10000000)), spread(call(before, 10000000)),
+                spread(copy(kept, 10000000), "%.2f"), spread(copy(before, 10000000), "%.2f"),
+                spread(call(kept, 100000000)), spread(call(before, 100000000)),
+                spread(call(("main",), 10000000)), spread(call(("main",), 100000000)), PIECES_FILE, PIECES_FILE))
     return [text, ""]
 
 
@@ -843,7 +896,7 @@ def _cuda(ctx):
                 "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
                 "wrote.",
                 "",
-            ] + _h200(ctx) + _sort_during_upload(ctx)
+            ] + _h200(ctx) + _sort_during_upload(ctx) + _staging_pieces(ctx)
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")

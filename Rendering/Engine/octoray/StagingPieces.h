@@ -37,15 +37,15 @@ constexpr int kMaxStagingThreads = 16;
 // a multiple of kPieceAlignment, before CutPieces cuts it at its array's end.
 // The threads start together: while they fill their first buffers the copy
 // engine has nothing to do, so the first pieces are small, and grow with the
-// bytes behind them. They do not shrink toward the run's end: the host's half
-// outruns the bus (190 MB in 1.7-2.9 ms against 3.45 for the pinned copy on
-// an H200's host), so the copy engine still has pieces queued when the
-// threads take their last ones, and each piece costs the copy time beyond
-// its bytes. With 1 MB buffers, 1848 pieces at 100 M points where 4 MB cut
-// 554, the staged copy took 42.4-43.2 ms against 36.7-37.0 (about 4.5 us a
-// piece); with 8 MB buffers (256 MB pinned) it was slower too. Without the
-// shrinking, 81 pieces at 10 M points where it cut 147, the whole call took
-// 1.59-1.68 times the pinned copy against 1.71-1.80 in the same call
+// bytes behind them. They do not shrink toward the run's end: each piece
+// costs the copy time beyond its bytes, and the threads mostly wait for the
+// copy engine, not it for them, so it still has pieces queued when they take
+// their last ones. On an H200's host, with 1 MB buffers (1848 pieces at
+// 100 M points where 4 MB cut 554) the staged copy took 42.4-43.2 ms against
+// 36.7-37.0, about 4.5 us a piece; 8 MB buffers were slower too. Without
+// the shrinking (81 pieces at 10 M points where it cut 147) the whole call
+// at 10 M points took 1.56-1.68 times the pinned copy against 1.63-1.80,
+// each round beside the engine before
 // (Benchmarks/gpu/variants-staging-pieces.txt).
 inline std::size_t PieceBytes(std::size_t offset, int threads)
 {
