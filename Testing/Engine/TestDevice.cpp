@@ -181,6 +181,34 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
   }
 }
 
+// Each piece costs the staged copy time beyond its bytes, so the pieces
+// only grow along the run, up to a buffer (StagingPieces.h's PieceBytes):
+// a piece smaller than one before it is the last of its array, cut where
+// the array ends.
+TEST(StagingPieces, GrowAlongTheRunUntilTheyFillABuffer)
+{
+  using namespace octoray::cuda;
+  const std::vector<std::vector<std::size_t>> runs = { { 120000000, 30000000, 40000000 },
+    { 1200000000, 300000000, 400000000 }, { 3 * kStagingPiece + 5 }, { 7, 50 * kEdgePiece, 9, 3 * kStagingPiece } };
+  for (int threads = 1; threads <= kMaxStagingThreads; ++threads)
+  {
+    for (const std::vector<std::size_t>& arrays : runs)
+    {
+      SCOPED_TRACE("first array " + std::to_string(arrays[0]) + " bytes, threads " + std::to_string(threads));
+      const std::vector<Piece> pieces = CutPieces(StagingRun(arrays), threads);
+      std::size_t largest = 0;
+      int shrunk = 0;
+      for (const Piece& p : pieces)
+      {
+        const bool endsItsArray = p.offset + p.bytes == arrays[p.array];
+        shrunk += p.bytes < largest && !endsItsArray;
+        largest = std::max(largest, endsItsArray ? 0 : p.bytes);
+      }
+      EXPECT_EQ(shrunk, 0);
+    }
+  }
+}
+
 TEST(CpuDevice, SelectKeepsOrderAndCounts)
 {
   OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectSelectKeepsOrderAndCounts(d, n); });
