@@ -847,7 +847,8 @@ def _cuda(ctx):
                 "(Benchmarks/gpu/variants-staging.txt), the whole call went from 2.88–2.96 to 2.48–2.56 times "
                 "the pinned copy at 10 M points with pieces that grow from 0.5 MB at a stripe's start and shrink "
                 "toward its end and threads kept, to 2.22–2.25 with 16 threads instead of 8; staging arrays from "
-                "1 MB instead of 16 took the 1 M-point call from 5.87–6.44 to 4.32–4.39 times.",
+                "1 MB instead of 16 took the 1 M-point call from 5.87–6.44 to 4.32–4.39 times. The shrinking toward "
+                "the end went in e3412b8 (**Fewer staging pieces**, below).",
                 "",
             ]
         if one_pass:
