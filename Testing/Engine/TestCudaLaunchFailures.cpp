@@ -147,7 +147,6 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   }
 }
 
-
 TEST_F(CudaFaultsLaunch, RenderKeepsTheOctreeAndTheNextFrame)
 {
   const Cloud cloud = UniformCloud(3000, 63);

@@ -109,16 +109,19 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
 // ones among them), cut for 1 to kMaxStagingThreads threads: the pieces
 // cover every array once, in order; none is empty or larger than a
 // page-locked buffer; each starts at a whole multiple of kPieceAlignment
-// into its array, so that no piece splits a point; and no array gets more
-// pieces than MaxPieces, which sizes the partial bounds of its pieces.
-// Dealt to as many threads (ChunkWorkers), every piece is taken once, and
-// each thread's buffers alternate.
-TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
+// into its array, so that no piece splits a point; no array gets more
+// pieces than MaxPieces, which sizes the partial bounds of its pieces; and
+// the pieces only grow along the run (each costs the copy time beyond its
+// bytes: PieceBytes), a piece smaller than one before it the last of its
+// array, cut where the array ends. Dealt to as many threads (ChunkWorkers),
+// every piece is taken once, and each thread's buffers alternate.
+TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
 {
   using namespace octoray::cuda;
   std::mt19937_64 rng(7);
   std::vector<std::vector<std::size_t>> runs = { { 1 }, { kPieceAlignment }, { kEdgePiece + 1 }, { kStagingPiece },
-    { 3 * kStagingPiece + 5 }, { 0, 5 }, { 5, 0 }, { 120000000, 30000000, 40000000 } };
+    { 3 * kStagingPiece + 5 }, { 0, 5 }, { 5, 0 }, { 120000000, 30000000, 40000000 },
+    { 1200000000, 300000000, 400000000 } };
   for (int i = 0; i < 300; ++i)
   {
     std::vector<std::size_t> run(1 + rng() % 4);
@@ -137,7 +140,8 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
         ", threads " + std::to_string(threads));
       const std::vector<Piece> pieces = CutPieces(StagingRun(arrays), threads);
       std::vector<std::size_t> covered(arrays.size(), 0), count(arrays.size(), 0);
-      int bad = 0;
+      int bad = 0, shrunk = 0;
+      std::size_t largest = 0; // of the pieces so far not cut where their array ends
       for (std::size_t k = 0; k < pieces.size(); ++k)
       {
         const Piece& p = pieces[k];
@@ -145,10 +149,14 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
           (p.array == pieces[k - 1].array && p.offset == pieces[k - 1].offset + pieces[k - 1].bytes);
         bad += !inOrder || p.array >= arrays.size() || p.bytes == 0 || p.bytes > kStagingPiece ||
           p.offset + p.bytes > arrays[p.array] || p.offset % kPieceAlignment != 0;
+        const bool endsItsArray = p.array < arrays.size() && p.offset + p.bytes == arrays[p.array];
+        shrunk += !endsItsArray && p.bytes < largest;
+        largest = std::max(largest, endsItsArray ? 0 : p.bytes);
         covered[p.array] += p.bytes;
         ++count[p.array];
       }
       EXPECT_EQ(bad, 0);
+      EXPECT_EQ(shrunk, 0);
       for (std::size_t a = 0; a < arrays.size(); ++a)
       {
         EXPECT_EQ(covered[a], arrays[a]) << "array " << a;
@@ -177,34 +185,6 @@ TEST(StagingPieces, CoverEveryArrayWithinTheBuffersAndMaxPieces)
       std::sort(all.begin(), all.end());
       EXPECT_EQ(all, expected);
       EXPECT_EQ(std::accumulate(badBuffers.begin(), badBuffers.end(), 0), 0);
-    }
-  }
-}
-
-// Each piece costs the staged copy time beyond its bytes, so the pieces
-// only grow along the run, up to a buffer (StagingPieces.h's PieceBytes):
-// a piece smaller than one before it is the last of its array, cut where
-// the array ends.
-TEST(StagingPieces, GrowAlongTheRunUntilTheyFillABuffer)
-{
-  using namespace octoray::cuda;
-  const std::vector<std::vector<std::size_t>> runs = { { 120000000, 30000000, 40000000 },
-    { 1200000000, 300000000, 400000000 }, { 3 * kStagingPiece + 5 }, { 7, 50 * kEdgePiece, 9, 3 * kStagingPiece } };
-  for (int threads = 1; threads <= kMaxStagingThreads; ++threads)
-  {
-    for (const std::vector<std::size_t>& arrays : runs)
-    {
-      SCOPED_TRACE("first array " + std::to_string(arrays[0]) + " bytes, threads " + std::to_string(threads));
-      const std::vector<Piece> pieces = CutPieces(StagingRun(arrays), threads);
-      std::size_t largest = 0;
-      int shrunk = 0;
-      for (const Piece& p : pieces)
-      {
-        const bool endsItsArray = p.offset + p.bytes == arrays[p.array];
-        shrunk += p.bytes < largest && !endsItsArray;
-        largest = std::max(largest, endsItsArray ? 0 : p.bytes);
-      }
-      EXPECT_EQ(shrunk, 0);
     }
   }
 }

@@ -77,10 +77,10 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 // positions while the attributes are still on their way (a staged copy of
 // more than 1 MB: CudaUpload.h), it sorts the indices and gathers those
 // records in sorted order after the copy (GatherSortedRecords), or reads
-// wider ones through the indices. Every
-// record width, at depths that sort 32-bit and 64-bit keys and at the
-// automatic depth, with and without kept points, against the brute-force
-// octree; then an update of every point reads the kept records again.
+// wider ones through the indices. Every record width, at depths that sort
+// 32-bit and 64-bit keys and at the automatic depth, with and without kept
+// points, against the brute-force octree; then an update of every point
+// reads the kept records again.
 TEST_P(OctreeBuild, RecordsOfEveryWidth)
 {
   const Cloud every = GaussianClusters(4000, 23);
