@@ -192,18 +192,24 @@ SUMMARY_FIGURES = ("phases", "floor", "ratio", "call")
 def summary_figures(path):
     """{(variant, n): {figure: [one a summary line]}} of a GPU record's
     summary lines: "phases" and "floor" in ms, "ratio" (phases / floor) and
-    "call" (whole call / pinned copy); the variant is NAME under a part
-    "== source-NAME", else None."""
+    "call" (whole call / pinned copy), by variant (variant_matches)."""
     pattern = re.compile(r"summary n=(\d+): phases ([0-9.]+) ms, floor ([0-9.]+) ms, phases / floor ([0-9.]+), "
                          r"call / pinned copy ([0-9.]+)")
     found = {}
+    for variant, m in variant_matches(path, pattern):
+        figures = found.setdefault((variant, int(m.group(1))), {k: [] for k in SUMMARY_FIGURES})
+        for k, value in zip(SUMMARY_FIGURES, m.groups()[1:]):
+            figures[k].append(float(value))
+    return found
+
+
+def variant_matches(path, pattern):
+    """(variant, match) for each line of a GPU record that pattern finds:
+    the variant is NAME under a part "== source-NAME", else None."""
     for header, lines in file_parts(path).items():
         variant = header[len("source-"):] if header.startswith("source-") else None
         for m in filter(None, map(pattern.search, lines)):
-            figures = found.setdefault((variant, int(m.group(1))), {k: [] for k in SUMMARY_FIGURES})
-            for k, value in zip(SUMMARY_FIGURES, m.groups()[1:]):
-                figures[k].append(float(value))
-    return found
+            yield variant, m
 
 
 def spread(values, form="%.2f"):
@@ -296,13 +302,11 @@ PIECES_FILE = "variants-staging-pieces.txt"
 
 def staged_copy_alone(path):
     """{(variant, n): [ms]} of the benchmark's "the engine's staged copy
-    alone" under each part "== source-NAME" of a GPU record."""
+    alone" in a GPU record, by variant (variant_matches)."""
     pattern = re.compile(r"upload of (\d+) points' .* the engine's staged copy alone ([0-9.]+) ms")
     found = {}
-    for header, lines in file_parts(path).items():
-        if header.startswith("source-"):
-            for m in filter(None, map(pattern.search, lines)):
-                found.setdefault((header[len("source-"):], int(m.group(1))), []).append(float(m.group(2)))
+    for variant, m in variant_matches(path, pattern):
+        found.setdefault((variant, int(m.group(1))), []).append(float(m.group(2)))
     return found
 
 
