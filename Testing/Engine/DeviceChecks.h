@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
@@ -298,6 +300,174 @@ void ExpectSortsStable(Device& d, std::size_t n, std::uint64_t seed)
   ExpectStableKeySort<std::uint64_t>(d, n, 29, seed);
   ExpectStableKeySort<std::uint32_t>(d, n, 30, seed);
   ExpectStableKeySort<std::uint32_t>(d, n, 5, seed);
+}
+
+// A copy of `count` values from `from` to `to`, a loop on the device.
+template <class Device, typename T>
+void CopyOnDevice(Device& d, const T* from, T* to, std::size_t count)
+{
+  d.ForEach("test", count, OCTORAY_LAMBDA(std::size_t i) { to[i] = from[i]; });
+}
+
+// `count` values of the device's array `data`, read back.
+template <class Device, typename T>
+std::vector<T> HostCopy(Device& d, const T* data, std::size_t count)
+{
+  std::vector<T> host(count);
+  d.ToHost(data, count, host.data(), "test");
+  return host;
+}
+
+// StageReduced: the array where the device's loops read it, the reduction
+// of its items of three floats (their largest value: exact in any order),
+// and the arrays Prepare adds along (an 8-bit and a float one) copied in
+// the same call. whenReduced runs where `expectWhenReduced` says (CUDA's
+// staged copy in one pass of several arrays), with the final result, and
+// the loop it queues, while the arrays along are still on their way, reads
+// the whole array: a copy of it made there must miss no piece.
+template <class Device>
+void ExpectStageReducedCopiesReducesAndCallsBack(Device& d, std::size_t n, bool expectWhenReduced)
+{
+  std::mt19937 rng(static_cast<unsigned>(n));
+  std::uniform_real_distribution<float> coordinate(-1000.0f, 1000.0f);
+  std::vector<float> xyz(3 * n);
+  std::generate(xyz.begin(), xyz.end(), [&] { return coordinate(rng); });
+  std::vector<std::uint8_t> bytes(n);
+  std::vector<float> values(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    bytes[i] = static_cast<std::uint8_t>(i * 7);
+    values[i] = 0.5f * static_cast<float>(i);
+  }
+  const float none = -std::numeric_limits<float>::infinity();
+  const float largest = xyz.empty() ? none : *std::max_element(xyz.begin(), xyz.end());
+
+  typename Device::template Staged<std::uint8_t> bytesStaged;
+  typename Device::template Staged<float> valuesStaged;
+  DeviceArray<Device, float> copied(d, 3 * n, 0.0f);
+  float* copy = copied.Get();
+  bool called = false;
+  float given = 0.0f;
+  float result = 0.0f;
+  const auto staged = d.StageReduced(
+    xyz.data(), 3 * n, 3, "test positions", none,
+    OCTORAY_LAMBDA(std::size_t i, const float* p) {
+      const float a = p[3 * i] > p[3 * i + 1] ? p[3 * i] : p[3 * i + 1];
+      return a > p[3 * i + 2] ? a : p[3 * i + 2];
+    },
+    OCTORAY_LAMBDA(float a, float b) { return a > b ? a : b; }, result,
+    [&](typename Device::Fills& fills) {
+      bytesStaged = d.Prepare(bytes.data(), n, "test bytes", fills);
+      valuesStaged = d.Prepare(values.data(), n, "test values", fills);
+    },
+    std::function<void(const float&, const float*)>([&](const float& r, const float* landed) {
+      called = true;
+      given = r;
+      CopyOnDevice(d, landed, copy, 3 * n);
+    }));
+  d.Synchronize("test");
+  EXPECT_EQ(result, largest);
+  EXPECT_EQ(HostCopy(d, staged.Get(), 3 * n), xyz);
+  EXPECT_EQ(HostCopy(d, bytesStaged.Get(), n), bytes);
+  EXPECT_EQ(HostCopy(d, valuesStaged.Get(), n), values);
+  ASSERT_EQ(called, expectWhenReduced);
+  if (called)
+  {
+    EXPECT_EQ(given, largest);
+    EXPECT_EQ(copied.Host(), xyz) << "whenReduced's loop ran before the array had landed";
+  }
+}
+
+// Levels of a test tree for ReduceSmallLevels: each node's result is the
+// size of its subtree, from its children's one level down, which must be
+// complete when it is reduced.
+struct SubtreeSizes
+{
+  struct Levels
+  {
+    std::uint32_t levelBegin[NestedLists::kMaxLists + 1];
+    OCTORAY_HD std::uint32_t LevelSize(int l) const { return levelBegin[l + 1] - levelBegin[l]; }
+  } view;
+  std::uint32_t* size; // one a node, level after level; the leaves' set to 1
+
+  OCTORAY_HD void Reduce(int l, std::uint32_t j, std::uint32_t c0, std::uint32_t c1) const
+  {
+    const std::uint32_t* children = size + view.levelBegin[l + 1];
+    std::uint32_t sum = 1;
+    for (std::uint32_t c = c0; c < c1; ++c)
+    {
+      sum += children[c];
+    }
+    size[view.levelBegin[l] + j] = sum;
+  }
+};
+
+// ReduceSmallLevels over a random tree of `leaves` leaves (each node one
+// to a dozen children, four on average): the levels from the one above
+// the leaves to the root, in turn, against the subtree sizes counted on the
+// host. The children's run starts are the nested lists' packed lists, as
+// LinkLevels passes them.
+template <class Device>
+void ExpectSmallLevelsReduceEachLevelAfterTheOneBelow(Device& d, std::size_t leaves)
+{
+  // starts[k]: the run starts of the k-th level from the leaves up.
+  std::vector<std::vector<std::uint32_t>> starts;
+  std::mt19937 rng(static_cast<unsigned>(leaves));
+  for (std::size_t children = leaves; children > 1; children = starts.back().size() - 1)
+  {
+    std::vector<std::uint32_t> runs{ 0 };
+    for (std::uint32_t c = 1; c < children; ++c)
+    {
+      if (rng() % 4 == 0 || c - runs.back() == 12)
+      {
+        runs.push_back(c);
+      }
+    }
+    runs.push_back(static_cast<std::uint32_t>(children));
+    starts.push_back(runs);
+  }
+  const int depth = static_cast<int>(starts.size());
+  if (leaves == 0 || depth == 0)
+  {
+    return; // no level above the leaves
+  }
+  ASSERT_LT(depth, NestedLists::kMaxLists);
+  std::reverse(starts.begin(), starts.end()); // level l's runs at starts[l]
+  SubtreeSizes levels{};
+  std::vector<std::uint32_t> packed;
+  std::uint32_t begin = 0;
+  for (int l = 0; l < depth; ++l)
+  {
+    levels.view.levelBegin[l] = begin;
+    begin += static_cast<std::uint32_t>(starts[l].size() - 1);
+    packed.insert(packed.end(), starts[l].begin(), starts[l].end());
+  }
+  levels.view.levelBegin[depth] = begin;
+  levels.view.levelBegin[depth + 1] = begin + static_cast<std::uint32_t>(leaves);
+  std::vector<std::uint32_t> expected(levels.view.levelBegin[depth + 1], 1);
+  for (int l = depth - 1; l >= 0; --l)
+  {
+    for (std::uint32_t j = 0; j < levels.view.LevelSize(l); ++j)
+    {
+      std::uint32_t& size = expected[levels.view.levelBegin[l] + j];
+      for (std::uint32_t c = starts[l][j]; c < starts[l][j + 1]; ++c)
+      {
+        size += expected[levels.view.levelBegin[l + 1] + c];
+      }
+    }
+  }
+  std::vector<std::uint32_t> initial(expected.size(), 0xFFFFFFFFu);
+  std::fill(initial.begin() + begin, initial.end(), 1u);
+  DeviceArray<Device, std::uint32_t> sizes(d, initial), lists(d, packed);
+  levels.size = sizes.Get();
+  NestedLists nested;
+  nested.count = depth + 1;
+  nested.packed = lists.Get();
+  nested.last = nullptr; // the leaves' runs: not read by the levels above them
+  nested.packedRoom = packed.size();
+  d.ReduceSmallLevels("test", depth - 1, levels, nested);
+  EXPECT_EQ(sizes.Host(), expected);
+  EXPECT_EQ(expected[0], expected.size());
 }
 
 // The driver's run starts (a Select) and first failing step (a loop and an

@@ -189,6 +189,18 @@ TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
   }
 }
 
+// On the CPU the loops read a caller's arrays where they are: nothing is
+// on its way, and whenReduced never runs.
+TEST(CpuDevice, StageReducedCopiesReducesAndCallsBack)
+{
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectStageReducedCopiesReducesAndCallsBack(d, n, false); });
+}
+
+TEST(CpuDevice, SmallLevelsReduceEachLevelAfterTheOneBelow)
+{
+  OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectSmallLevelsReduceEachLevelAfterTheOneBelow(d, n); });
+}
+
 TEST(CpuDevice, SelectKeepsOrderAndCounts)
 {
   OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectSelectKeepsOrderAndCounts(d, n); });
