@@ -314,6 +314,14 @@ std::vector<T> HostCopy(Device& d, const T* data, std::size_t count)
   return host;
 }
 
+// The bytes of the arrays ExpectStageReducedCopiesReducesAndCallsBack
+// stages for n items: the reduced one of three floats an item, an 8-bit
+// and a float array along.
+inline std::vector<std::size_t> StagedArrayBytes(std::size_t n)
+{
+  return { 3 * n * sizeof(float), n * sizeof(std::uint8_t), n * sizeof(float) };
+}
+
 // StageReduced: the array where the device's loops read it, the reduction
 // of its items of three floats (their largest value: exact in any order),
 // and the arrays Prepare adds along (an 8-bit and a float one) copied in
@@ -431,15 +439,16 @@ void ExpectSmallLevelsReduceEachLevelAfterTheOneBelow(Device& d, std::size_t lea
   std::reverse(starts.begin(), starts.end()); // level l's runs at starts[l]
   SubtreeSizes levels{};
   std::vector<std::uint32_t> packed;
-  std::uint32_t begin = 0;
+  std::uint32_t levelBegin = 0;
   for (int l = 0; l < depth; ++l)
   {
-    levels.view.levelBegin[l] = begin;
-    begin += static_cast<std::uint32_t>(starts[l].size() - 1);
+    levels.view.levelBegin[l] = levelBegin;
+    levelBegin += static_cast<std::uint32_t>(starts[l].size() - 1);
     packed.insert(packed.end(), starts[l].begin(), starts[l].end());
   }
-  levels.view.levelBegin[depth] = begin;
-  levels.view.levelBegin[depth + 1] = begin + static_cast<std::uint32_t>(leaves);
+  const std::uint32_t leafBegin = levelBegin;
+  levels.view.levelBegin[depth] = leafBegin;
+  levels.view.levelBegin[depth + 1] = leafBegin + static_cast<std::uint32_t>(leaves);
   std::vector<std::uint32_t> expected(levels.view.levelBegin[depth + 1], 1);
   for (int l = depth - 1; l >= 0; --l)
   {
@@ -453,7 +462,7 @@ void ExpectSmallLevelsReduceEachLevelAfterTheOneBelow(Device& d, std::size_t lea
     }
   }
   std::vector<std::uint32_t> initial(expected.size(), 0xFFFFFFFFu);
-  std::fill(initial.begin() + begin, initial.end(), 1u);
+  std::fill(initial.begin() + leafBegin, initial.end(), 1u);
   DeviceArray<Device, std::uint32_t> sizes(d, initial), lists(d, packed);
   levels.size = sizes.Get();
   NestedLists nested;

@@ -39,13 +39,13 @@ TEST_F(CudaDeviceCUDA, ForEachReduceAndHistogramCoverEveryItemOnce)
   OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectLoopsCoverEveryItemOnce(d, n); });
 }
 
-// Staged in one pass (the arrays' 17 bytes a point together past
-// kStagingThreshold), whenReduced runs while the arrays along are on their
-// way; below, they are copied directly and it does not.
+// Staged in one pass (the arrays together past kStagingThreshold),
+// whenReduced runs while the arrays along are on their way; below, they
+// are copied directly and it does not.
 TEST_F(CudaDeviceCUDA, StageReducedCopiesReducesAndCallsBack)
 {
   OnEverySize([](std::size_t n, CudaDevice& d) {
-    const bool staged = cuda::StagingRun({ 12 * n, n, 4 * n }).Length() >= cuda::kStagingThreshold;
+    const bool staged = cuda::StagingRun(checks::StagedArrayBytes(n)).Length() >= cuda::kStagingThreshold;
     checks::ExpectStageReducedCopiesReducesAndCallsBack(d, n, staged);
   });
 }
