@@ -77,6 +77,41 @@ def _device_checks(ctx):
     ]
 
 
+# The two checks the thirty-first session added (StageReduced and
+# ReduceSmallLevels, on both devices): their tests, compute-sanitizer and
+# the sabotaged engine in call 2's parts "== call 2, ..." of the first.
+STAGING_CHECKS_FILE = "variants-gather-staged.txt"
+STAGING_CHECKS = ("StageReducedCopiesReducesAndCallsBack", "SmallLevelsReduceEachLevelAfterTheOneBelow")
+
+
+def _staging_checks(ctx):
+    """What call 2 of the file says of the two checks it added."""
+    path = ctx.gpu_file(STAGING_CHECKS_FILE)
+    if not path:
+        return []
+    parts = file_parts(path)
+
+    def count(part, result):  # each test's own line: "[  FAILED  ] CudaDeviceCUDA.NAME (270 ms)"
+        pattern = re.compile(r"\[ +%s +\] CudaDeviceCUDA\.(%s) \(" % (result, "|".join(STAGING_CHECKS)))
+        return sum(bool(pattern.search(line)) for line in parts.get(part, []))
+    passed = count("call 2, the device checks among main's engine tests", "OK")
+    sabotaged = count("call 2, the new checks against the sabotaged engine (staging-checks-sabotage.sh)", "FAILED")
+    tools = ["%s %s" % (m.group(1), m.group(2)) for m in (
+        re.match(r"(\w+) rc \d+ =+ (?:ERROR|RACECHECK) SUMMARY: (.*?) \[", line)
+        for line in parts.get("call 2, the new checks under compute-sanitizer", [])) if m]
+    return [
+        "Since the thirty-first session the device's staged copy with its reduction (StageReduced: the copies, "
+        "the result, and a loop queued once the array has landed, while the arrays along are still on their "
+        "way) and the small levels near the root (ReduceSmallLevels, each level after the one below) are held "
+        "to checks of their own on both devices. On an NVIDIA H200 ([gpu/%s](gpu/%s), call 2): %d of %d "
+        "passed; compute-sanitizer over them: %s; against an engine that reduces the small levels from the root "
+        "down and runs the copy's afterFirst without waiting for the first array's pieces, %d of %d failed."
+        % (STAGING_CHECKS_FILE, STAGING_CHECKS_FILE, passed, len(STAGING_CHECKS), "; ".join(tools), sabotaged,
+           len(STAGING_CHECKS)),
+        "",
+    ]
+
+
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
     if not summary_path:
@@ -140,6 +175,7 @@ def render(ctx):
         "```",
         "",
         *_device_checks(ctx),
+        *_staging_checks(ctx),
         "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",
         "plugin (ParaView is not built there); its CPU backend runs in `make test`.",
     ]
