@@ -33,8 +33,8 @@ constexpr std::size_t kEdgePiece = (std::size_t(512) << 10) / kPieceAlignment * 
 // page-locked memory: 128 MB at most.
 constexpr int kMaxStagingThreads = 16;
 
-// The bytes of the piece at `offset` of a run that `threads` threads copy,
-// a multiple of kPieceAlignment, before CutPieces cuts it at its array's end.
+// The bytes of the piece at `offset` of a run that `threads` threads copy, a
+// multiple of kPieceAlignment, before CutPieces cuts it at its array's end.
 // The threads start together: while they fill their first buffers the copy
 // engine has nothing to do, so the first pieces are small, and grow with the
 // bytes behind them. They do not shrink toward the run's end: each piece
@@ -42,10 +42,11 @@ constexpr int kMaxStagingThreads = 16;
 // copy engine, not it for them, so it still has pieces queued when they take
 // their last ones. On an H200's host, with 1 MB buffers (1848 pieces at
 // 100 M points where 4 MB cut 554) the staged copy took 42.4-43.2 ms against
-// 36.7-37.0, about 4.5 us a piece; 8 MB buffers were slower too. Without
-// the shrinking (81 pieces at 10 M points where it cut 147) the whole call
-// at 10 M points took 1.56-1.68 times the pinned copy against 1.63-1.80,
-// each round beside the engine before
+// 36.7-37.0, about 4.5 us a piece, of which the copy engine takes 2.2-3.6 us
+// from page-locked memory alone (Benchmarks/gpu/pinned-pieces.txt); 8 MB
+// buffers were slower too. Without the shrinking (81 pieces at 10 M points
+// where it cut 147) the whole call at 10 M points took 1.56-1.68 times the
+// pinned copy against 1.63-1.80, each round beside the engine before
 // (Benchmarks/gpu/variants-staging-pieces.txt).
 inline std::size_t PieceBytes(std::size_t offset, int threads)
 {
