@@ -357,9 +357,8 @@ def _dma_pieces(ctx):
         return ""
     pattern = re.compile(r"pieces of +\d+ kB on +(\d+) stream\(s\): .*, ([0-9.]+) us a piece beyond the whole")
     us = {}
-    with open(path) as f:
-        for m in filter(None, map(pattern.search, f)):
-            us.setdefault(int(m.group(1)), []).append(float(m.group(2)))
+    for _, m in variant_matches(path, pattern):  # under the parts "== run N"
+        us.setdefault(int(m.group(1)), []).append(float(m.group(2)))
     return (" Of the 4.5 µs, the copy engine takes about half or more by itself: copies from page-locked memory "
             "alone, with no host copy beside them, cost %s µs a piece beyond the whole copy on one stream and %s "
             "over 16 streams, pieces of 256 kB to 8 MB of 190 MiB and 1900 MiB (the thirty-first session, "

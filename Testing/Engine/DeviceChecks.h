@@ -24,6 +24,15 @@ namespace octoray
 {
 namespace checks
 {
+// `count` values of the device's array `data`, read back.
+template <class Device, typename T>
+std::vector<T> HostCopy(Device& d, const T* data, std::size_t count)
+{
+  std::vector<T> host(count);
+  d.ToHost(data, count, host.data(), "test");
+  return host;
+}
+
 // An array in the device's memory, made from a host vector and read back.
 template <class Device, typename T>
 class DeviceArray
@@ -39,12 +48,7 @@ public:
   {
   }
   T* Get() { return Data.Get(); }
-  std::vector<T> Host() const
-  {
-    std::vector<T> host;
-    D.Download(Data, host);
-    return host;
-  }
+  std::vector<T> Host() const { return HostCopy(D, Data.Get(), Data.Count()); }
 
 private:
   Device& D;
@@ -303,15 +307,6 @@ template <class Device, typename T>
 void CopyOnDevice(Device& d, const T* from, T* to, std::size_t count)
 {
   d.ForEach("test", count, OCTORAY_LAMBDA(std::size_t i) { to[i] = from[i]; });
-}
-
-// `count` values of the device's array `data`, read back.
-template <class Device, typename T>
-std::vector<T> HostCopy(Device& d, const T* data, std::size_t count)
-{
-  std::vector<T> host(count);
-  d.ToHost(data, count, host.data(), "test");
-  return host;
 }
 
 // The bytes of the arrays ExpectStageReducedCopiesReducesAndCallsBack
