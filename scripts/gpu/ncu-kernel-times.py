@@ -14,12 +14,14 @@ microseconds (the level phase's selects and loops, level by level). With
 --steps, the last run's launches summed by the build's steps, in the order
 the build queues them: the positions' bounds (during the upload), the keys,
 the records, the sort, the levels' run starts counted with their sizes and
-placed (before cd56a2a: the histogram of neighbouring keys), then each level
+placed (before cd56a2a: the histogram of neighbouring keys), the records
+gathered in sorted order (a build from host arrays since 022a550), then each level
 from the leaves (level 10, the depth of --profile-build) up (a loop each;
 before cd56a2a a CUB select and a loop, the select beginning with its
 DeviceCompactInitKernel), the levels near the root in one launch
 (SmallLevelsKernel), and the device phases' sum (keys, sort, level sizes,
-levels: what the benchmark's phases time, but the records).
+levels: what the benchmark's phases of a build from device arrays time, but
+the records; such a build gathers none).
 """
 import re
 import sys
@@ -72,6 +74,7 @@ STEPS = (("positions' bounds (in the upload)", ("ReduceRangeKernel", "reduce::De
          ("levels' run starts counted, their sizes", ("NestedCountKernel", "scan::DeviceScan")),
          ("levels' run starts placed", ("NestedPlaceKernel",)),
          ("records", ("IngestAttributes",)),
+         ("records gathered in sorted order", ("GatherSortedRecords",)),
          ("sort (CUB)", ("DeviceRadixSort",)),
          ("keys", ("QueueSort",)))
 PHASES = ("keys", "sort (CUB)", "histogram of neighbouring keys", "levels' run starts counted, their sizes",
