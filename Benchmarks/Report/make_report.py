@@ -28,6 +28,7 @@ import csv
 import importlib
 import json
 import os
+import re
 import shlex
 import subprocess
 import sys
@@ -136,6 +137,17 @@ class Context:
         """A file of the committed GPU run, or None when there is none."""
         path = os.path.join(self.gpu, name)
         return path if os.path.exists(path) else None
+
+    def gpu_call(self, summary):
+        """The day and the device of a call of its own, as "DAY on an
+        DEVICE" with a link to its closing table (the file `summary`, whose
+        heading line gpu-check.sh writes); None where there is none."""
+        path = self.gpu_file(summary)
+        if not path:
+            return None
+        with open(path) as f:
+            heading = re.search(r"GPU check, (\d{4}-\d\d-\d\d): ([^,]+),", f.read())
+        return heading and f"{heading.group(1)} on an {heading.group(2)} ([gpu/{summary}](gpu/{summary}))"
 
     def gpu_command(self):
         path = os.path.join(self.gpu, "COMMAND.md")

@@ -149,21 +149,23 @@ def count(n):
 # octoray_bench_orbit --tile 1e9 on the GPU machine: a real scan tiled to a
 # billion points through the mapper (the second-to-last call of COMMAND.md).
 TILED_FILE = "orbit-tiled.json"
+TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More runs of the CUDA build benchmark on the same machine (COMMAND.md):
-# lines "run N: build n=... depth=10: ... whole call R.RRx that ...".
-REPEATS_FILE = "bench-build-repeats.txt"
+# More rounds of the engine this report's run measures (7b07d72's engine
+# is 1645776's): the thirty-first session's rounds of "main" and
+# "main-call2" in its variants file, on H200 machines (COMMAND.md).
+ROUNDS_FILE = "variants-gather-staged.txt"
+ROUNDS_VARIANTS = ("main", "main-call2")
 
 
-def repeated_call_ratios(ctx, n):
-    """The whole call / pinned copy ratios of the repeated runs at n points."""
-    path = ctx.gpu_file(REPEATS_FILE)
+def more_rounds(ctx, n):
+    """The whole call / pinned copy ratios of those rounds at n points."""
+    path = ctx.gpu_file(ROUNDS_FILE)
     if not path:
         return []
-    pattern = re.compile(r"build n=%d depth=10: .* whole call ([0-9.]+)x" % n)
-    with open(path) as f:
-        return [float(m.group(1)) for m in map(pattern.search, f) if m]
+    runs = summary_figures(path)
+    return sum((runs.get((v, n), {}).get("call", []) for v in ROUNDS_VARIANTS), [])
 
 
 # The twenty-seventh session's runs on an NVIDIA H200 (COMMAND.md): the
@@ -225,14 +227,14 @@ def spread(values, form="%.2f"):
 
 
 def _h200(ctx):
-    """The H200's rounds beside the report's H100 run, from their files."""
+    """The earlier H200 calls' rounds and variants, from their files."""
     bench = ctx.gpu_file(H200_BENCH_FILE)
     if not bench:
         return []
     none = {k: [] for k in SUMMARY_FIGURES}
     runs = summary_figures(bench)
     ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
-    text = ("**On an NVIDIA H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): over "
+    text = ("**Earlier runs on the H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): over "
             "%d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
             "read %s times the sort (%s at 100 M points); the whole call %s times the pinned copy at 10 M points "
             "and %s at 100 M." % (
@@ -818,22 +820,19 @@ def _cuda(ctx):
         "",
     ]
     text += _steps_at_10m(ctx)
-    repeats = {n: repeated_call_ratios(ctx, n) for n in (10000000, 100000000)}
-    if all(repeats.values()):
-        both = [r["call_over_pinned_copy"] for r in builds if r["depth"] == 10 and r["n"] == 100000000
-                and r.get("call_over_pinned_copy")]
-        ratios = sorted(both + repeats[100000000])
+    rounds = {n: more_rounds(ctx, n) for n in (10000000, 100000000)}
+    if all(rounds.values()):
+        here = {n: [r["call_over_pinned_copy"] for r in builds if r["depth"] == 10 and r["n"] == n
+                    and r.get("call_over_pinned_copy")] for n in rounds}
         text += [
-            "Call / copy moves with the host's copy speed from run to run: at 100 M points and depth 10 it was %s "
-            "in this run and %s in %d more runs of the engine at 40104ca on a machine of the same kind "
-            "([gpu/%s](gpu/%s)), %.2f–%.2f in all; "
-            "at 10 M, "
-            "%s in those runs." % (", ".join("%.2f" % r for r in both),
-                                   ", ".join("%.2f" % r for r in repeats[100000000]), len(repeats[100000000]),
-                                   REPEATS_FILE, REPEATS_FILE, ratios[0], ratios[-1],
-                                   ", ".join("%.2f" % r for r in repeats[10000000])),
-        "",
-    ]
+            "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
+            "this run and %s in %d rounds of the same engine on other H200 machines the session before "
+            "([gpu/%s](gpu/%s), the rounds of \"main\" and \"main-call2\"); at 100 M, %s here and %s there." % (
+                ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
+                len(rounds[10000000]), ROUNDS_FILE, ROUNDS_FILE, ", ".join("%.2f" % r for r in here[100000000]),
+                ", ".join("%.2f" % r for r in rounds[100000000])),
+            "",
+        ]
     if staging:
         text += [
             "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
@@ -965,14 +964,15 @@ def _cuda(ctx):
             for r in tiled)
         first = tiled[0]
         text += [
-            "**A real scan tiled to %s points** (%s, `octoray_bench_orbit --points 0 --file "
+            "**A real scan tiled to %s points** (%s; a call of its own, %s; `octoray_bench_orbit --points 0 --file "
             "Data/External/PCL/table_scene_lms400.pcd --tile 1e9 --tile-depth 12 --methods octoray`): the LMS400 "
             "laser scan (460 400 points) copied side by side on a square grid in host memory, handed to "
             "vtkOctreeVolumeMapper as one vtkPolyData (KeepPointsForUpdates off, leaf depth 12) and drawn in an "
             "offscreen EGL window over a camera orbit. First picture (the pageable upload, the build and the first "
             "frame) %s; GPU memory the mapper added %.2f bytes per point; median frames %s. "
             "[Picture at 1920×1080](gpu/tiled-billion-1920x1080.png)." % (
-                count(first["n"]), gpu_source(ctx, TILED_FILE), seconds(first["first_picture_s"]),
+                count(first["n"]), gpu_source(ctx, TILED_FILE), ctx.gpu_call(TILED_SUMMARY) or TILED_SUMMARY,
+                seconds(first["first_picture_s"]),
                 first["gpu_bytes"] / first["n"], frames),
             "",
         ]

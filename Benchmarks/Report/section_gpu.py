@@ -150,7 +150,7 @@ def render(ctx):
                 result += "" if name == "summary.txt" else f" ([gpu/{name}](gpu/{name}))"
                 break
         rows.append((what, result))
-    steps = [line for line in summary.splitlines() if re.match(r"^[a-z-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
+    steps = [line for line in summary.splitlines() if re.match(r"^[a-z0-9-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
 
     text = [
         f"Device: {device or 'see gpu/gpu.txt'}; run of {date.group(1) if date else 'unknown date'}. Command: "

@@ -131,6 +131,10 @@ def render(ctx):
     return Section("\n".join(text), summary_rows)
 
 
+# The orbit runs in a call of its own (COMMAND.md).
+ORBIT_SUMMARY = "summary-orbit.txt"
+
+
 def orbit_text(ctx, rows, summary_rows):
     table = [(r["scene"], f"{r['n']:,}", r["size"], method_title(r["method"]), ms(r["median"]), ms(r["p95"]),
               r["frames"], ms(r["first"]), ms(r["prepare"]) if r["prepare"] else "–", f"{r['gpu'] / 1e6:.0f}")
@@ -162,7 +166,8 @@ def orbit_text(ctx, rows, summary_rows):
         "is skipped, and says so. First picture: from points in memory to the first frame (octree "
         "build, or resampling onto an image, plus the first render); making the points is not counted. "
         "GPU memory: what the device's use grew by (cudaMemGetInfo: CUDA and OpenGL together). "
-        f"Table as CSV: [{link}]({link}).",
+        f"From a call of its own ({ctx.gpu_call(ORBIT_SUMMARY) or 'gpu/COMMAND.md'}), not the tests' call "
+        f"above. Table as CSV: [{link}]({link}).",
         "",
         ctx.table(["scene", "points", "window", "method", "median frame ms", "p95 ms", "frames",
                    "first picture ms", "of which resampling ms", "GPU MB"], table, "lrlrrrrrrr"),
