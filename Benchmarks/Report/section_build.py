@@ -152,9 +152,10 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measures (7b07d72's engine
+# More rounds of the engine this report's run measured (7b07d72's engine
 # is 1645776's): the thirty-first session's rounds of "main" and
 # "main-call2" in its variants file, on H200 machines (COMMAND.md).
+ROUNDS_ENGINE = "1645776"
 ROUNDS_FILE = "variants-gather-staged.txt"
 ROUNDS_VARIANTS = ("main", "main-call2")
 
@@ -234,8 +235,8 @@ def _h200(ctx):
     none = {k: [] for k in SUMMARY_FIGURES}
     runs = summary_figures(bench)
     ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
-    text = ("**Earlier runs on the H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): over "
-            "%d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
+    text = ("**Earlier runs on the H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): "
+            "over %d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
             "read %s times the sort (%s at 100 M points); the whole call %s times the pinned copy at 10 M points "
             "and %s at 100 M." % (
                 H200_BENCH_FILE, H200_BENCH_FILE, len(ten["ratio"]), spread(ten["phases"], "%.3f"),
@@ -826,10 +827,11 @@ def _cuda(ctx):
                     and r.get("call_over_pinned_copy")] for n in rounds}
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
-            "this run and %s in %d rounds of the same engine on other H200 machines the session before "
+            "this run and %s in %d rounds of %s's engine on other H200 machines in the thirty-first session "
             "([gpu/%s](gpu/%s), the rounds of \"main\" and \"main-call2\"); at 100 M, %s here and %s there." % (
                 ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
-                len(rounds[10000000]), ROUNDS_FILE, ROUNDS_FILE, ", ".join("%.2f" % r for r in here[100000000]),
+                len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_FILE, ROUNDS_FILE,
+                ", ".join("%.2f" % r for r in here[100000000]),
                 ", ".join("%.2f" % r for r in rounds[100000000])),
             "",
         ]
