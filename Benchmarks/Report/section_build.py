@@ -369,6 +369,42 @@ def _dma_pieces(ctx):
             % (spread(us.get(1, []), "%.1f"), spread(us.get(16, []), "%.1f"), DMA_PIECES_FILE, DMA_PIECES_FILE))
 
 
+# The thirty-second session's pool of the engine's kind, its memory mapped,
+# reused and trimmed (scripts/gpu/pool-regrowth.cu, three runs): lines
+# "... mapping costs M ms a GB; the trim that gives it back T ms (U ms a GB)".
+POOL_FILE = "pool-regrowth.txt"
+
+
+def _lean_builds(ctx, builds, mem_records):
+    """What a build without the points pays for giving its memory back,
+    from the pool's H200 file and this run's builds at depth 10."""
+    path = ctx.gpu_file(POOL_FILE)
+    if not path:
+        return []
+    pattern = re.compile(r"mapping costs ([0-9.]+) ms a GB; the trim that gives it back [0-9.]+ ms \(([0-9.]+) ms a GB")
+    per_gb = [float(m.group(1)) + float(m.group(2)) for _, m in variant_matches(path, pattern)]
+    cases = []
+    for r in builds:
+        arrays = mem_records.get((r["n"], r["depth"]), {}).get("array_bytes_per_point")
+        if r["depth"] == 10 and r["n"] >= 10000000 and arrays and r.get("lean_seconds"):
+            gb = arrays * r["n"] / 1e9
+            cases.append("%s points: %s against %s with the points kept, %.1f ms more, where its %.1f GB of arrays "
+                         "would cost %.1f–%.1f ms" % (count(r["n"]), seconds(r["lean_seconds"]),
+                                                      seconds(r["seconds"]), 1e3 * (r["lean_seconds"] - r["seconds"]),
+                                                      gb, gb * min(per_gb), gb * max(per_gb)))
+    if not per_gb or not cases:
+        return []
+    return [
+        "**A build without the points** (`BuildOptions::keepPoints` off, as ParaView's representation builds) "
+        "gives the allocator's memory back after it (Device::TrimCache), so that a static scene holds its nodes "
+        "alone, and the next build maps that memory again. In a pool made as the engine makes it, mapping new "
+        "memory costs beyond reusing it, plus the trim that gives it back, %s ms a GB (the thirty-second session, "
+        "scripts/gpu/pool-regrowth.cu, [gpu/%s](gpu/%s)). In this run, %s. Keeping the memory would spend the "
+        "memory goal." % (spread(per_gb), POOL_FILE, POOL_FILE, "; ".join(cases)),
+        "",
+    ]
+
+
 STEPS_FILE = "profile-build-10m.txt"
 
 
@@ -869,7 +905,7 @@ def _cuda(ctx):
                       + ["upload / pinned", "B/point, arrays", "B/point, with cache", "whole call, points not kept",
                          "B/point, points not kept"], staging_rows),
             "",
-        ]
+        ] + _lean_builds(ctx, builds, mem_records)
         if host_copy:
             text += [
                 "The staging's threads start together and end together: with 4 MB pieces the copy engine waited "
