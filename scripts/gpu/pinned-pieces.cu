@@ -6,7 +6,7 @@
 // divided by the pieces beyond one is what each piece costs the copy itself.
 //
 //   nvcc -O2 -arch=sm_90 -o /tmp/pinned-pieces scripts/gpu/pinned-pieces.cu && /tmp/pinned-pieces [MB...]
-#include <cuda_runtime.h>
+#include "probe-support.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -15,15 +15,6 @@
 
 namespace
 {
-void Check(cudaError_t e, const char* what)
-{
-  if (e != cudaSuccess)
-  {
-    std::fprintf(stderr, "%s: %s\n", what, cudaGetErrorString(e));
-    std::exit(1);
-  }
-}
-
 // Median milliseconds of `rounds` copies of `bytes` in pieces of `piece`
 // bytes, queued in turn on the first `streamCount` streams.
 float CopyMilliseconds(char* device, const char* host, std::size_t bytes, std::size_t piece,
@@ -63,8 +54,7 @@ float CopyMilliseconds(char* device, const char* host, std::size_t bytes, std::s
   }
   Check(cudaEventDestroy(start), "cudaEventDestroy");
   Check(cudaEventDestroy(stop), "cudaEventDestroy");
-  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-  return times[times.size() / 2];
+  return Median(times);
 }
 }
 

@@ -9,9 +9,8 @@
 // Host wall time, with the stream synchronised, median of the rounds.
 //
 //   nvcc -O2 -arch=sm_90 -o /tmp/pool-regrowth scripts/gpu/pool-regrowth.cu && /tmp/pool-regrowth [GB...]
-#include <cuda_runtime.h>
+#include "probe-support.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -20,15 +19,6 @@
 
 namespace
 {
-void Check(cudaError_t e, const char* what)
-{
-  if (e != cudaSuccess)
-  {
-    std::fprintf(stderr, "%s: %s\n", what, cudaGetErrorString(e));
-    std::exit(1);
-  }
-}
-
 constexpr std::size_t kArrayBytes = std::size_t(100) << 20;
 
 double Milliseconds(const std::function<void()>& work)
@@ -37,12 +27,6 @@ double Milliseconds(const std::function<void()>& work)
   work();
   Check(cudaStreamSynchronize(0), "cudaStreamSynchronize");
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-double Median(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 // Arrays of kArrayBytes taking `bytes` from the pool, each written once.
