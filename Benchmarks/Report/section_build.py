@@ -370,7 +370,7 @@ def _dma_pieces(ctx):
 
 
 # The thirty-second session's pool of the engine's kind, its memory mapped,
-# reused and trimmed (scripts/gpu/pool-regrowth.cu, three runs): lines
+# reused and trimmed (scripts/gpu/pool-regrowth.cu, calls 4 and 5): lines
 # "... mapping costs M ms a GB; the trim that gives it back T ms (U ms a GB)".
 POOL_FILE = "pool-regrowth.txt"
 
@@ -383,16 +383,18 @@ def _lean_builds(ctx, builds, mem_records):
         return []
     pattern = re.compile(r"mapping costs ([0-9.]+) ms a GB; the trim that gives it back [0-9.]+ ms \(([0-9.]+) ms a GB")
     per_gb = [float(m.group(1)) + float(m.group(2)) for _, m in variant_matches(path, pattern)]
+    if not per_gb:
+        return []
     cases = []
     for r in builds:
         arrays = mem_records.get((r["n"], r["depth"]), {}).get("array_bytes_per_point")
         if r["depth"] == 10 and r["n"] >= 10000000 and arrays and r.get("lean_seconds"):
             gb = arrays * r["n"] / 1e9
-            cases.append("%s points: %s against %s with the points kept, %.1f ms more, where its %.1f GB of arrays "
-                         "would cost %.1f–%.1f ms" % (count(r["n"]), seconds(r["lean_seconds"]),
+            cases.append("%s points: %s against %s with the points kept, %.1f ms more, where the %.1f GB of arrays "
+                         "the build with its points holds would cost %.1f–%.1f ms" % (count(r["n"]), seconds(r["lean_seconds"]),
                                                       seconds(r["seconds"]), 1e3 * (r["lean_seconds"] - r["seconds"]),
                                                       gb, gb * min(per_gb), gb * max(per_gb)))
-    if not per_gb or not cases:
+    if not cases:
         return []
     return [
         "**A build without the points** (`BuildOptions::keepPoints` off, as ParaView's representation builds) "
