@@ -185,6 +185,13 @@ H200_VARIANTS = (
      "the thirty-first session's records written in sorted order straight from the staged attribute arrays, one "
      "loop an attribute, where they are gathered from the point records (the sort phase with the gather took "
      "0.79–0.80 ms at 10 M points against 0.76–0.77, and 9.65 ms at 100 M against 7.10–7.12)"),
+    ("variants-leaf-parents.txt", "leaf-parents",
+     "the thirty-third session's leaves reduced in the loop of the level above them, a thread a parent that "
+     "reads its leaves back where it has just written them (in ncu at 10 M points that launch took 376 µs where "
+     "the leaves and level 9 took 164 + 101)"),
+    ("variants-overlapped-launches.txt", "overlapped",
+     "the thirty-third session's build kernels launched to begin while the kernel before each ends (Hopper's "
+     "programmatic dependent launch), each waiting there for that kernel's writes"),
     ("variants-landed-records.txt", "landed",
      "the twenty-ninth session's records stored as each piece of the attributes lands, in the caller's order and "
      "ranked by the sort during the upload, where they are made and gathered in sorted order after the copy (the "
@@ -248,10 +255,11 @@ def _h200(ctx):
             continue
         rounds = summary_figures(path)
         main, other = (rounds.get((v, 10000000), none) for v in ("main", variant))
-        text += (" Built beside main and run in turn there, %s: at 10 M points %s times the sort against %s, the "
-                 "whole call %s times the pinned copy against %s; not kept ([gpu/%s](gpu/%s))." % (
-                     tried, spread(other["ratio"]), spread(main["ratio"]), spread(other["call"]),
-                     spread(main["call"]), name, name))
+        text += (" Built beside main and run in turn there, %s: at 10 M points the device phases %s ms against "
+                 "%s, %s times the sort against %s, the whole call %s times the pinned copy against %s; not kept "
+                 "([gpu/%s](gpu/%s))." % (
+                     tried, spread(other["phases"], "%.3f"), spread(main["phases"], "%.3f"), spread(other["ratio"]),
+                     spread(main["ratio"]), spread(other["call"]), spread(main["call"]), name, name))
     return [text, ""]
 
 
