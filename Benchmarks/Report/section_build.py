@@ -170,9 +170,10 @@ def more_rounds(ctx, n):
 
 
 # The twenty-seventh session's runs on an NVIDIA H200 (COMMAND.md): the
-# benchmark, and two variants built beside main and run in turn. Their
-# "summary n=..." lines are scripts/gpu/build-ratios.py's, under a line
-# "== source-NAME" for each variant of a variants file.
+# benchmark; and the variants of that session and later ones, each built
+# beside main and run in turn, not kept. Their "summary n=..." lines are
+# scripts/gpu/build-ratios.py's, under a line "== source-NAME" for each
+# variant of a variants file ("main" the engine it was built beside).
 H200_BENCH_FILE = "bench-h200.txt"
 H200_VARIANTS = (
     ("variants-staging-one-stream.txt", "one",
