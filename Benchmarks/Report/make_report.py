@@ -146,8 +146,8 @@ class Context:
         if not path:
             return None
         with open(path) as f:
-            heading = re.search(r"GPU check, (\d{4}-\d\d-\d\d): ([^,]+),", f.read())
-        return heading and f"{heading.group(1)} on an {heading.group(2)} ([gpu/{summary}](gpu/{summary}))"
+            heading = gpu_check_heading(f.read())
+        return heading and f"{heading[0]} on an {heading[1]} ([gpu/{summary}](gpu/{summary}))"
 
     def gpu_command(self):
         path = os.path.join(self.gpu, "COMMAND.md")
@@ -199,6 +199,14 @@ class Context:
         lines = ["| " + " | ".join(str(h) for h in header) + " |", "| " + " | ".join(marks) + " |"]
         lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
         return "\n".join(lines)
+
+
+def gpu_check_heading(text):
+    """(day, device) from the heading line that gpu-check.sh writes atop a
+    call's closing table ("== octoray GPU check, DAY: DEVICE, driver,
+    memory =="); None where the text has none."""
+    heading = re.search(r"GPU check, (\d{4}-\d\d-\d\d): ([^,]+),", text)
+    return heading.groups() if heading else None
 
 
 def file_parts(path):

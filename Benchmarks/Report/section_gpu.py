@@ -6,7 +6,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section, file_parts
+from make_report import Section, file_parts, gpu_check_heading
 
 TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
 
@@ -130,7 +130,7 @@ def render(ctx):
     if ctx.gpu_file("gpu.txt"):
         with open(ctx.gpu_file("gpu.txt")) as f:
             device = f.read().strip()
-    date = re.search(r"(?:CUDA|GPU) check, (\d{4}-\d\d-\d\d)", summary)
+    heading = gpu_check_heading(summary)
 
     rows = []
     if ctx.gpu_file("engine-tests.xml"):
@@ -153,7 +153,7 @@ def render(ctx):
     steps = [line for line in summary.splitlines() if re.match(r"^[a-z0-9-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
 
     text = [
-        f"Device: {device or 'see gpu/gpu.txt'}; run of {date.group(1) if date else 'unknown date'}. Command: "
+        f"Device: {device or 'see gpu/gpu.txt'}; run of {heading[0] if heading else 'unknown date'}. Command: "
         f"`{ctx.gpu_command() or 'scripts/gpu/gpu-check.sh OUTDIR'}`.",
         "",
         "gpu-check.sh builds the whole project for sm_90 against VTK 9.2 with EGL (the GPU machine has",
