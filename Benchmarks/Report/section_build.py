@@ -329,6 +329,11 @@ def staged_copy_alone(path):
     return found
 
 
+# The pieces the staging cut at 100 M points with 1 MB buffers and with
+# 4 MB ones, as variants-staging-pieces.txt's header gives them.
+PIECES_1MB, PIECES_4MB = 1848, 554
+
+
 def _staging_pieces(ctx):
     """Fewer staging pieces, from their H200 file."""
     path = ctx.gpu_file(PIECES_FILE)
@@ -339,10 +344,13 @@ def _staging_pieces(ctx):
     call = lambda variants, n: sum((rounds.get((v, n), none)["call"] for v in variants), [])
     copy = lambda variants, n: sum((alone.get((v, n), []) for v in variants), [])
     kept, before = ("flat-call2", "main-call3"), ("before-call2", "before")
+    one_mb, four_mb = copy(("piece1m",), 100000000), copy(("before-call1",), 100000000)
+    mean = lambda values: sum(values) / len(values)
+    per_piece = 1e3 * (mean(one_mb) - mean(four_mb)) / (PIECES_1MB - PIECES_4MB) if one_mb and four_mb else None
     text = ("**Fewer staging pieces** (the thirtieth session, on the H200, kept in e3412b8): each piece of the "
             "staged copy costs the copy time beyond its bytes. With 1 MB page-locked buffers where there are 4 MB, "
-            "1848 pieces at 100 M points where 554 were cut, the engine's staged copy alone took %s ms against %s "
-            "(about 4.5 µs a piece); with 8 MB buffers (256 MB pinned) it was slower too, %s ms. Since e3412b8 the "
+            "%d pieces at 100 M points where %d were cut, the engine's staged copy alone took %s ms against %s "
+            "(about %s µs a piece); with 8 MB buffers (256 MB pinned) it was slower too, %s ms. Since e3412b8 the "
             "pieces grow from 0.5 MB as before but no longer shrink toward the run's end, which was to keep the "
             "copy engine's last pieces short: the threads mostly wait for the copy engine, not it for them, so it "
             "still has pieces queued when they take their last ones (StagingPieces.h's PieceBytes; 81 pieces at "
@@ -350,13 +358,13 @@ def _staging_pieces(ctx):
             "call took %s times the pinned copy at 10 M points against %s, and the staged copy alone %s ms "
             "against %s; at 100 M points %s against %s. In a later call the kept engine read %s at 10 M points "
             "and %s at 100 M ([gpu/%s](gpu/%s))." % (
-                spread(copy(("piece1m",), 100000000), "%.1f"), spread(copy(("before-call1",), 100000000), "%.1f"),
-                spread(copy(("flat8",), 100000000), "%.1f"),
+                PIECES_1MB, PIECES_4MB, spread(one_mb, "%.1f"), spread(four_mb, "%.1f"),
+                "%.1f" % per_piece if per_piece else "–", spread(copy(("flat8",), 100000000), "%.1f"),
                 spread(call(kept, 10000000)), spread(call(before, 10000000)),
                 spread(copy(kept, 10000000), "%.2f"), spread(copy(before, 10000000), "%.2f"),
                 spread(call(kept, 100000000)), spread(call(before, 100000000)),
                 spread(call(("main",), 10000000)), spread(call(("main",), 100000000)), PIECES_FILE, PIECES_FILE))
-    return [text + _dma_pieces(ctx), ""]
+    return [text + _dma_pieces(ctx, per_piece), ""]
 
 
 # The thirty-first session's copies from page-locked memory alone, whole
@@ -365,8 +373,9 @@ def _staging_pieces(ctx):
 DMA_PIECES_FILE = "pinned-pieces.txt"
 
 
-def _dma_pieces(ctx):
-    """What a piece costs the copy engine alone, from its H200 file."""
+def _dma_pieces(ctx, per_piece):
+    """What a piece costs the copy engine alone, from its H200 file, of the
+    `per_piece` µs a staged piece costs."""
     path = ctx.gpu_file(DMA_PIECES_FILE)
     if not path:
         return ""
@@ -374,11 +383,12 @@ def _dma_pieces(ctx):
     us = {}
     for _, m in variant_matches(path, pattern):  # under the parts "== run N"
         us.setdefault(int(m.group(1)), []).append(float(m.group(2)))
-    return (" Of the 4.5 µs, the copy engine takes about half or more by itself: copies from page-locked memory "
+    return (" Of the %s µs, the copy engine takes about half or more by itself: copies from page-locked memory "
             "alone, with no host copy beside them, cost %s µs a piece beyond the whole copy on one stream and %s "
             "over 16 streams, pieces of 256 kB to 8 MB of 190 MiB and 1900 MiB (the thirty-first session, "
             "scripts/gpu/pinned-pieces.cu, [gpu/%s](gpu/%s)); the rest comes with the staging threads' copies."
-            % (spread(us.get(1, []), "%.1f"), spread(us.get(16, []), "%.1f"), DMA_PIECES_FILE, DMA_PIECES_FILE))
+            % ("%.1f" % per_piece if per_piece else "–", spread(us.get(1, []), "%.1f"), spread(us.get(16, []), "%.1f"),
+               DMA_PIECES_FILE, DMA_PIECES_FILE))
 
 
 # The thirty-second session's pool of the engine's kind, its memory mapped,
@@ -403,9 +413,9 @@ def _lean_builds(ctx, builds, mem_records):
         if r["depth"] == 10 and r["n"] >= 10000000 and arrays and r.get("lean_seconds"):
             gb = arrays * r["n"] / 1e9
             cases.append("%s points: %s against %s with the points kept, %.1f ms more, where the %.1f GB of arrays "
-                         "the build with its points holds would cost %.1f–%.1f ms" % (count(r["n"]), seconds(r["lean_seconds"]),
-                                                      seconds(r["seconds"]), 1e3 * (r["lean_seconds"] - r["seconds"]),
-                                                      gb, gb * min(per_gb), gb * max(per_gb)))
+                         "the build with its points holds would cost %.1f–%.1f ms" % (
+                             count(r["n"]), seconds(r["lean_seconds"]), seconds(r["seconds"]),
+                             1e3 * (r["lean_seconds"] - r["seconds"]), gb, gb * min(per_gb), gb * max(per_gb)))
     if not cases:
         return []
     return [
