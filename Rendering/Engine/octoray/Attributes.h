@@ -98,6 +98,7 @@ enum AttributeBits : unsigned
 #define OCTORAY_BIT(member, Name, ...) kHas##Name = 1u << kAttribute##Name,
   OCTORAY_ATTRIBUTES(OCTORAY_BIT)
 #undef OCTORAY_BIT
+    kAllAttributes = (1u << kAttributeCount) - 1
 };
 
 // An attribute value as its slots (Slot: float, or whole bytes), the

@@ -38,6 +38,25 @@
 
 namespace octoray
 {
+// A loop body (OCTORAY_LAMBDA) that asks CUDA for `Blocks` blocks a
+// multiprocessor: its kernel's launch bounds, to which the compiler fits
+// its registers (CudaDevice::ForEach). The CPU runs it as any other body.
+// Loops that do not ask get kLoopBlocks.
+constexpr int kLoopBlocks = 4;
+
+template <int Blocks, typename Fn>
+struct Occupying
+{
+  Fn body;
+  OCTORAY_HD_INLINE void operator()(std::size_t i) const { body(i); }
+};
+
+template <int Blocks, typename Fn>
+Occupying<Blocks, Fn> BlocksPerMultiprocessor(Fn body)
+{
+  return Occupying<Blocks, Fn>{ body };
+}
+
 // Deepest level of the octree: 21 bits per axis fill a 63-bit Morton key.
 constexpr int kMaxLevel = 21;
 constexpr std::uint32_t kInvalidIndex = 0xFFFFFFFFu;

@@ -36,12 +36,14 @@ inline unsigned Blocks(std::size_t n)
   return static_cast<unsigned>((n + kBlock - 1) / kBlock);
 }
 
-// At least 4 blocks of kBlock threads on a multiprocessor: 64 registers a
-// thread. The build's level loops, which read each node's children or points
-// and sum their attributes in double, took 80 to 96 registers and ran 1.2 to
-// 1.6 times longer on an H100 with them (Benchmarks/gpu/variants-records.txt).
-template <typename Fn>
-__global__ void __launch_bounds__(kBlock, 4) ForEachKernel(std::size_t n, Fn fn)
+// At least MinBlocks blocks of kBlock threads on a multiprocessor:
+// kLoopBlocks (4, 64 registers a thread) unless the loop asks for more
+// (Occupying). The build's level loops, which read each node's children or
+// points and sum their attributes in double, took 80 to 96 registers and ran
+// 1.2 to 1.6 times longer on an H100 without that bound
+// (Benchmarks/gpu/variants-records.txt).
+template <int MinBlocks, typename Fn>
+__global__ void __launch_bounds__(kBlock, MinBlocks) ForEachKernel(std::size_t n, Fn fn)
 {
   const std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
   if (i < n)
@@ -643,9 +645,14 @@ public:
   template <typename Fn>
   void ForEach(const char* name, std::size_t n, Fn fn)
   {
+    ForEach(name, n, Occupying<kLoopBlocks, Fn>{ fn });
+  }
+  template <int Blocks, typename Fn>
+  void ForEach(const char* name, std::size_t n, Occupying<Blocks, Fn> loop)
+  {
     if (n)
     {
-      Launch(name, cuda::ForEachKernel<Fn>, cuda::Blocks(n), cuda::kBlock, n, fn);
+      Launch(name, cuda::ForEachKernel<Blocks, Fn>, cuda::Blocks(n), cuda::kBlock, n, loop.body);
     }
   }
 

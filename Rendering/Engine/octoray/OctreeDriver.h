@@ -876,6 +876,36 @@ NestedLists LevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeS
   return lists;
 }
 
+// The nodes from the sorted points and each level's run starts: leaves,
+// then each level from the one below, the few small ones near the root
+// together (Device::ReduceSmallLevels). Neither the points' records nor the
+// nodes hold attributes outside Possible: the loops of kLeanAttributes ask
+// for eight blocks a multiprocessor, to which their registers fit.
+template <unsigned Possible, class Device>
+void ReduceNodes(Device& d, const OctreeView& view, const PointArraysView& pts, const SortedKeys& keys,
+  const NestedLists& starts)
+{
+  constexpr int kBlocks = Possible == kLeanAttributes ? 8 : kLoopBlocks;
+  const std::uint32_t leafBegin = view.levelBegin[view.depth];
+  const std::uint32_t* leafStarts = starts.last;
+  d.ForEach("LeafKernel", view.LevelSize(view.depth), BlocksPerMultiprocessor<kBlocks>(OCTORAY_LAMBDA(std::size_t j) {
+    ReduceLeaf<Possible>(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), leafStarts[j], leafStarts[j + 1]);
+  }));
+  const InnerLevels<Possible> levels{ view };
+  int l = view.depth - 1;
+  for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
+  {
+    const std::uint32_t* children = starts.List(l, view.levelBegin[l]);
+    d.ForEach("InnerKernel", view.LevelSize(l), BlocksPerMultiprocessor<kBlocks>(OCTORAY_LAMBDA(std::size_t j) {
+      levels.Reduce(l, static_cast<std::uint32_t>(j), children[j], children[j + 1]);
+    }));
+  }
+  if (l >= 0)
+  {
+    d.ReduceSmallLevels("SmallLevelsKernel", l, levels, starts);
+  }
+}
+
 // The node arrays from the sorted points: leaves, then each level from the
 // one below, its nodes the runs of equal parent keys. The level sizes are
 // known from the histogram, and every level's run starts come from one pass
@@ -917,25 +947,13 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const NestedLists starts = LevelStarts(d, scratch, s, sorted);
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
-  const std::uint32_t leafBegin = view.levelBegin[depth];
-  const std::uint32_t* leafStarts = starts.last;
-  d.ForEach("LeafKernel", view.LevelSize(depth), OCTORAY_LAMBDA(std::size_t j) {
-    ReduceLeaf(view, pts, keys, leafBegin + static_cast<std::uint32_t>(j), leafStarts[j], leafStarts[j + 1]);
-  });
-  // Levels of many children a loop each; the few small ones near the root
-  // together (Device::ReduceSmallLevels).
-  const InnerLevels levels{ view };
-  int l = depth - 1;
-  for (; l >= 0 && levels.Children(l) > Device::kSmallLevelItems; --l)
+  if (((s.attributes | pts.layout.Attributes()) & ~kLeanAttributes) == 0)
   {
-    const std::uint32_t* children = starts.List(l, s.levelBegin[l]);
-    d.ForEach("InnerKernel", view.LevelSize(l), OCTORAY_LAMBDA(std::size_t j) {
-      levels.Reduce(l, static_cast<std::uint32_t>(j), children[j], children[j + 1]);
-    });
+    ReduceNodes<kLeanAttributes>(d, view, pts, keys, starts);
   }
-  if (l >= 0)
+  else
   {
-    d.ReduceSmallLevels("SmallLevelsKernel", l, levels, starts);
+    ReduceNodes<kAllAttributes>(d, view, pts, keys, starts);
   }
 }
 

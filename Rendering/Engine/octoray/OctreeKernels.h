@@ -81,14 +81,14 @@ struct BoundsUnion
   }
 };
 
-// fn(slot, value) for each slot of each attribute the nodes store, of node
-// n (as ForEachRecordSlot for a point).
-template <typename Fn>
+// fn(slot, value) for each slot of each attribute the nodes store, of
+// those in Possible, of node n (as ForEachRecordSlot for a point).
+template <unsigned Possible = kAllAttributes, typename Fn>
 OCTORAY_HD void ForEachNodeSlot(const OctreeView& t, std::uint32_t n, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
-    if (A::Of(t))
+    if ((Possible & A::kBit) != 0 && A::Of(t))
     {
       const typename A::Type value = A::Of(t)[n];
       ForEachSlotOf(a, value, fn);
@@ -155,7 +155,22 @@ struct SortedKeys
   }
 };
 
+// The attributes of most clouds, scanned or simulated: 8-bit colours,
+// scalars and reflectivity; not float colours, normals (for lighting) or
+// refraction (for glass). The leaf and inner loops keep the sums of every
+// slot their points or children may have in registers, so a loop that may
+// meet fewer attributes holds fewer: the leaf loop 39 where it may meet
+// every attribute 60, on sm_90. With fewer registers more blocks fit on a
+// multiprocessor, and these loops wait mostly on their loads: at 10 M
+// points on an H200 the leaves took 124 us at six blocks and 115 at eight
+// (32 registers, 12 bytes spilled) where they took 163 at four
+// (Benchmarks/gpu/variants-lean-loops.txt). LinkLevels runs the loops of
+// clouds of these alone as ReduceNodes<kLeanAttributes>.
+constexpr unsigned kLeanAttributes = kHasColor8 | kHasScalar | kHasReflectivity;
+
 // Leaf `node` holds the sorted points [begin, end): key, topology and means.
+// Its points' records hold no attributes outside Possible (AttributeBits).
+template <unsigned Possible = kAllAttributes>
 OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, const SortedKeys& sorted,
   std::uint32_t node, std::uint32_t begin, std::uint32_t end)
 {
@@ -175,7 +190,7 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
   SlotSums<double> sums;
   for (std::uint32_t s = begin; s < end; ++s)
   {
-    ForEachRecordSlot(sorted.Record(pts, s), pts.layout, [&](int k, auto x) { sums.Add(k, x, 1); });
+    ForEachRecordSlot<Possible>(sorted.Record(pts, s), pts.layout, [&](int k, auto x) { sums.Add(k, x, 1); });
   }
   StoreNodeMeans(t, node, sums, static_cast<double>(end - begin));
 }
@@ -191,6 +206,7 @@ OCTORAY_HD void ReduceLeaf(const OctreeView& t, const PointArraysView& pts, cons
 // a multiprocessor; in float 40 and six, and level 9 of 10 M points took
 // 150 us against 182 (Benchmarks/gpu/variants-inner-float.txt). A leaf's
 // points stay summed in double (ReduceLeaf): a leaf may hold millions.
+template <unsigned Possible = kAllAttributes>
 OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uint32_t c0, std::uint32_t c1)
 {
   t.SetKey(node, t.Key(c0) >> 3);
@@ -208,7 +224,7 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
     count += n;
     if (t.attributes) // one test the compiler can take out of the loop, not one an attribute
     {
-      ForEachNodeSlot(t, c, [&](int k, auto x) { sums.Add(k, x, n); });
+      ForEachNodeSlot<Possible>(t, c, [&](int k, auto x) { sums.Add(k, x, n); });
     }
   }
   t.SetChildMask(node, mask);
@@ -223,7 +239,9 @@ OCTORAY_HD void ReduceChildren(const OctreeView& t, std::uint32_t node, std::uin
 // Device::ReduceSmallLevels the small ones together: level l's nodes are the
 // runs of equal parent keys among level l + 1's nodes, its children (c and
 // j count from each level's first node; the runs' starts come from
-// LinkLevels' nested lists).
+// LinkLevels' nested lists). The nodes store no attributes outside
+// Possible.
+template <unsigned Possible = kAllAttributes>
 struct InnerLevels
 {
   OctreeView view;
@@ -234,7 +252,7 @@ struct InnerLevels
   OCTORAY_HD void Reduce(int l, std::uint32_t j, std::uint32_t c0, std::uint32_t c1) const
   {
     const std::uint32_t first = view.levelBegin[l + 1];
-    ReduceChildren(view, view.levelBegin[l] + j, first + c0, first + c1);
+    ReduceChildren<Possible>(view, view.levelBegin[l] + j, first + c0, first + c1);
   }
 };
 

@@ -30,6 +30,17 @@ struct PointRecordLayout
       offset[a] = -1;
     }
   }
+
+  // The attributes a record holds (AttributeBits).
+  OCTORAY_HD unsigned Attributes() const
+  {
+    unsigned bits = 0;
+    for (int a = 0; a < kAttributeCount; ++a)
+    {
+      bits |= offset[a] >= 0 ? 1u << a : 0u;
+    }
+    return bits;
+  }
 };
 
 // The words a value of type T takes in a record: whole words, so that every
@@ -63,18 +74,20 @@ OCTORAY_HD void StoreInRecord(std::uint32_t* records, const PointRecordLayout& l
   }
 }
 
-// fn(slot, value) for each slot of each attribute the record holds. The
-// build's loops add up only these: summing every slot, absent attributes'
+// fn(slot, value) for each slot of each attribute the record holds, of
+// those in Possible (AttributeBits; the caller knows the record holds no
+// others): the code of the rest is left out when compiled. The build's
+// loops add up only these slots: summing every slot, absent attributes'
 // zeros included, cost a conversion to double and an add per slot and point
 // (with the byte-wise reads below, the leaf kernel took 1.63 ms at 100 M
 // points on an H100 against 1.32: Benchmarks/gpu/variants-slots.txt).
-template <typename Fn>
+template <unsigned Possible = kAllAttributes, typename Fn>
 OCTORAY_HD void ForEachRecordSlot(const std::uint32_t* record, const PointRecordLayout& layout, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
     const int offset = layout.offset[A::kIndex];
-    if (offset < 0)
+    if ((Possible & A::kBit) == 0 || offset < 0)
     {
       return;
     }
