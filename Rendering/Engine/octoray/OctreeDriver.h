@@ -19,7 +19,8 @@
 //   Upload, Download, ToHost, FillBytes   copies in and out, a memset
 //   QueueToHost(data, n, what), WaitToHost(host, what)   a copy of n 64-bit words to the host that the host
 //                                     waits for only in WaitToHost, queuing more work meanwhile
-//   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h)
+//   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h), at
+//                                     the blocks a multiprocessor fn asks for where it is Occupying (Config.h)
 //   Reduce(n, identity, map, combine) combine over every map(i), returned to the host
 //   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
@@ -880,12 +881,12 @@ NestedLists LevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeS
 // then each level from the one below, the few small ones near the root
 // together (Device::ReduceSmallLevels). Neither the points' records nor the
 // nodes hold attributes outside Possible: the loops of kLeanAttributes ask
-// for eight blocks a multiprocessor, to which their registers fit.
+// for kLeanLoopBlocks blocks a multiprocessor, to which their registers fit.
 template <unsigned Possible, class Device>
 void ReduceNodes(Device& d, const OctreeView& view, const PointArraysView& pts, const SortedKeys& keys,
   const NestedLists& starts)
 {
-  constexpr int kBlocks = Possible == kLeanAttributes ? 8 : kLoopBlocks;
+  constexpr int kBlocks = Possible == kLeanAttributes ? kLeanLoopBlocks : kLoopBlocks;
   const std::uint32_t leafBegin = view.levelBegin[view.depth];
   const std::uint32_t* leafStarts = starts.last;
   d.ForEach("LeafKernel", view.LevelSize(view.depth), BlocksPerMultiprocessor<kBlocks>(OCTORAY_LAMBDA(std::size_t j) {

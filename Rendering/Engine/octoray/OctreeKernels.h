@@ -88,10 +88,13 @@ OCTORAY_HD void ForEachNodeSlot(const OctreeView& t, std::uint32_t n, Fn&& fn)
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
-    if ((Possible & A::kBit) != 0 && A::Of(t))
+    if constexpr ((Possible & A::kBit) != 0)
     {
-      const typename A::Type value = A::Of(t)[n];
-      ForEachSlotOf(a, value, fn);
+      if (A::Of(t))
+      {
+        const typename A::Type value = A::Of(t)[n];
+        ForEachSlotOf(a, value, fn);
+      }
     }
   });
 }
@@ -159,14 +162,17 @@ struct SortedKeys
 // scalars and reflectivity; not float colours, normals (for lighting) or
 // refraction (for glass). The leaf and inner loops keep the sums of every
 // slot their points or children may have in registers, so a loop that may
-// meet fewer attributes holds fewer: the leaf loop 39 where it may meet
-// every attribute 60, on sm_90. With fewer registers more blocks fit on a
-// multiprocessor, and these loops wait mostly on their loads: at 10 M
-// points on an H200 the leaves took 124 us at six blocks and 115 at eight
-// (32 registers, 12 bytes spilled) where they took 163 at four
+// meet fewer attributes holds fewer: the leaf loop 39 registers on sm_90
+// where it may meet every attribute 60 (four blocks a multiprocessor).
+// With fewer registers more blocks fit, and these loops wait mostly on
+// their loads: at 10 M points on an H200 the leaves took 124 us at six
+// blocks and 115 at kLeanLoopBlocks (32 registers, 12 bytes spilled) where
+// they took 163 at four, level 9 88 us at eight against 101
 // (Benchmarks/gpu/variants-lean-loops.txt). LinkLevels runs the loops of
-// clouds of these alone as ReduceNodes<kLeanAttributes>.
+// clouds of these alone as ReduceNodes<kLeanAttributes>; the general loops,
+// at eight blocks, spilled 152 bytes a thread and took twice as long.
 constexpr unsigned kLeanAttributes = kHasColor8 | kHasScalar | kHasReflectivity;
+constexpr int kLeanLoopBlocks = 8;
 
 // Leaf `node` holds the sorted points [begin, end): key, topology and means.
 // Its points' records hold no attributes outside Possible (AttributeBits).

@@ -86,20 +86,23 @@ OCTORAY_HD void ForEachRecordSlot(const std::uint32_t* record, const PointRecord
 {
   ForEachAttribute([&](auto a) {
     using A = decltype(a);
-    const int offset = layout.offset[A::kIndex];
-    if ((Possible & A::kBit) == 0 || offset < 0)
+    if constexpr ((Possible & A::kBit) != 0)
     {
-      return;
+      const int offset = layout.offset[A::kIndex];
+      if (offset < 0)
+      {
+        return;
+      }
+      // Whole words: a memcpy straight from the record reads it a byte at a time.
+      std::uint32_t words[kWordsOf<typename A::Type>];
+      for (int w = 0; w < kWordsOf<typename A::Type>; ++w)
+      {
+        words[w] = record[offset + w];
+      }
+      typename A::Type value;
+      memcpy(&value, words, sizeof value);
+      ForEachSlotOf(a, value, fn);
     }
-    // Whole words: a memcpy straight from the record reads it a byte at a time.
-    std::uint32_t words[kWordsOf<typename A::Type>];
-    for (int w = 0; w < kWordsOf<typename A::Type>; ++w)
-    {
-      words[w] = record[offset + w];
-    }
-    typename A::Type value;
-    memcpy(&value, words, sizeof value);
-    ForEachSlotOf(a, value, fn);
   });
 }
 
