@@ -267,6 +267,67 @@ def _h200(ctx):
     return [text, ""]
 
 
+# The thirty-fourth session's change on the H200 (COMMAND.md): the leaf and
+# inner loops of clouds of the lean attributes compiled for those alone,
+# built beside the engine before and run in turn ("main" against "before"
+# in call 3; "set3" and "set3o8" against "before-call2" in call 2), with
+# ncu's steps of a 10 M-point build ("call 3: ncu, main" against call 1's
+# "colour-scalar", whose leaves ran the engine before's general loop, and
+# "occ8", that general loop at eight blocks).
+LEAN_FILE = "variants-lean-loops.txt"
+LEAN_STEPS = {"lean": "call 3: ncu, main: steps of the last of two 10 M-point builds",
+              "before": "call 1: ncu, colour-scalar: steps of the last of two 10 M-point builds (its leaves: "
+                        "ReduceLeaves<63>, the general loop)",
+              "occ8": "call 1: ncu, occ8: steps of the last of two 10 M-point builds"}
+
+
+def step_microseconds(lines, step):
+    """The µs of a step in ncu-kernel-times.py --steps lines."""
+    for line in lines:
+        m = re.match(r"\s*([0-9.]+) us\s.*\s%s$" % re.escape(step), line)
+        if m:
+            return float(m.group(1))
+    return float("nan")
+
+
+def _lean_loops(ctx):
+    """The lean loops, from their H200 file."""
+    path = ctx.gpu_file(LEAN_FILE)
+    if not path:
+        return []
+    none = {k: [] for k in SUMMARY_FIGURES}
+    rounds = summary_figures(path)
+    at = lambda variant, n, figure, form="%.2f": spread(rounds.get((variant, n), none)[figure], form)
+    parts = file_parts(path)
+    us = {(k, step): step_microseconds(parts.get(header, []), step) for k, header in LEAN_STEPS.items()
+          for step in ("leaves (level 10)", "level 9", "device phases (keys, sort, level sizes, levels)")}
+    text = ("**The lean loops** (the thirty-fourth session, on the H200, kept in 4881ff3): the leaf loop keeps the sum "
+            "of every slot its points may have in registers through its loop, and where every attribute may be "
+            "present that is ten doubles and four 64-bit words, 60 registers on sm_90, four blocks a multiprocessor. "
+            "The loops of clouds of 8-bit colours, scalars and reflectivity alone (OctreeKernels.h's "
+            "kLeanAttributes, most scanned and simulated clouds, the benchmark's among them) are compiled for "
+            "those alone (OctreeDriver.h's ReduceNodes) and ask for eight blocks a multiprocessor "
+            "(Config.h's Occupying): the leaf loop holds 32 registers so, 12 bytes spilled, the inner one 32. "
+            "Built beside fd530d0's engine and run in turn, three rounds, the device phases at 10 M points took %s ms "
+            "against %s, %s times the sort against %s, and at 100 M %s against %s times; the whole call %s times the "
+            "pinned copy at 10 M points against %s. In ncu at 10 M points the leaves took %.1f µs against %.1f, "
+            "level 9 %.1f against %.1f, the device phases by step %.1f against %.1f. At six blocks (39 registers) "
+            "the device phases took %s ms, at eight %s, against %s in that call; the general loop forced to eight "
+            "blocks spilled 152 bytes a thread and took the leaves to %.1f µs ([gpu/%s](gpu/%s)). Clouds with float "
+            "colours, normals or refraction keep the general loops." % (
+                at("main", 10000000, "phases", "%.3f"), at("before", 10000000, "phases", "%.3f"),
+                at("main", 10000000, "ratio"), at("before", 10000000, "ratio"),
+                at("main", 100000000, "ratio"), at("before", 100000000, "ratio"),
+                at("main", 10000000, "call"), at("before", 10000000, "call"),
+                us["lean", "leaves (level 10)"], us["before", "leaves (level 10)"],
+                us["lean", "level 9"], us["before", "level 9"],
+                us["lean", "device phases (keys, sort, level sizes, levels)"],
+                us["before", "device phases (keys, sort, level sizes, levels)"],
+                at("set3", 10000000, "phases", "%.3f"), at("set3o8", 10000000, "phases", "%.3f"),
+                at("before-call2", 10000000, "phases", "%.3f"), us["occ8", "leaves (level 10)"], LEAN_FILE, LEAN_FILE))
+    return [text, ""]
+
+
 # The twenty-eighth session's change on the H200 (COMMAND.md): the keys and
 # the sort during the attributes' upload, built beside the engine before and
 # run in turn in calls 2 and 3 (variants "main-79d9b9f" and "before-call2",
@@ -819,9 +880,10 @@ def _cuda(ctx):
         "100 M points: its records staged a warp at a time in shared memory (4.17 ms: a warp of long leaves "
         "then adds them nearly one after another), the loop unrolled four times (6.40 ms), five blocks a "
         "multiprocessor at 48 registers (4.41 ms; Benchmarks/gpu/variants-leaf-loop.txt, with ncu's SASS "
-        "counters of the old loop). On the H200 at 10 M points the leaf loop of today waits on its loads "
-        "(long scoreboard, 63 % of its stalls) at 42 % achieved occupancy and issues on 54 % of its cycles, about "
-        "380 warp instructions a warp of 32 leaves; level 9 alike (Benchmarks/gpu/profile-build-kernels-10m.txt). "
+        "counters of the old loop). On the H200 at 10 M points the leaf loop of 557ad59's engine waits on its "
+        "loads (long scoreboard, 63 % of its stalls) at 42 % achieved occupancy and issues on 54 % of its cycles, "
+        "about 380 warp instructions a warp of 32 leaves; level 9 alike (Benchmarks/gpu/profile-build-kernels-10m.txt). "
+        "With fewer registers, eight blocks a multiprocessor did help it (**The lean loops**, below). "
         "Neither its leaves reduced in their parents' loop (a thread a parent: 376 µs where the two loops took "
         "265) nor its loads moved before its stores (164.4 µs against 164.0) helped "
         "(Benchmarks/gpu/variants-leaf-parents.txt, variants-loads-first.txt). "
@@ -994,7 +1056,7 @@ def _cuda(ctx):
                 "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
                 "wrote.",
                 "",
-            ] + _h200(ctx) + _sort_during_upload(ctx) + _staging_pieces(ctx)
+            ] + _lean_loops(ctx) + _h200(ctx) + _sort_during_upload(ctx) + _staging_pieces(ctx)
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")
