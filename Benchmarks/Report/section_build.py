@@ -281,15 +281,6 @@ LEAN_STEPS = {"lean": "call 3: ncu, main: steps of the last of two 10 M-point bu
               "occ8": "call 1: ncu, occ8: steps of the last of two 10 M-point builds"}
 
 
-def step_microseconds(lines, step):
-    """The µs of a step in ncu-kernel-times.py --steps lines."""
-    for line in lines:
-        m = re.match(r"\s*([0-9.]+) us\s.*\s%s$" % re.escape(step), line)
-        if m:
-            return float(m.group(1))
-    return float("nan")
-
-
 def _lean_loops(ctx):
     """The lean loops, from their H200 file."""
     path = ctx.gpu_file(LEAN_FILE)
@@ -299,8 +290,7 @@ def _lean_loops(ctx):
     rounds = summary_figures(path)
     at = lambda variant, n, figure, form="%.2f": spread(rounds.get((variant, n), none)[figure], form)
     parts = file_parts(path)
-    us = {(k, step): step_microseconds(parts.get(header, []), step) for k, header in LEAN_STEPS.items()
-          for step in ("leaves (level 10)", "level 9", "device phases (keys, sort, level sizes, levels)")}
+    us = {(k, step): t for k, header in LEAN_STEPS.items() for step, t in build_steps(parts.get(header, []))}
     text = ("**The lean loops** (the thirty-fourth session, on the H200, kept in 4881ff3): the leaf loop keeps the sum "
             "of every slot its points may have in registers through its loop, and where every attribute may be "
             "present that is ten doubles and four 64-bit words, 60 registers on sm_90, four blocks a multiprocessor. "
