@@ -1125,7 +1125,24 @@ def _cuda(ctx):
             summary.append(("CUDA octree build, 10 M points, depth 10 (whole call, GPU run)", seconds(r["seconds"]),
                             "bare CUB radix sort " + seconds(r["peer_seconds"]),
                             "%.0f× the sort" % (r["seconds"] / r["peer_seconds"])))
-    return "\n".join(text) + "\n", summary + _goal_rows(builds, records, phases, upload)
+    return "\n".join(text) + "\n", summary + _lean_row(ctx) + _goal_rows(builds, records, phases, upload)
+
+
+def _lean_row(ctx):
+    """The README summary's row of the lean loops' rounds (kept after this
+    run's engine): their device phases against the sort beside them."""
+    path = ctx.gpu_file(LEAN_FILE)
+    if not path:
+        return []
+    none = {k: [] for k in SUMMARY_FIGURES}
+    rounds = summary_figures(path)
+    main = [rounds.get(("main", n), none) for n in (10000000, 100000000)]
+    return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, since 4881ff3 (the lean loops; three "
+             "rounds on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
+             " / ".join(spread(m["phases"], "%.3f") + " ms" for m in main),
+             "bare CUB radix sort %s; issue 16's goal ≤ %g× the sort" % (
+                 " / ".join(spread(m["floor"], "%.3f") + " ms" for m in main), GOAL_OVER_SORT),
+             " / ".join(spread(m["ratio"]) + "×" for m in main))]
 
 
 def _goal_rows(builds, records, phases, upload):
