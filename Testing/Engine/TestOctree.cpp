@@ -104,7 +104,7 @@ TEST_P(OctreeBuild, RecordsOfEveryWidth)
     { "no attributes (0 words)", only(every, false, false, false, false, false) },
     { "colours (1 word)", only(every, true, false, false, false, false) },
     { "colours and reflectivity (2 words)", only(every, true, false, true, false, false) },
-    // Every attribute of the lean loops (kLeanAttributes), and one more.
+    // Every attribute of the lean loops (kLeanAttributes); the next cloud has one outside them.
     { "colours, scalars and reflectivity (3 words)", only(every, true, true, true, false, false) },
     { "colours, scalars and normals (3 words)", only(every, true, true, false, true, false) },
     { "every attribute (5 words)", every },

@@ -93,7 +93,7 @@ def steps(last):
         step = next((name for name, keys in STEPS if any(k in full for k in keys)), None)
         if "DeviceCompactInitKernel" in full:
             levels, selected = levels + 1, True
-        elif "LinkLevels" in full or "ReduceNodes" in full:
+        elif "LinkLevels" in full or "ReduceNodes" in full:  # the level loops' lambdas (ReduceNodes since 4881ff3)
             levels, selected = levels + (0 if selected else 1), False
         if "SmallLevelsKernel" in full:
             step = SMALL_LEVELS
