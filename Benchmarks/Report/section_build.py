@@ -1,6 +1,7 @@
 """Octree build: octoray against PCL's octree and VTK's point locators (same
 points, same run), the engine alone (phases, memory), the CUDA backend from
 the committed GPU run, and the octree's quantisation error against depth."""
+import collections
 import json
 import os
 import re
@@ -166,7 +167,7 @@ def more_rounds(ctx, n):
     if not path:
         return []
     runs = summary_figures(path)
-    return sum((runs.get((v, n), {}).get("call", []) for v in ROUNDS_VARIANTS), [])
+    return sum((runs[(v, n)]["call"] for v in ROUNDS_VARIANTS), [])
 
 
 # The twenty-seventh session's runs on an NVIDIA H200 (COMMAND.md): the
@@ -210,12 +211,13 @@ SUMMARY_FIGURES = ("phases", "floor", "ratio", "call")
 def summary_figures(path):
     """{(variant, n): {figure: [one a summary line]}} of a GPU record's
     summary lines: "phases" and "floor" in ms, "ratio" (phases / floor) and
-    "call" (whole call / pinned copy), by variant (variant_matches)."""
+    "call" (whole call / pinned copy), by variant (variant_matches); empty
+    lists for a variant and size the record lacks."""
     pattern = re.compile(r"summary n=(\d+): phases ([0-9.]+) ms, floor ([0-9.]+) ms, phases / floor ([0-9.]+), "
                          r"call / pinned copy ([0-9.]+)")
-    found = {}
+    found = collections.defaultdict(lambda: {k: [] for k in SUMMARY_FIGURES})
     for variant, m in variant_matches(path, pattern):
-        figures = found.setdefault((variant, int(m.group(1))), {k: [] for k in SUMMARY_FIGURES})
+        figures = found[(variant, int(m.group(1)))]
         for k, value in zip(SUMMARY_FIGURES, m.groups()[1:]):
             figures[k].append(float(value))
     return found
@@ -243,9 +245,8 @@ def _h200(ctx):
     bench = ctx.gpu_file(H200_BENCH_FILE)
     if not bench:
         return []
-    none = {k: [] for k in SUMMARY_FIGURES}
     runs = summary_figures(bench)
-    ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
+    ten, hundred = (runs[(None, n)] for n in (10000000, 100000000))
     text = ("**Earlier runs on the H200** (the twenty-seventh session's calls, c6857bf's engine, [gpu/%s](gpu/%s)): "
             "over %d runs of the benchmark the device phases at 10 M points took %s ms and the sort %s, so the build "
             "read %s times the sort (%s at 100 M points); the whole call %s times the pinned copy at 10 M points "
@@ -258,7 +259,7 @@ def _h200(ctx):
         if not path:
             continue
         rounds = summary_figures(path)
-        main, other = (rounds.get((v, 10000000), none) for v in ("main", variant))
+        main, other = (rounds[(v, 10000000)] for v in ("main", variant))
         text += (" Built beside main and run in turn there, %s: at 10 M points the device phases %s ms against "
                  "%s, %s times the sort against %s, the whole call %s times the pinned copy against %s; not kept "
                  "([gpu/%s](gpu/%s))." % (
@@ -286,9 +287,8 @@ def _lean_loops(ctx):
     path = ctx.gpu_file(LEAN_FILE)
     if not path:
         return []
-    none = {k: [] for k in SUMMARY_FIGURES}
     rounds = summary_figures(path)
-    at = lambda variant, n, figure, form="%.2f": spread(rounds.get((variant, n), none)[figure], form)
+    at = lambda variant, n, figure, form="%.2f": spread(rounds[(variant, n)][figure], form)
     parts = file_parts(path)
     us = {(k, step): t for k, header in LEAN_STEPS.items() for step, t in build_steps(parts.get(header, []))}
     text = ("**The lean loops** (the thirty-fourth session, on the H200, kept in 4881ff3): the leaf loop keeps the sum "
@@ -331,12 +331,11 @@ def _sort_during_upload(ctx):
     variants, bench = ctx.gpu_file(OVERLAP_VARIANTS_FILE), ctx.gpu_file(OVERLAP_BENCH_FILE)
     if not variants or not bench:
         return []
-    none = {k: [] for k in SUMMARY_FIGURES}
     rounds = summary_figures(variants)
-    at = lambda variants, n, figure: sum((rounds.get((v, n), none)[figure] for v in variants), [])
+    at = lambda variants, n, figure: sum((rounds[(v, n)][figure] for v in variants), [])
     kept, before = ("main-79d9b9f", "main"), ("before-call2", "before")
     runs = summary_figures(bench)
-    ten, hundred = (runs.get((None, n), none) for n in (10000000, 100000000))
+    ten, hundred = (runs[(None, n)] for n in (10000000, 100000000))
     text = ("**The keys and the sort during the upload** (the twenty-eighth session, on the H200, kept in 022a550): "
             "where a build's attributes are still on their way once its positions have landed (the staged copy of "
             "host arrays of 1 MB and more, the positions first), the cube's check, the keys, the sort of the "
@@ -390,9 +389,8 @@ def _staging_pieces(ctx):
     path = ctx.gpu_file(PIECES_FILE)
     if not path:
         return []
-    none = {k: [] for k in SUMMARY_FIGURES}
     rounds, alone = summary_figures(path), staged_copy_alone(path)
-    call = lambda variants, n: sum((rounds.get((v, n), none)["call"] for v in variants), [])
+    call = lambda variants, n: sum((rounds[(v, n)]["call"] for v in variants), [])
     copy = lambda variants, n: sum((alone.get((v, n), []) for v in variants), [])
     kept, before = ("flat-call2", "main-call3"), ("before-call2", "before")
     one_mb, four_mb = copy(("piece1m",), 100000000), copy(("before-call1",), 100000000)
@@ -1135,9 +1133,8 @@ def _lean_row(ctx):
     path = ctx.gpu_file(LEAN_FILE)
     if not path:
         return []
-    none = {k: [] for k in SUMMARY_FIGURES}
     rounds = summary_figures(path)
-    main = [rounds.get(("main", n), none) for n in (10000000, 100000000)]
+    main = [rounds[("main", n)] for n in (10000000, 100000000)]
     return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, since 4881ff3 (the lean loops; three "
              "rounds on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
              " / ".join(spread(m["phases"], "%.3f") + " ms" for m in main),
