@@ -153,12 +153,13 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measured (7b07d72's engine
-# is 1645776's): the thirty-first session's rounds of "main" and
-# "main-call2" in its variants file, on H200 machines (COMMAND.md).
-ROUNDS_ENGINE = "1645776"
-ROUNDS_FILE = "variants-gather-staged.txt"
-ROUNDS_VARIANTS = ("main", "main-call2")
+# More rounds of the engine this report's run measured (607a057's engine
+# is 4881ff3's, its PTX the same): the thirty-fourth session's rounds of
+# "main" in its variants file, on an H200 machine (COMMAND.md).
+ROUNDS_ENGINE = "4881ff3"
+ROUNDS_SESSION = "thirty-fourth"
+ROUNDS_FILE = "variants-lean-loops.txt"
+ROUNDS_VARIANTS = ("main",)
 
 
 def more_rounds(ctx, n):
@@ -944,10 +945,11 @@ def _cuda(ctx):
                     and r.get("call_over_pinned_copy")] for n in rounds}
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
-            "this run and %s in %d rounds of %s's engine on other H200 machines in the thirty-first session "
-            "([gpu/%s](gpu/%s), the rounds of \"main\" and \"main-call2\"); at 100 M, %s here and %s there." % (
+            "this run and %s in %d rounds of %s's engine on another H200 machine in the %s session "
+            "([gpu/%s](gpu/%s), the rounds of %s); at 100 M, %s here and %s there." % (
                 ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
-                len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_FILE, ROUNDS_FILE,
+                len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_SESSION, ROUNDS_FILE, ROUNDS_FILE,
+                " and ".join('"%s"' % v for v in ROUNDS_VARIANTS),
                 ", ".join("%.2f" % r for r in here[100000000]),
                 ", ".join("%.2f" % r for r in rounds[100000000])),
             "",
@@ -1128,15 +1130,15 @@ def _cuda(ctx):
 
 
 def _lean_row(ctx):
-    """The README summary's row of the lean loops' rounds (kept after this
-    run's engine): their device phases against the sort beside them."""
+    """The README summary's row of the lean loops' rounds (this run's engine,
+    three more rounds): their device phases against the sort beside them."""
     path = ctx.gpu_file(LEAN_FILE)
     if not path:
         return []
     rounds = summary_figures(path)
     main = [rounds[("main", n)] for n in (10000000, 100000000)]
-    return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, since 4881ff3 (the lean loops; three "
-             "rounds on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
+    return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, the same engine in three more rounds "
+             "(4881ff3's lean loops, on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
              " / ".join(spread(m["phases"], "%.3f") + " ms" for m in main),
              "bare CUB radix sort %s; issue 16's goal ≤ %g× the sort" % (
                  " / ".join(spread(m["floor"], "%.3f") + " ms" for m in main), GOAL_OVER_SORT),
