@@ -121,8 +121,8 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   // Levels of more children than SmallLevelsKernel takes (InnerKernel).
   const Cloud wide = UniformCloud(50000, 62);
   // Records of two words over 1 MB of input: staged, its keys and sort
-  // queued from a staging thread during the attributes' upload, its records
-  // gathered in sorted order after it (GatherRecordsKernel).
+  // queued from a staging thread during the attributes' upload, its leaf
+  // loop reading the records through the sorted indices after it.
   Cloud staged = UniformCloud(60000, 64);
   staged.scalar.clear();
   staged.normal.clear();
@@ -132,13 +132,11 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   BuildOptions automaticDepth; // depth 0: the depth histogram runs too
 
   for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel",
-         "GatherRecordsKernel" })
+         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
   {
     const std::string name = kernel;
-    const std::vector<const Cloud*> seconds = name == "InnerKernel" ? std::vector<const Cloud*>{ &wide }
-      : name == "GatherRecordsKernel"                                 ? std::vector<const Cloud*>{ &staged }
-                                                                      : std::vector<const Cloud*>{ &tight, &staged };
+    const std::vector<const Cloud*> seconds =
+      name == "InnerKernel" ? std::vector<const Cloud*>{ &wide } : std::vector<const Cloud*>{ &tight, &staged };
     for (const Cloud* second : seconds)
     {
       SCOPED_TRACE(name + (second == &staged ? ", staged" : ""));

@@ -72,12 +72,12 @@ TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
 }
 
 // The sort moves each point's record with its key where the record is one
-// or two words and the leaf keys fit 32 bits, and gathers the records by
-// index otherwise (SortedKeys, OctreeKernels.h). Where CUDA sorts the
-// positions while the attributes are still on their way (a staged copy of
-// more than 1 MB: CudaUpload.h), it sorts the indices and gathers those
-// records in sorted order after the copy (GatherSortedRecords), or reads
-// wider ones through the indices. Every record width, at depths that sort
+// or two words and the leaf keys fit 32 bits, and the leaf loop reads the
+// records through the points' indices otherwise (SortedKeys,
+// OctreeKernels.h). Where CUDA sorts the positions while the attributes are
+// still on their way (a staged copy of more than 1 MB: CudaUpload.h), it
+// sorts the indices, through which the leaf loop reads records of every
+// width after the copy. Every record width, at depths that sort
 // 32-bit and 64-bit keys and at the automatic depth, with and without kept
 // points, against the brute-force octree; then an update of every point
 // reads the kept records again.

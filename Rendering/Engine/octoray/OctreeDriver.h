@@ -505,6 +505,10 @@ SortInput ReserveSortInput(Device& d, DriverScratch<Device>& scratch, std::size_
       d.Release(scratch.sortIndex[b]);
     }
   }
+  if (indexed) // the records stay where they are (SortedKeys)
+  {
+    d.Release(scratch.sortRecords);
+  }
   return SortInput{ narrow ? nullptr : scratch.sortKey[0].Get(), narrow ? scratch.narrowKey[0].Get() : nullptr,
     indexed ? scratch.sortIndex[0].Get() : nullptr };
 }
@@ -569,42 +573,6 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
     sorted.wideKey = keys[result];
   }
   return sorted;
-}
-
-// Where a sort queued before the points' records had landed sorted their
-// indices (QueueSort) and the records would have travelled with the keys,
-// copies the records in sorted order into the sort's record array, which
-// is what the travelling sort leaves: SortedKeys with records, no index.
-// A read at a random place a point: in ncu on an H200 its kernel took
-// 249 us at 10 M points, 3.27 ms at 100 M, after the copy, where the sort
-// it lets run during the copy took 0.39 and 3.09 ms.
-template <class Device>
-void GatherSortedRecords(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, SortedKeys& keys)
-{
-  const int stride = pts.layout.stride;
-  if (!keys.index || !keys.narrowKey || !SortedKeys::RecordsFit(stride))
-  {
-    return;
-  }
-  d.Reserve(scratch.sortRecords, pts.count * stride, "sort records");
-  std::uint32_t* sorted = scratch.sortRecords.Get();
-  const std::uint32_t* index = keys.index;
-  d.ForEach("GatherRecordsKernel", pts.count, OCTORAY_LAMBDA(std::size_t j) {
-    const std::uint32_t* record = pts.Record(index[j]);
-    for (int w = 0; w < stride; ++w)
-    {
-      sorted[j * stride + w] = record[w];
-    }
-  });
-  keys.records = sorted;
-  keys.index = nullptr;
-  for (auto& buffer : scratch.sortIndex) // the other holds the leaves' run starts (SortedPoints::spare)
-  {
-    if (buffer.Get() == index)
-    {
-      d.Release(buffer);
-    }
-  }
 }
 
 // fn(words) with the sorted keys as the sort stored them: 32-bit words
@@ -674,11 +642,11 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 // sort, and the histogram of neighbouring sorted keys. Records that fit
 // travel with the keys (SortedKeys::RecordsTravel); where a record layout
 // is given but its records have not landed (pts.records null), the points'
-// indices do, for GatherSortedRecords. chooseDepth: the histograms the
-// automatic depth reads, else the levels' run starts counted
-// (CountLevelStarts), their sizes in the histogram, and placed where they
-// fit. Marks on `clock`: marks[0] after the keys, marks[1] after the
-// histograms or the run starts.
+// indices do, through which the leaf loop reads the records (SortedKeys).
+// chooseDepth: the histograms the automatic depth reads, else the levels'
+// run starts counted (CountLevelStarts), their sizes in the histogram, and
+// placed where they fit. Marks on `clock`: marks[0] after the keys,
+// marks[1] after the histograms or the run starts.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
@@ -772,13 +740,12 @@ void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
 // while the points' records may still be on their way, and finished
 // (FinishBuild) once they are in the state. Marks on `clock`: the keys
 // [0, 1] and the sort [1, 2]; the automatic depth's full-depth sort, keys
-// [3, 4] and sort [4, 5]; the records gathered in sorted order [6, 7]; -1:
-// none.
+// [3, 4] and sort [4, 5]; -1: none.
 template <class Device>
 struct QueuedBuild
 {
   typename Device::Clock clock;
-  int marks[8];
+  int marks[6];
   FirstFailure outside;
   int requestedDepth;
   SortedPoints sorted;
@@ -792,7 +759,7 @@ template <class Device>
 void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int requestedDepth, QueuedBuild<Device>& q)
 {
-  std::fill_n(q.marks, 8, -1);
+  std::fill_n(q.marks, 6, -1);
   q.marks[0] = q.clock.Mark();
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
@@ -827,9 +794,6 @@ void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     sorted.keys.keyShift += 3 * (sorted.depth - depth);
     sorted.depth = depth;
   }
-  q.marks[6] = q.clock.Mark();
-  GatherSortedRecords(d, scratch, s.Points(), sorted.keys);
-  q.marks[7] = q.clock.Mark();
 }
 
 // levelBegin[l]: the first node of level l, from the newNode histogram;
@@ -976,7 +940,7 @@ BuildStats FinishBuild(Device& d, DriverScratch<Device>& scratch, OctreeState<De
     return q.marks[from] >= 0 ? q.clock.Seconds(q.marks[from], q.marks[to]) : 0.0;
   };
   stats.keySeconds = span(0, 1) + span(3, 4);
-  stats.sortSeconds = span(1, 2) + span(4, 5) + span(6, 7);
+  stats.sortSeconds = span(1, 2) + span(4, 5);
   stats.levelSeconds = q.clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
   stats.cube = cube;
@@ -1029,11 +993,10 @@ struct StagedInput
 // once the positions have landed (CUDA's staged copy of a caller's host
 // arrays), the cube is checked then and the keys and the sort of the
 // positions are queued into `queued`, with the points' indices, to run
-// meanwhile; the records are gathered in sorted order after the copy
-// (FinishSort). At 10 M points on an H200 the whole call took 1.61-1.65
-// times the pinned copy against 1.70-1.77 with the sort after the copy, at
-// 100 M 1.34-1.36 against 1.38-1.42
-// (Benchmarks/gpu/variants-sort-during-upload.txt).
+// meanwhile; the leaf loop reads the records through them (SortedKeys). At
+// 10 M points on an H200 the whole call took 1.61-1.65 times the pinned
+// copy against 1.70-1.77 with the sort after the copy, at 100 M 1.34-1.36
+// against 1.38-1.42 (Benchmarks/gpu/variants-sort-during-upload.txt).
 template <class Device>
 StagedInput<Device> StageInput(Device& d, DriverScratch<Device>& scratch, const PointCloudView& points,
   const BuildOptions& options, const PointRecordLayout& layout, QueuedBuild<Device>& queued)

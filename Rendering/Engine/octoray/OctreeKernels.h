@@ -129,12 +129,16 @@ OCTORAY_HD bool ComputeLeafKey(const PointArraysView& pts, const RootCube::CellM
 // The points in the order of their leaf keys, as the build's sort leaves
 // them. Leaf keys of depth 10 and less fit 32 bits; each travels with its
 // point's record where that is one or two words (RecordsTravel), so that
-// the leaf pass reads the records in order. Gathering them in sorted order
-// from the points' own records instead costs a random read each, which on
-// an H100 took longer than the sort (Benchmarks/gpu/variants-records.txt).
-// Other keys travel with their points' indices, and so do these where the
-// sort runs before the records have landed, which are then gathered in
-// sorted order once (OctreeDriver.h's GatherSortedRecords).
+// the leaf pass reads the records in order. Reading them through the
+// points' indices instead costs a random read each, which on an H100 took
+// longer than the sort (Benchmarks/gpu/variants-records.txt). Other keys
+// travel with their points' indices, and so do these where the sort runs
+// before the records have landed (a staged build), whose leaf loop then
+// reads them so: on an H200 at 10 M points that loop took 296 us in ncu
+// where the records gathered in sorted order first and the loop over them
+// took 238 + 115, at 100 M 3.78 ms against 3.26 + 0.80, and the whole call
+// 1.40-1.45 times the pinned copy against 1.45-1.62
+// (Benchmarks/gpu/variants-direct-records.txt).
 struct SortedKeys
 {
   const std::uint64_t* wideKey;   // leaf keys deeper than 32 bits, else null
