@@ -319,6 +319,45 @@ def _lean_loops(ctx):
     return [text, ""]
 
 
+# The thirty-fifth session's change on the H200 (COMMAND.md): a staged
+# build's leaf loop reading the records through the sorted indices
+# ("direct") against the gather in sorted order first ("main"), built side
+# by side and run in turn, with ncu's steps of a 10 M and a 100 M-point
+# build of each.
+DIRECT_FILE = "variants-direct-records.txt"
+DIRECT_STEPS = "ncu, %s: steps of the last of two %d M-point builds"
+
+
+def _direct_records(ctx):
+    """The staged build's records read through the indices, from their H200
+    file."""
+    path = ctx.gpu_file(DIRECT_FILE)
+    if not path:
+        return []
+    rounds = summary_figures(path)
+    at = lambda variant, n: ", ".join("%.2f" % r for r in rounds[(variant, n)]["call"])
+    parts = file_parts(path)
+    us = {(v, m, step): t for v in ("main", "direct") for m in (10, 100)
+          for step, t in build_steps(parts.get(DIRECT_STEPS % (v, m), []))}
+    text = ("**The records read through the indices** (the thirty-fifth session, on the H200, kept in b422446): a "
+            "build from host arrays sorts the positions' keys with their indices while the attributes are still on "
+            "their way, and after the copy gathered the records in sorted order, a random read a point, for a leaf "
+            "loop that read them in order. The leaf loop now reads them through the indices itself "
+            "(OctreeKernels.h's SortedKeys), eight blocks a multiprocessor waiting on those reads as the gather's "
+            "threads did. In ncu the leaves took %.1f µs at 10 M points where the gather and the leaves took "
+            "%.1f + %.1f, and %.2f ms at 100 M where they took %.2f + %.2f. Built beside 607a057's engine and run "
+            "in turn, three rounds, the whole call took %s times the pinned copy at 10 M points against %s (the "
+            "engine before's first round the freshly started machine's first build), and %s at 100 M against %s "
+            "([gpu/%s](gpu/%s)). A "
+            "build from device arrays, whose records travel with the keys, runs as before." % (
+                us["direct", 10, "leaves (level 10)"], us["main", 10, "records gathered in sorted order"],
+                us["main", 10, "leaves (level 10)"], us["direct", 100, "leaves (level 10)"] / 1e3,
+                us["main", 100, "records gathered in sorted order"] / 1e3, us["main", 100, "leaves (level 10)"] / 1e3,
+                at("direct", 10000000), at("main", 10000000), at("direct", 100000000), at("main", 100000000),
+                DIRECT_FILE, DIRECT_FILE))
+    return [text, ""]
+
+
 # The twenty-eighth session's change on the H200 (COMMAND.md): the keys and
 # the sort during the attributes' upload, built beside the engine before and
 # run in turn in calls 2 and 3 (variants "main-79d9b9f" and "before-call2",
@@ -1047,7 +1086,7 @@ def _cuda(ctx):
                 "that host's 300 MiB L3 holds the 128 MB of buffers, from which the DMA reads what ordinary stores "
                 "wrote.",
                 "",
-            ] + _lean_loops(ctx) + _h200(ctx) + _sort_during_upload(ctx) + _staging_pieces(ctx)
+            ] + _direct_records(ctx) + _lean_loops(ctx) + _h200(ctx) + _sort_during_upload(ctx) + _staging_pieces(ctx)
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         arrays = [(k, v) for k, v in r.items() if k.startswith("node ") or k.startswith("point ")

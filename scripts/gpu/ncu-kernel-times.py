@@ -15,7 +15,7 @@ microseconds (the level phase's selects and loops, level by level). With
 the build queues them: the positions' bounds (during the upload), the keys,
 the records, the sort, the levels' run starts counted with their sizes and
 placed (before cd56a2a: the histogram of neighbouring keys), the records
-gathered in sorted order (a build from host arrays since 022a550), then each level
+gathered in sorted order (a build from host arrays from 022a550 to 607a057), then each level
 from the leaves (level 10, the depth of --profile-build) up (a loop each;
 before cd56a2a a CUB select and a loop, the select beginning with its
 DeviceCompactInitKernel), the levels near the root in one launch
