@@ -153,13 +153,15 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measured (607a057's engine
-# is 4881ff3's, its PTX the same): the thirty-fourth session's rounds of
-# "main" in its variants file, on an H200 machine (COMMAND.md).
-ROUNDS_ENGINE = "4881ff3"
-ROUNDS_SESSION = "thirty-fourth"
-ROUNDS_FILE = "variants-lean-loops.txt"
-ROUNDS_VARIANTS = ("main",)
+# More rounds of the engine this report's run measured: the thirty-fifth
+# session's rounds of "direct" in its variants file, on an H200 machine
+# (COMMAND.md), whose kernels are b422446's (b422446 releases the sort's
+# record array where indices sort, on the host, and takes the gather out
+# of a test).
+ROUNDS_ENGINE = "b422446"
+ROUNDS_SESSION = "thirty-fifth"
+ROUNDS_FILE = "variants-direct-records.txt"
+ROUNDS_VARIANTS = ("direct",)
 
 
 def more_rounds(ctx, n):
@@ -382,7 +384,8 @@ def _sort_during_upload(ctx):
             "positions with their indices and the levels' run starts are queued then, from the staging thread that "
             "queued the positions' last piece (CudaUpload.h's afterFirst), and run during the rest of the copy; "
             "after it the records are gathered in sorted order, a random read a point (OctreeDriver.h's "
-            "GatherSortedRecords: 249 µs at 10 M points in ncu, 3.27 ms at 100 M). Built beside 823848b's engine "
+            "GatherSortedRecords: 249 µs at 10 M points in ncu, 3.27 ms at 100 M; since b422446 the leaf loop reads "
+            "them through the indices instead). Built beside 823848b's engine "
             "and run in turn in two calls, the whole call took %s times the pinned copy at 10 M points against %s, "
             "and %s at 100 M against %s ([gpu/%s](gpu/%s)). Builds from device arrays, page-locked ones and the CPU "
             "sort after the copy with the records travelling, as before: from device arrays the device phases "
@@ -1169,15 +1172,16 @@ def _cuda(ctx):
 
 
 def _lean_row(ctx):
-    """The README summary's row of the lean loops' rounds (this run's engine,
-    three more rounds): their device phases against the sort beside them."""
+    """The README summary's row of the lean loops' rounds (three more rounds
+    of this run's device phases, which b422446 left as they were): their
+    device phases against the sort beside them."""
     path = ctx.gpu_file(LEAN_FILE)
     if not path:
         return []
     rounds = summary_figures(path)
     main = [rounds[("main", n)] for n in (10000000, 100000000)]
-    return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, the same engine in three more rounds "
-             "(4881ff3's lean loops, on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
+    return [("CUDA octree build, 10 M / 100 M points, depth 10, device phases, three more rounds of the lean loops' "
+             "engine (4881ff3, on an H200 beside the engine before, Benchmarks/gpu/%s)" % LEAN_FILE,
              " / ".join(spread(m["phases"], "%.3f") + " ms" for m in main),
              "bare CUB radix sort %s; issue 16's goal ≤ %g× the sort" % (
                  " / ".join(spread(m["floor"], "%.3f") + " ms" for m in main), GOAL_OVER_SORT),
