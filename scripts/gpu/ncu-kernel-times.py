@@ -15,10 +15,11 @@ microseconds (the level phase's selects and loops, level by level). With
 the build queues them: the positions' bounds (during the upload), the keys,
 the records, the sort, the levels' run starts counted with their sizes and
 placed (before cd56a2a: the histogram of neighbouring keys), the records
-gathered in sorted order (a build from host arrays from 022a550 to 607a057), then each level
-from the leaves (level 10, the depth of --profile-build) up (a loop each;
-before cd56a2a a CUB select and a loop, the select beginning with its
-DeviceCompactInitKernel), the levels near the root in one launch
+gathered in sorted order (a build from host arrays from 022a550 to
+607a057), then each level from the leaves (level 10, the depth of
+--profile-build) up (a loop each; before cd56a2a a CUB select and a loop,
+the select beginning with its DeviceCompactInitKernel), the levels near
+the root in one launch
 (SmallLevelsKernel), and the device phases' sum (keys, sort, level sizes,
 levels: what the benchmark's phases of a build from device arrays time, but
 the records; such a build gathers none).
