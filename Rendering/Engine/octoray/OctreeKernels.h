@@ -169,10 +169,12 @@ struct SortedKeys
 // meet fewer attributes holds fewer: the leaf loop 39 registers on sm_90
 // where it may meet every attribute 60 (four blocks a multiprocessor).
 // With fewer registers more blocks fit, and these loops wait mostly on
-// their loads: at 10 M points on an H200 the leaves took 124 us at six
-// blocks and 115 at kLeanLoopBlocks (32 registers, 12 bytes spilled) where
-// they took 163 at four, level 9 88 us at eight against 101
-// (Benchmarks/gpu/variants-lean-loops.txt). LinkLevels runs the loops of
+// their loads: at 10 M points on an H200 the leaves, over records in
+// sorted order, took 124 us at six blocks and 115 at kLeanLoopBlocks (32
+// registers, 12 bytes spilled) where they took 163 at four, level 9 88 us
+// at eight against 101 (Benchmarks/gpu/variants-lean-loops.txt). The
+// leaves of a staged build read the records at random (SortedKeys); their
+// kernel's bounds are the same. LinkLevels runs the loops of
 // clouds of these alone as ReduceNodes<kLeanAttributes>; the general loops,
 // at eight blocks, spilled 152 bytes a thread and took twice as long.
 constexpr unsigned kLeanAttributes = kHasColor8 | kHasScalar | kHasReflectivity;
