@@ -154,14 +154,15 @@ TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
 # More rounds of the engine this report's run measured: the thirty-fifth
-# session's rounds of "direct" in its variants file, on an H200 machine
-# (COMMAND.md), whose kernels are b422446's (b422446 releases the sort's
-# record array where indices sort, on the host, and takes the gather out
-# of a test).
+# session's rounds of "direct" (call 2, whose kernels are b422446's:
+# b422446 releases the sort's record array where indices sort, on the
+# host, and takes the gather out of a test) and "final" (call 4, the tree
+# after the report's run) in its variants file, on H200 machines
+# (COMMAND.md).
 ROUNDS_ENGINE = "b422446"
 ROUNDS_SESSION = "thirty-fifth"
 ROUNDS_FILE = "variants-direct-records.txt"
-ROUNDS_VARIANTS = ("direct",)
+ROUNDS_VARIANTS = ("direct", "final")
 
 
 def more_rounds(ctx, n):
@@ -987,7 +988,7 @@ def _cuda(ctx):
                     and r.get("call_over_pinned_copy")] for n in rounds}
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
-            "this run and %s in %d rounds of %s's engine on another H200 machine in the %s session "
+            "this run and %s in %d rounds of %s's engine on other H200 machines in the %s session "
             "([gpu/%s](gpu/%s), the rounds of %s); at 100 M, %s here and %s there." % (
                 ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
                 len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_SESSION, ROUNDS_FILE, ROUNDS_FILE,
