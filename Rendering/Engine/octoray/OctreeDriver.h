@@ -58,6 +58,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -759,7 +760,7 @@ template <class Device>
 void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int requestedDepth, QueuedBuild<Device>& q)
 {
-  std::fill_n(q.marks, 6, -1);
+  std::fill(std::begin(q.marks), std::end(q.marks), -1);
   q.marks[0] = q.clock.Mark();
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.

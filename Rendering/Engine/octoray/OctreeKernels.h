@@ -130,8 +130,9 @@ OCTORAY_HD bool ComputeLeafKey(const PointArraysView& pts, const RootCube::CellM
 // them. Leaf keys of depth 10 and less fit 32 bits; each travels with its
 // point's record where that is one or two words (RecordsTravel), so that
 // the leaf pass reads the records in order. Reading them through the
-// points' indices instead costs a random read each, which on an H100 took
-// longer than the sort (Benchmarks/gpu/variants-records.txt). Other keys
+// points' indices instead costs a random read each, which in the general
+// leaf loop on an H100 took longer than the sort
+// (Benchmarks/gpu/variants-records.txt). Other keys
 // travel with their points' indices, and so do these where the sort runs
 // before the records have landed (a staged build), whose leaf loop then
 // reads them so: on an H200 at 10 M points that loop took 296 us in ncu
@@ -174,9 +175,9 @@ struct SortedKeys
 // registers, 12 bytes spilled) where they took 163 at four, level 9 88 us
 // at eight against 101 (Benchmarks/gpu/variants-lean-loops.txt). The
 // leaves of a staged build read the records at random (SortedKeys); their
-// kernel's bounds are the same. LinkLevels runs the loops of
-// clouds of these alone as ReduceNodes<kLeanAttributes>; the general loops,
-// at eight blocks, spilled 152 bytes a thread and took twice as long.
+// kernel's bounds are the same. LinkLevels runs the loops of clouds of
+// these alone as ReduceNodes<kLeanAttributes>; the general loops, at eight
+// blocks, spilled 152 bytes a thread and took twice as long.
 constexpr unsigned kLeanAttributes = kHasColor8 | kHasScalar | kHasReflectivity;
 constexpr int kLeanLoopBlocks = 8;
 
