@@ -350,9 +350,9 @@ def _direct_records(ctx):
             "threads did. In ncu the leaves took %.1f µs at 10 M points where the gather and the leaves took "
             "%.1f + %.1f, and %.2f ms at 100 M where they took %.2f + %.2f. Built beside 607a057's engine and run "
             "in turn, three rounds, the whole call took %s times the pinned copy at 10 M points against %s (the "
-            "engine before's first round the freshly started machine's first build), and %s at 100 M against %s "
-            "([gpu/%s](gpu/%s)). A "
-            "build from device arrays, whose records travel with the keys, runs as before." % (
+            "engine before's first round was the freshly started machine's first build), and %s at 100 M against "
+            "%s ([gpu/%s](gpu/%s)). A build from device arrays, whose records travel with the keys, runs as "
+            "before." % (
                 us["direct", 10, "leaves (level 10)"], us["main", 10, "records gathered in sorted order"],
                 us["main", 10, "leaves (level 10)"], us["direct", 100, "leaves (level 10)"] / 1e3,
                 us["main", 100, "records gathered in sorted order"] / 1e3, us["main", 100, "leaves (level 10)"] / 1e3,
