@@ -101,49 +101,34 @@ enum AttributeBits : unsigned
     kAllAttributes = (1u << kAttributeCount) - 1
 };
 
-// An attribute value as its slots (Slot: float, or whole bytes), the
-// entries of the sums in which build and update add it up (SlotSums below)
-// and from which they store its mean: its floats in order, for any value
-// made of floats alone (float, Rgba, Vec3f).
-template <typename T>
-struct AttributeValue
-{
-  static_assert(sizeof(T) % sizeof(float) == 0 && std::is_trivially_copyable<T>::value, "a value made of floats");
-  static constexpr int kSlots = static_cast<int>(sizeof(T) / sizeof(float));
-  static constexpr bool kRounded = false; // the mean is stored as computed
-  using Slot = float;
-
-  OCTORAY_HD static void ToSlots(const T& value, float* v) { memcpy(v, &value, sizeof(T)); }
-  template <typename Real>
-  OCTORAY_HD static T Mean(const Real* sum, double inv)
-  {
-    float mean[kSlots];
-    for (int k = 0; k < kSlots; ++k)
-    {
-      mean[k] = static_cast<float>(sum[k] * inv);
-    }
-    T value;
-    memcpy(&value, mean, sizeof(T));
-    return value;
-  }
-};
-
-// Values stored rounded: summed as the floats ToFloats gives (as the
-// attributes of floats) and stored as FromFloats of their mean (8-bit
-// colours alike, as whole bytes: below). A leaf's mean is
-// rounded once; an inner node's is the count-weighted mean of its children's
-// rounded ones, rounded again (the bounds below). Being rounded, such a mean
-// cannot be adjusted by the points that leave and join a node (an update's
-// in-place path): the rounding would be carried into the new mean,
-// multiplied where a node loses most of its points.
-template <typename T, int Slots>
-struct RoundedAttributeValue
+// An attribute value summed as Slots floats, from whose means the node's
+// value is made: a value made of floats alone (float, Rgba, Vec3f) is its
+// floats in order, its mean stored as computed; a value stored Rounded is
+// summed as the floats its ToFloats gives and stored as FromFloats of
+// their means (8-bit colours alike, as whole bytes: below). A rounded
+// leaf's mean is rounded once; an inner node's is the count-weighted mean
+// of its children's rounded ones, rounded again (the bounds below). Being
+// rounded, such a mean cannot be adjusted by the points that leave and
+// join a node (an update's in-place path): the rounding would be carried
+// into the new mean, multiplied where a node loses most of its points.
+template <typename T, int Slots, bool Rounded>
+struct FloatSlotsValue
 {
   static constexpr int kSlots = Slots;
-  static constexpr bool kRounded = true;
+  static constexpr bool kRounded = Rounded;
   using Slot = float;
 
-  OCTORAY_HD static void ToSlots(const T& value, float* v) { ToFloats(value, v); }
+  OCTORAY_HD static void ToSlots(const T& value, float* v)
+  {
+    if constexpr (Rounded)
+    {
+      ToFloats(value, v);
+    }
+    else
+    {
+      memcpy(v, &value, sizeof(T));
+    }
+  }
   template <typename Real>
   OCTORAY_HD static T Mean(const Real* sum, double inv)
   {
@@ -153,9 +138,26 @@ struct RoundedAttributeValue
       mean[k] = static_cast<float>(sum[k] * inv);
     }
     T value;
-    FromFloats(mean, value);
+    if constexpr (Rounded)
+    {
+      FromFloats(mean, value);
+    }
+    else
+    {
+      memcpy(&value, mean, sizeof(T));
+    }
     return value;
   }
+};
+
+// An attribute value as its slots (Slot: float, or whole bytes), the
+// entries of the sums in which build and update add it up (SlotSums below)
+// and from which they store its mean: its floats, for any value made of
+// floats alone; scalars, normals and 8-bit colours below.
+template <typename T>
+struct AttributeValue : FloatSlotsValue<T, static_cast<int>(sizeof(T) / sizeof(float)), false>
+{
+  static_assert(sizeof(T) % sizeof(float) == 0 && std::is_trivially_copyable<T>::value, "a value made of floats");
 };
 
 // Scalars: their unit values, stored as codes (Scalar16.h); the points'
@@ -212,11 +214,11 @@ struct AttributeValue<Rgba8>
   }
 };
 template <>
-struct AttributeValue<Scalar16> : RoundedAttributeValue<Scalar16, 1>
+struct AttributeValue<Scalar16> : FloatSlotsValue<Scalar16, 1, true>
 {
 };
 template <>
-struct AttributeValue<OctNormal> : RoundedAttributeValue<OctNormal, 3>
+struct AttributeValue<OctNormal> : FloatSlotsValue<OctNormal, 3, true>
 {
 };
 

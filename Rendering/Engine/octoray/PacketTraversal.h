@@ -108,14 +108,10 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
   PausedNodes paused[kMaxLevel];
   unsigned pausedLevels = 0;
   std::uint64_t live = p.lanes; // lanes whose visitors still look
-  Vec3f lo{ 0.0f, 0.0f, 0.0f };
-  float size = 1.0f;
-  int level = 0;
-  Crossings<PacketFloats> c = CrossingsOf<false>(p, p.signs, lo, size);
-  unsigned childMask = ChildMaskOf(tree, 0);
-  std::uint32_t firstChild = FirstChildOf(tree, 0);
-  std::uint64_t todo = live & LaneSets(static_cast<int>(MirrorOctants(childMask, p.signs)) &
-                                 MetOctants(c.midT, Later(p.tEnter, p.tMin), Earlier(p.tExit, p.tMax)));
+  WalkNode<PacketFloats> node;
+  node.StartAtRoot<false>(tree, p, p.signs);
+  std::uint64_t todo = live & LaneSets(static_cast<int>(MirrorOctants(node.childMask, p.signs)) &
+                                 MetOctants(node.c.midT, Later(p.tEnter, p.tMin), Earlier(p.tExit, p.tMax)));
   while (live)
   {
     const unsigned any = UnionOfLanes(todo);
@@ -125,33 +121,22 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
       {
         return;
       }
-      level = HighestBit(pausedLevels);
+      const int level = HighestBit(pausedLevels);
       pausedLevels &= ~(1u << level);
-      firstChild = paused[level].firstChild;
-      childMask = paused[level].childMask;
+      node.ClimbTo<false>(level, paused[level].firstChild, paused[level].childMask, p, p.signs);
       todo = paused[level].todo & live;
-      for (int a = 0; a < 3; ++a)
-      {
-        lo[a] = NodeCorner(lo[a], level);
-      }
-      size = PowerOfTwo(-level);
-      c = CrossingsOf<false>(p, p.signs, lo, size);
       continue;
     }
     const unsigned m = LowestBit(any);
     const std::uint64_t entering = LanesHolding(todo, m); // the lanes that meet child m
     todo &= ~(kEveryLaneByte << m);
-    const ChildSpan<PacketFloats> span = SpanOf(c, m);
-    const unsigned octant = m ^ p.signs;
-    const float half = 0.5f * size;
-    const Vec3f childLo = ChildCorner(lo, octant, half);
-    const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
+    const ChildSpan<PacketFloats> span = SpanOf(node.c, m);
+    const WalkChild child = node.Child(m, p.signs);
     std::uint64_t drawn = entering; // lanes that stop at the child: all at the leaves
-    if (level + 1 < tree.depth)
+    if (child.level < tree.depth)
     {
-      drawn = p.lodOn ? entering &
-          LaneBytes(half < p.lodPixels * (p.footprint0 + p.footprintSlope * Later(span.tEnter, PacketFloats{})))
-                    : 0;
+      const PacketFloats tEnter = Later(span.tEnter, PacketFloats{});
+      drawn = p.lodOn ? entering & LaneBytes(child.size < p.lodPixels * (p.footprint0 + p.footprintSlope * tEnter)) : 0;
     }
     if (drawn)
     {
@@ -160,8 +145,7 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
         if ((drawn >> (8 * lane)) & 1u)
         {
           const float tEnter = span.tEnter[lane], tExit = span.tExit[lane];
-          const int axis = EntryAxis(LaneOf(c, lane), m, tEnter);
-          if (visitors[lane].Visit(NodeHit{ child, level + 1, tEnter, tExit, axis, childLo, half }))
+          if (visitors[lane].Visit(child.Hit(tEnter, tExit, EntryAxis(LaneOf(node.c, lane), m, tEnter))))
           {
             live &= ~(std::uint64_t{ 0xFF } << (8 * lane));
           }
@@ -177,10 +161,10 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     PacketFloats innerMidT[3];
     for (int a = 0; a < 3; ++a)
     {
-      innerMidT[a] = Crossing<false>(p, a, childLo[a] + 0.5f * half);
+      innerMidT[a] = child.MidCrossing<false>(p, a);
     }
-    const std::uint64_t groupMasks = tree.childMasks[child >> 3];
-    const unsigned grandchildMask = MaskInWord(groupMasks, child);
+    const std::uint64_t groupMasks = tree.childMasks[child.node >> 3];
+    const unsigned grandchildMask = MaskInWord(groupMasks, child.node);
     const std::uint64_t met = descending &
       LaneSets(static_cast<int>(MirrorOctants(grandchildMask, p.signs)) &
         MetOctants(innerMidT, Later(span.tEnter, p.tMin), Earlier(span.tExit, p.tMax)));
@@ -193,15 +177,10 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     }
     if (todo)
     {
-      paused[level] = PausedNodes{ firstChild, childMask, todo };
-      pausedLevels |= 1u << level;
+      paused[node.level] = PausedNodes{ node.firstChild, node.childMask, todo };
+      pausedLevels |= 1u << node.level;
     }
-    ++level;
-    EnterChild(c, m, innerMidT);
-    lo = childLo;
-    size = half;
-    childMask = grandchildMask;
-    firstChild = FirstChildInGroup(tree.childBase[child >> 3], groupMasks, child);
+    node.Enter(tree, m, child, innerMidT, groupMasks, grandchildMask);
     todo = met;
   }
 }

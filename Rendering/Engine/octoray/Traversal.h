@@ -457,6 +457,98 @@ struct PausedNode
   OCTORAY_HD_INLINE unsigned Todo() const { return static_cast<unsigned>(bits >> 40) & 0xFFu; }
 };
 
+// A child of the node a walk is in: its index, level, corner and side.
+struct WalkChild
+{
+  std::uint32_t node;
+  int level;
+  Vec3f lo;
+  float size;
+
+  // Where a ray crosses its mid plane on axis a (the rays of a packet, lane
+  // by lane).
+  template <bool MayBeParallel, typename Rays>
+  OCTORAY_HD_INLINE ValuesOf<Rays> MidCrossing(const Rays& rays, int a) const
+  {
+    return Crossing<MayBeParallel>(rays, a, lo[a] + 0.5f * size);
+  }
+  // The child as a drawn voxel, met over [tEnter, tExit] through a face of
+  // `axis`.
+  OCTORAY_HD_INLINE NodeHit Hit(float tEnter, float tExit, int axis) const
+  {
+    return NodeHit{ node, level, tEnter, tExit, axis, lo, size };
+  }
+};
+
+// The node a walk of the octree is in, and the rays' crossings of its
+// planes: one ray's (T a float: Traverse) or a packet's lanes'
+// (TraversePacket). Both walks look at a child, go down into it and climb
+// back to a paused node through these, so that each lane of a packet
+// computes what Traverse computes for its ray, bit for bit.
+template <typename T>
+struct WalkNode
+{
+  Vec3f lo; // corner and side
+  float size;
+  int level;
+  Crossings<T> c;
+  unsigned childMask;
+  std::uint32_t firstChild;
+
+  // The root, for rays whose directions have these signs.
+  template <bool MayBeParallel, typename Rays>
+  OCTORAY_HD_INLINE void StartAtRoot(const OctreeView& tree, const Rays& rays, unsigned signs)
+  {
+    lo = Vec3f{ 0.0f, 0.0f, 0.0f };
+    size = 1.0f;
+    level = 0;
+    c = CrossingsOf<MayBeParallel>(rays, signs, lo, size);
+    childMask = ChildMaskOf(tree, 0);
+    firstChild = FirstChildOf(tree, 0);
+  }
+
+  // The child in mirrored octant m.
+  OCTORAY_HD_INLINE WalkChild Child(unsigned m, unsigned signs) const
+  {
+    const unsigned octant = m ^ signs;
+    const float half = 0.5f * size;
+    return WalkChild{ ChildIndex(childMask, firstChild, octant), level + 1, ChildCorner(lo, octant, half), half };
+  }
+
+  // Down into `child`, in mirrored octant m, whose mid planes the rays cross
+  // at childMidT and whose group of eight has the child masks groupMasks
+  // (the child's own, grandchildMask): the child's first child is found
+  // only here, once the walk goes in (Attributes.h).
+  template <typename Triple>
+  OCTORAY_HD_INLINE void Enter(const OctreeView& tree, unsigned m, const WalkChild& child, const Triple& childMidT,
+    std::uint64_t groupMasks, unsigned grandchildMask)
+  {
+    level = child.level;
+    EnterChild(c, m, childMidT);
+    lo = child.lo;
+    size = child.size;
+    childMask = grandchildMask;
+    firstChild = FirstChildInGroup(tree.childBase[child.node >> 3], groupMasks, child.node);
+  }
+
+  // Back up to the node of level l, which holds this one and has these
+  // children (a paused node's): its corner cut from this node's, its
+  // crossings computed again.
+  template <bool MayBeParallel, typename Rays>
+  OCTORAY_HD_INLINE void ClimbTo(int l, std::uint32_t first, unsigned mask, const Rays& rays, unsigned signs)
+  {
+    level = l;
+    firstChild = first;
+    childMask = mask;
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = NodeCorner(lo[a], level);
+    }
+    size = PowerOfTwo(-level);
+    c = CrossingsOf<MayBeParallel>(rays, signs, lo, size);
+  }
+};
+
 // The loop of Traverse (below) from the root, whose span the ray's is.
 template <bool MayBeParallel, typename Visitor>
 OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const LevelOfDetail& lod, Visitor& visitor,
@@ -470,17 +562,13 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
   const bool lodOn = lod.pixels > 0.0f;
   PausedNode paused[kMaxLevel]; // by level, where `pausedLevels` has its bit
   unsigned pausedLevels = 0;
-  Vec3f lo{ 0.0f, 0.0f, 0.0f }; // the current node's corner and side
-  float size = 1.0f;
-  int level = 0;
-  NodeCrossings c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
-  unsigned childMask = ChildMaskOf(tree, 0);
-  std::uint32_t firstChild = FirstChildOf(tree, 0);
+  WalkNode<float> node;
+  node.StartAtRoot<MayBeParallel>(tree, ray, signs);
   // Children are tested against the part of each span within [tMin, tMax]
   // (never empty: a child is stepped to only where it meets that part), so
   // the loop needs no test of its own for voxels before tMin or past tMax.
   unsigned todo =
-    mirror(childMask) & MetOctants(c.midT, Later(tEnter, ray.tMin), Earlier(tExit, ray.tMax));
+    mirror(node.childMask) & MetOctants(node.c.midT, Later(tEnter, ray.tMin), Earlier(tExit, ray.tMax));
   for (;;)
   {
     if (!todo)
@@ -489,32 +577,21 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
       {
         return;
       }
-      level = HighestBit(pausedLevels);
+      const int level = HighestBit(pausedLevels);
       pausedLevels &= ~(1u << level);
-      const PausedNode node = paused[level];
-      firstChild = node.FirstChild();
-      childMask = node.ChildMask();
-      todo = node.Todo();
-      for (int a = 0; a < 3; ++a)
-      {
-        lo[a] = NodeCorner(lo[a], level);
-      }
-      size = PowerOfTwo(-level);
-      c = CrossingsOf<MayBeParallel>(ray, signs, lo, size);
+      const PausedNode resumed = paused[level];
+      todo = resumed.Todo();
+      node.ClimbTo<MayBeParallel>(level, resumed.FirstChild(), resumed.ChildMask(), ray, signs);
       // A paused node has children left: on to the next of them in the same
       // step, where the threads of a warp that did not climb are.
     }
     const unsigned m = LowestBit(todo);
     todo &= todo - 1u;
-    const auto span = SpanOf(c, m);
-    const unsigned octant = m ^ signs;
-    const float half = 0.5f * size;
-    const Vec3f childLo = ChildCorner(lo, octant, half);
-    const std::uint32_t child = ChildIndex(childMask, firstChild, octant);
-    if (level + 1 == tree.depth || (lodOn && lod.StopAt(half, span.tEnter)))
+    const auto span = SpanOf(node.c, m);
+    const WalkChild child = node.Child(m, signs);
+    if (child.level == tree.depth || (lodOn && lod.StopAt(child.size, span.tEnter)))
     {
-      const NodeHit hit{ child, level + 1, span.tEnter, span.tExit, EntryAxis(c, m, span.tEnter), childLo, half };
-      if (visitor.Visit(hit))
+      if (visitor.Visit(child.Hit(span.tEnter, span.tExit, EntryAxis(node.c, m, span.tEnter))))
       {
         return;
       }
@@ -523,12 +600,12 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     Vec3f innerMidT;
     for (int a = 0; a < 3; ++a)
     {
-      innerMidT[a] = Crossing<MayBeParallel>(ray, a, childLo[a] + 0.5f * half);
+      innerMidT[a] = child.MidCrossing<MayBeParallel>(ray, a);
     }
     // The child's group of eight: its mask now, its first child if it is
     // entered (Attributes.h).
-    const std::uint64_t groupMasks = tree.childMasks[child >> 3];
-    const unsigned grandchildMask = MaskInWord(groupMasks, child);
+    const std::uint64_t groupMasks = tree.childMasks[child.node >> 3];
+    const unsigned grandchildMask = MaskInWord(groupMasks, child.node);
     const unsigned met = mirror(grandchildMask) &
       MetOctants(innerMidT, Later(span.tEnter, ray.tMin), Earlier(span.tExit, ray.tMax));
     const unsigned after = todo & OctantsAfter(m);
@@ -539,15 +616,10 @@ OCTORAY_HD void TraverseFromRoot(const OctreeView& tree, const Ray& ray, const L
     }
     if (after)
     {
-      paused[level] = PausedNode::Of(firstChild, childMask, after);
-      pausedLevels |= 1u << level;
+      paused[node.level] = PausedNode::Of(node.firstChild, node.childMask, after);
+      pausedLevels |= 1u << node.level;
     }
-    ++level;
-    EnterChild(c, m, innerMidT);
-    lo = childLo;
-    size = half;
-    childMask = grandchildMask;
-    firstChild = FirstChildInGroup(tree.childBase[child >> 3], groupMasks, child);
+    node.Enter(tree, m, child, innerMidT, groupMasks, grandchildMask);
     todo = met;
   }
 }
