@@ -111,15 +111,11 @@ DeviceImage CudaEngine::LastDeviceImage() const
   return image;
 }
 
-RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
+// The frame's inputs in host memory (its transfer function, a depth buffer)
+// copied to the device, and the frame pointed at the copies; a depth
+// buffer the caller already has there is read where it is.
+void CudaEngine::PlaceFrameInputs(const RenderSettings& settings, FrameConstants& frame)
 {
-  const auto scope = Dev.Scope();
-  ImageWidth = ImageHeight = 0; // no picture until this one is complete
-  ValidateRender(State->count, DiscardedByUpdate);
-  const auto start = std::chrono::steady_clock::now();
-  const OctreeView view = View();
-  FrameConstants frame = MakeFrame(settings, view);
-  const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
   if (frame.transfer)
   {
     Dev.Upload(Transfer, settings.transfer.table.data(), settings.transfer.table.size(), "transfer function");
@@ -135,9 +131,47 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   }
   else if (frame.depthBuffer)
   {
-    Dev.Upload(DepthIn, settings.depthBuffer.data(), pixels, "depth buffer");
+    Dev.Upload(DepthIn, settings.depthBuffer.data(), settings.depthBuffer.size(), "depth buffer");
     frame.depthBuffer = DepthIn.Get();
   }
+}
+
+// The last frame into `image` where the settings ask for it (else `image`
+// is left empty, the frame on the device alone); returns the copy's time.
+double CudaEngine::CopyImage(const RenderSettings& settings, Image& image)
+{
+  image.width = settings.width;
+  image.height = settings.height;
+  image.rgba.clear();
+  image.rgba8.clear();
+  image.depth.clear();
+  if (!settings.copyToHost)
+  {
+    return 0.0;
+  }
+  const auto copy = std::chrono::steady_clock::now();
+  if (settings.rgba8)
+  {
+    Dev.Download(ImageRgba8, image.rgba8);
+  }
+  else
+  {
+    Dev.Download(ImageRgba, image.rgba);
+  }
+  Dev.Download(ImageDepth, image.depth);
+  return SecondsSince(copy);
+}
+
+RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
+{
+  const auto scope = Dev.Scope();
+  ImageWidth = ImageHeight = 0; // no picture until this one is complete
+  ValidateRender(State->count, DiscardedByUpdate);
+  const auto start = std::chrono::steady_clock::now();
+  const OctreeView view = View();
+  FrameConstants frame = MakeFrame(settings, view);
+  PlaceFrameInputs(settings, frame);
+  const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
   if (settings.rgba8)
   {
     Dev.Reserve(ImageRgba8, 4 * pixels, "image colours");
@@ -164,31 +198,10 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   Dev.ToHost(RayCounter.Get(), 1, &secondary, "RenderKernel");
   stats.secondaryRays = secondary;
   stats.seconds = SecondsSince(start);
-  image.width = ImageWidth = settings.width;
-  image.height = ImageHeight = settings.height;
+  ImageWidth = settings.width;
+  ImageHeight = settings.height;
   ImageIs8Bit = settings.rgba8;
-  if (settings.copyToHost)
-  {
-    const auto copy = std::chrono::steady_clock::now();
-    if (settings.rgba8)
-    {
-      Dev.Download(ImageRgba8, image.rgba8);
-      image.rgba.clear();
-    }
-    else
-    {
-      Dev.Download(ImageRgba, image.rgba);
-      image.rgba8.clear();
-    }
-    Dev.Download(ImageDepth, image.depth);
-    stats.copySeconds = SecondsSince(copy);
-  }
-  else
-  {
-    image.rgba.clear();
-    image.rgba8.clear();
-    image.depth.clear();
-  }
+  stats.copySeconds = CopyImage(settings, image);
   return stats;
 }
 

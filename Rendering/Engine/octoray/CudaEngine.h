@@ -6,6 +6,8 @@
 
 namespace octoray
 {
+struct FrameConstants;
+
 class CudaEngine final : public OctreeEngine<CudaDevice>
 {
 public:
@@ -24,6 +26,9 @@ public:
   void SetMemoryBudget(std::size_t bytes) override { Dev.Pool().budget = bytes; }
 
 private:
+  void PlaceFrameInputs(const RenderSettings& settings, FrameConstants& frame);
+  double CopyImage(const RenderSettings& settings, Image& image);
+
   std::string DeviceName;
   // The last frame in device memory: premultiplied RGBA (4 floats or bytes a
   // pixel) and window depth, rows from the bottom.

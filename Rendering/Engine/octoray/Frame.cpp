@@ -80,12 +80,10 @@ void Multiply(const double a[16], const double b[16], double out[16])
     }
   }
 }
-}
 
-FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
+// Settings no frame can be drawn with: an error naming what is wrong.
+void CheckSettings(const RenderSettings& s)
 {
-  const RootCube& cube = tree.cube;
-  const bool secondaryRays = tree.reflectivity != nullptr || tree.refraction != nullptr;
   if (s.width <= 0 || s.height <= 0)
   {
     throw Error("octoray: the viewport must be at least 1x1, got " + std::to_string(s.width) + "x" +
@@ -104,11 +102,12 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   {
     throw Error("octoray: the transfer function's scalar range is empty");
   }
-  FrameConstants f;
-  f.width = s.width;
-  f.height = s.height;
+}
 
-  // unit <- world: u = (p - origin) / size; world <- unit: its inverse.
+// The camera between normalised device coordinates and the octree's unit
+// cube: unit <- world is u = (p - origin) / size, world <- unit its inverse.
+void SetCamera(const RenderSettings& s, const RootCube& cube, FrameConstants& f)
+{
   const double unitFromWorld[16] = { 1 / cube.size, 0, 0, -cube.origin[0] / cube.size, 0, 1 / cube.size, 0,
     -cube.origin[1] / cube.size, 0, 0, 1 / cube.size, -cube.origin[2] / cube.size, 0, 0, 0, 1 };
   const double worldFromUnit[16] = { cube.size, 0, 0, cube.origin[0], 0, cube.size, 0, cube.origin[1], 0, 0,
@@ -120,19 +119,11 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   }
   Multiply(unitFromWorld, s.inverseViewProjection, f.unitFromNdc);
   Multiply(ndcFromWorld, worldFromUnit, f.ndcFromUnit);
+}
 
-  f.blend = s.blend;
-  f.shade = s.shade;
-  f.ambient = s.ambient;
-  f.diffuse = s.diffuse;
-  f.specular = s.specular;
-  f.specularPower = s.specularPower;
-  f.depthCue = s.depthCue;
-  f.shadows = s.shadows && !s.lights.empty() && s.shade == ShadeMode::Phong;
-  f.maxBounces = secondaryRays ? s.maxBounces : 0;
-  f.lodPixels = s.lodPixels;
-  f.opacityUnitDistance = s.opacityUnitDistance > 0 ? s.opacityUnitDistance / static_cast<float>(cube.size) : 1.0f;
-
+// The lights in the unit cube: directions normalised, positions mapped.
+void SetLights(const RenderSettings& s, const RootCube& cube, FrameConstants& f)
+{
   f.lightCount = static_cast<int>(s.lights.size());
   for (int i = 0; i < f.lightCount; ++i)
   {
@@ -145,9 +136,13 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
     u.position = ToFloat(u.directional ? position / (len > 0 ? len : 1.0) : (position - origin) / cube.size);
     u.color = Vec3f{ l.color[0], l.color[1], l.color[2] } * l.intensity;
   }
+}
 
-  // Pixel footprint at the near and far planes through the image centre,
-  // for level of detail, and the cube's distance range for depth cue.
+// A pixel's footprint at the near and far planes through the image
+// centre, for the level of detail, and the unit cube's range of distances
+// along the view, for the depth cue (f.unitFromNdc set).
+void SetFootprintAndCue(const RenderSettings& s, FrameConstants& f)
+{
   const int cx = s.width / 2, cy = s.height / 2;
   auto ndcX = [&](int x) { return 2.0 * (x + 0.5) / s.width - 1.0; };
   auto ndcY = [&](int y) { return 2.0 * (y + 0.5) / s.height - 1.0; };
@@ -172,7 +167,31 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   }
   f.cueNear = static_cast<float>(std::fmax(nearest, 0.0));
   f.cueFar = static_cast<float>(std::fmax(farthest, f.cueNear + 1e-6));
+}
+}
 
+FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
+{
+  CheckSettings(s);
+  const RootCube& cube = tree.cube;
+  const bool secondaryRays = tree.reflectivity != nullptr || tree.refraction != nullptr;
+  FrameConstants f;
+  f.width = s.width;
+  f.height = s.height;
+  SetCamera(s, cube, f);
+  f.blend = s.blend;
+  f.shade = s.shade;
+  f.ambient = s.ambient;
+  f.diffuse = s.diffuse;
+  f.specular = s.specular;
+  f.specularPower = s.specularPower;
+  f.depthCue = s.depthCue;
+  f.shadows = s.shadows && !s.lights.empty() && s.shade == ShadeMode::Phong;
+  f.maxBounces = secondaryRays ? s.maxBounces : 0;
+  f.lodPixels = s.lodPixels;
+  f.opacityUnitDistance = s.opacityUnitDistance > 0 ? s.opacityUnitDistance / static_cast<float>(cube.size) : 1.0f;
+  SetLights(s, cube, f);
+  SetFootprintAndCue(s, f);
   if (!s.transfer.table.empty())
   {
     f.transfer = s.transfer.table.data();

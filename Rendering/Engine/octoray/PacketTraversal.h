@@ -93,6 +93,42 @@ inline NodeCrossings LaneOf(const Crossings<PacketFloats>& c, int lane)
   return one;
 }
 
+// Of the lanes `entering` the child, those that stop at it (as Traverse's
+// rays): all at the leaves, else those whose level of detail stops there.
+inline std::uint64_t DrawnLanes(const OctreeView& tree, const RayPacket& p, const WalkChild& child,
+  const ChildSpan<PacketFloats>& span, std::uint64_t entering)
+{
+  if (child.level == tree.depth)
+  {
+    return entering;
+  }
+  return p.lodOn
+    ? entering & LaneBytes(FootprintCovers(child.size, p.lodPixels, p.footprint0, p.footprintSlope, span.tEnter))
+    : 0;
+}
+
+// Shows the child, in mirrored octant m of the node whose crossings are c,
+// to the visitor of each lane in `drawn`; returns the lanes whose visitors
+// said stop, as bytes of 0xFF.
+template <typename Visitor>
+std::uint64_t VisitLanes(std::uint64_t drawn, const Crossings<PacketFloats>& c, unsigned m,
+  const ChildSpan<PacketFloats>& span, const WalkChild& child, Visitor visitors[kPacketLanes])
+{
+  std::uint64_t stopped = 0;
+  for (int lane = 0; lane < kPacketLanes; ++lane)
+  {
+    if ((drawn >> (8 * lane)) & 1u)
+    {
+      const float tEnter = span.tEnter[lane], tExit = span.tExit[lane];
+      if (visitors[lane].Visit(child.Hit(tEnter, tExit, EntryAxis(LaneOf(c, lane), m, tEnter))))
+      {
+        stopped |= std::uint64_t{ 0xFF } << (8 * lane);
+      }
+    }
+  }
+  return stopped;
+}
+
 // The walk for the lanes of p (Traverse's loop, TraverseFromRoot, for each
 // lane; see the header), visitors[lane] seeing its lane's voxels. `todo`
 // and the paused nodes hold a set per lane.
@@ -132,25 +168,10 @@ void TraversePacket(const OctreeView& tree, const RayPacket& p, Visitor visitors
     todo &= ~(kEveryLaneByte << m);
     const ChildSpan<PacketFloats> span = SpanOf(node.c, m);
     const WalkChild child = node.Child(m, p.signs);
-    std::uint64_t drawn = entering; // lanes that stop at the child: all at the leaves
-    if (child.level < tree.depth)
-    {
-      const PacketFloats tEnter = Later(span.tEnter, PacketFloats{});
-      drawn = p.lodOn ? entering & LaneBytes(child.size < p.lodPixels * (p.footprint0 + p.footprintSlope * tEnter)) : 0;
-    }
+    const std::uint64_t drawn = DrawnLanes(tree, p, child, span, entering);
     if (drawn)
     {
-      for (int lane = 0; lane < kPacketLanes; ++lane)
-      {
-        if ((drawn >> (8 * lane)) & 1u)
-        {
-          const float tEnter = span.tEnter[lane], tExit = span.tExit[lane];
-          if (visitors[lane].Visit(child.Hit(tEnter, tExit, EntryAxis(LaneOf(node.c, lane), m, tEnter))))
-          {
-            live &= ~(std::uint64_t{ 0xFF } << (8 * lane));
-          }
-        }
-      }
+      live &= ~VisitLanes(drawn, node.c, m, span, child, visitors);
       todo &= live;
     }
     const std::uint64_t descending = entering & ~drawn;

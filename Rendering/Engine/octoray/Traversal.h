@@ -87,18 +87,27 @@ OCTORAY_HD_INLINE bool IntersectBox(const Ray& ray, const Vec3f& lo, float size,
 // threshold's pixels at distance t is drawn as it is (its averaged
 // attributes), without descending. Footprint of a pixel grows linearly
 // along the ray: footprint(t) = footprint0 + footprintSlope * t.
+// Whether a node of side `voxel` (in the unit cube), met at t, is smaller
+// than `pixels` pixels' footprint there (a pixel's footprint grows from
+// footprint0 by footprintSlope a unit of t; t before the eye counts as 0):
+// the level of detail's rule, for one ray (T a float) or a packet's lanes
+// (PacketTraversal.h). False for pixels <= 0 with no test of its own: no
+// side is below 0, nor below NaN where 0 meets an infinite footprint.
+template <typename T>
+OCTORAY_HD_INLINE auto FootprintCovers(float voxel, T pixels, T footprint0, T footprintSlope, T t)
+{
+  return voxel < pixels * (footprint0 + footprintSlope * (t > T{} ? t : T{}));
+}
+
 struct LevelOfDetail
 {
   float footprint0 = 0.0f;
   float footprintSlope = 0.0f;
   float pixels = 0.0f; // 0 (or less): always down to the leaves
 
-  // `voxel`: the node's side in the unit cube. False for pixels <= 0 with
-  // no test of its own: no side is below 0, nor below NaN where 0 meets an
-  // infinite footprint.
   OCTORAY_HD bool StopAt(float voxel, float t) const
   {
-    return voxel < pixels * (footprint0 + footprintSlope * (t > 0.0f ? t : 0.0f));
+    return FootprintCovers(voxel, pixels, footprint0, footprintSlope, t);
   }
 };
 
