@@ -1142,48 +1142,56 @@ bool UpdateInPlace(Device& d, DriverScratch<Device>& scratch, OctreeState<Device
   return true;
 }
 
-// Engine::Update on a built state (the caller validated `positions`). Sets
-// `writing` before its first write to the state.
+// An update's new positions and their indices where the device's loops
+// read them, the indices staged in the positions' pass.
 template <class Device>
-UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s,
-  const PositionsView& positions, bool& writing)
+struct StagedMoves
 {
-  const auto start = std::chrono::steady_clock::now();
+  StagedPositions<Device> xyz;
+  typename Device::template Staged<std::uint32_t> indices; // none: the moves are the points, in order
+};
+
+// Stages an update's moves. Of the positions' bounds only the first
+// non-finite point counts, an error here, before the first write to the
+// state, so that a bad position changes nothing.
+template <class Device>
+StagedMoves<Device> StageMoves(Device& d, const PositionsView& positions)
+{
   const std::size_t moved = positions.count;
-  UpdateStats stats;
-  stats.moved = moved;
-  d.Reserve(scratch.counters, kCounterSlots, "counters");
-  // The indices go in the positions' pass; of the positions' bounds only the
-  // first non-finite point counts, checked before the first write, so that a
-  // bad position changes nothing.
-  typename Device::template Staged<std::uint32_t> staged;
+  typename Device::template Staged<std::uint32_t> indices;
   Bounds bounds;
-  const StagedPositions<Device> xyz = StageBoundedPositions(d, positions.xyzFloat, positions.xyzDouble, moved,
+  StagedPositions<Device> xyz = StageBoundedPositions(d, positions.xyzFloat, positions.xyzDouble, moved,
     "update positions", bounds, [&](typename Device::Fills& fills) {
-      staged = d.Prepare(positions.indices, positions.indices ? moved : 0, "update indices", fills);
+      indices = d.Prepare(positions.indices, positions.indices ? moved : 0, "update indices", fills);
     });
-  const PointArraysView to = xyz.View(moved);
-  const std::uint32_t* indices = staged.Get();
   const std::uint64_t bad = bounds.firstBad;
   if (bad != kNoIndex)
   {
     throw Error(NonFinitePointMessage(positions.indices ? positions.indices[bad] : bad, positions.Position(bad)));
   }
+  return StagedMoves<Device>{ std::move(xyz), std::move(indices) };
+}
 
-  // Each move's leaf before and after it; the moves that changed leaf, in
-  // order; the first point that left the cube.
-  typename Device::template Buffer<std::uint64_t> fromLeaf, toLeaf;
-  typename Device::template Buffer<std::uint32_t> changedMoves;
-  d.Reserve(fromLeaf, moved, "update moves");
-  d.Reserve(toLeaf, moved, "update moves");
-  d.Reserve(changedMoves, moved, "update moves");
+// What the moves did to the leaves: the first point that left the cube
+// (kNoIndex: none) and how many moves changed leaf.
+struct MovedLeaves
+{
+  std::uint64_t firstOutside;
+  std::size_t changed;
+};
+
+// Writes the `moved` new positions `to` (of the points `indices`, or of
+// every point in order) into the state, with each move's leaf before it in
+// from[k] and after it in into[k], and the moves that changed leaf, in
+// order, in changedMoves. One copy to the host.
+template <class Device>
+MovedLeaves MoveLeaves(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const PointArraysView& to,
+  const std::uint32_t* indices, std::uint64_t* from, std::uint64_t* into, std::uint32_t* changedMoves)
+{
+  const std::size_t moved = to.count;
   const PointArraysView pts = s.Points();
   const RootCube::CellMap grid = s.cube.Grid();
   const int depth = s.depth;
-  std::uint64_t* from = fromLeaf.Get();
-  std::uint64_t* into = toLeaf.Get();
-
-  writing = true;
   float* xyzFloat = s.points.xyzFloat.Get();
   double* xyzDouble = s.points.xyzDouble.Get();
   // A point's old leaf from the position it leaves, read before the new one
@@ -1205,7 +1213,6 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
     }
   });
   // The new leaves from the positions as stored (floats, where they are).
-  // One copy to the host: the first point outside and the moves' count.
   const FirstFailure outside = ArmFirstFailure(d, scratch);
   d.ForEach("MovedKeysKernel", moved, OCTORAY_LAMBDA(std::size_t k) {
     const std::size_t i = indices ? indices[k] : k;
@@ -1217,16 +1224,41 @@ UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<
       outside.Report(i);
     }
   });
-  d.Select(moved, OCTORAY_LAMBDA(std::size_t k) { return from[k] != into[k]; }, changedMoves.Get(),
+  d.Select(moved, OCTORAY_LAMBDA(std::size_t k) { return from[k] != into[k]; }, changedMoves,
     scratch.counters.Get() + kCounterSelected);
   std::uint64_t report[2]; // kCounterFirst, kCounterSelected
   d.ToHost(outside.slot, 2, report, "MovedKeysKernel");
-  const std::size_t changed = report[1];
+  return MovedLeaves{ report[0], static_cast<std::size_t>(report[1]) };
+}
 
-  if (report[0] != kNoIndex)
+// Engine::Update on a built state (the caller validated `positions`). Sets
+// `writing` before its first write to the state.
+template <class Device>
+UpdateStats UpdateOctree(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s,
+  const PositionsView& positions, bool& writing)
+{
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t moved = positions.count;
+  UpdateStats stats;
+  stats.moved = moved;
+  d.Reserve(scratch.counters, kCounterSlots, "counters");
+  const StagedMoves<Device> staged = StageMoves(d, positions);
+  const std::uint32_t* indices = staged.indices.Get();
+  typename Device::template Buffer<std::uint64_t> fromLeaf, toLeaf;
+  typename Device::template Buffer<std::uint32_t> changedMoves;
+  d.Reserve(fromLeaf, moved, "update moves");
+  d.Reserve(toLeaf, moved, "update moves");
+  d.Reserve(changedMoves, moved, "update moves");
+  std::uint64_t* from = fromLeaf.Get();
+  std::uint64_t* into = toLeaf.Get();
+  writing = true;
+  const MovedLeaves leaves =
+    MoveLeaves(d, scratch, s, staged.xyz.View(moved), indices, from, into, changedMoves.Get());
+  const std::size_t changed = leaves.changed;
+  if (leaves.firstOutside != kNoIndex)
   {
     // A point left the cube: rebuild around the new bounds, at the same depth.
-    const Bounds b = PositionBounds(d, pts);
+    const Bounds b = PositionBounds(d, s.Points());
     BuildLevels(d, scratch, s, RootCube::FromBounds(b.lo, b.hi), s.depth);
     stats.changedLeaf = moved;
     stats.path = UpdateStats::Path::NewCube;
