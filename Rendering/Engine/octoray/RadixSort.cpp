@@ -16,6 +16,47 @@ int RadixSortPasses(int bits)
   return (bits + 10) / 11;
 }
 
+namespace
+{
+// Whether the `chunks` histograms (chunk-major, each of the same digits)
+// of n keys put them all under one digit.
+bool OneDigit(const std::vector<std::size_t>& histogram, int chunks, std::size_t n)
+{
+  const std::size_t buckets = histogram.size() / chunks;
+  for (std::size_t d = 0; d < buckets; ++d)
+  {
+    std::size_t total = 0;
+    for (int c = 0; c < chunks; ++c)
+    {
+      total += histogram[c * buckets + d];
+    }
+    if (total)
+    {
+      return total == n;
+    }
+  }
+  return false;
+}
+
+// The histograms' counts replaced by where each chunk's keys of each digit
+// go: exclusive offsets, digit-major then chunk, which keeps the sort
+// stable.
+void ToExclusiveOffsets(std::vector<std::size_t>& histogram, int chunks)
+{
+  const std::size_t buckets = histogram.size() / chunks;
+  std::size_t running = 0;
+  for (std::size_t d = 0; d < buckets; ++d)
+  {
+    for (int c = 0; c < chunks; ++c)
+    {
+      const std::size_t count = histogram[c * buckets + d];
+      histogram[c * buckets + d] = running;
+      running += count;
+    }
+  }
+}
+}
+
 template <typename Key, typename Value>
 int RadixSort(Key* keys, Value* values, std::size_t n, int bits, int threads, Key* scratchKeys, Value* scratchValues,
   const Value* valuesIn)
@@ -57,38 +98,11 @@ int RadixSort(Key* keys, Value* values, std::size_t n, int bits, int threads, Ke
       }
     });
     // Skip a pass in which every key has the same digit: it would only copy.
-    bool trivial = false;
-    for (std::size_t d = 0; d < buckets; ++d)
-    {
-      std::size_t total = 0;
-      for (int c = 0; c < chunks; ++c)
-      {
-        total += histogram[c * buckets + d];
-      }
-      if (total == n)
-      {
-        trivial = true;
-      }
-      if (total)
-      {
-        break;
-      }
-    }
-    if (trivial)
+    if (OneDigit(histogram, chunks, n))
     {
       continue;
     }
-    // Exclusive offsets, digit-major then chunk: keeps the sort stable.
-    std::size_t running = 0;
-    for (std::size_t d = 0; d < buckets; ++d)
-    {
-      for (int c = 0; c < chunks; ++c)
-      {
-        const std::size_t count = histogram[c * buckets + d];
-        histogram[c * buckets + d] = running;
-        running += count;
-      }
-    }
+    ToExclusiveOffsets(histogram, chunks);
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::size_t* offset = histogram.data() + c * buckets;
       for (std::size_t i = begin; i < end; ++i)
