@@ -576,6 +576,25 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
   return sorted;
 }
 
+// Sorts the leaf keys of `depth` levels that the keys kernel entered
+// (SortInput): with the records that travel with them, else with the
+// points' indices; returns the sorted keys and the array the sort left free.
+template <class Device>
+SortedKeys SortLeafKeys(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, int depth, bool travel,
+  std::uint32_t*& spare)
+{
+  const int bits = 3 * depth;
+  if (travel)
+  {
+    return SortNarrowKeys(d, scratch, pts, bits, spare);
+  }
+  if (SortedKeys::Narrow(depth))
+  {
+    return SortKeysWithIndices(d, scratch, scratch.narrowKey, pts.count, bits, spare);
+  }
+  return SortKeysWithIndices(d, scratch, scratch.sortKey, pts.count, bits, spare);
+}
+
 // fn(words) with the sorted keys as the sort stored them: 32-bit words
 // where the leaf keys fit them, else 64-bit (SortedKeys).
 template <typename Fn>
@@ -676,19 +695,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
 
   SortedPoints sorted;
   sorted.depth = sortDepth;
-  const int bits = 3 * sortDepth;
-  if (travel)
-  {
-    sorted.keys = SortNarrowKeys(d, scratch, pts, bits, sorted.spare);
-  }
-  else if (narrow)
-  {
-    sorted.keys = SortKeysWithIndices(d, scratch, scratch.narrowKey, n, bits, sorted.spare);
-  }
-  else
-  {
-    sorted.keys = SortKeysWithIndices(d, scratch, scratch.sortKey, n, bits, sorted.spare);
-  }
+  sorted.keys = SortLeafKeys(d, scratch, pts, sortDepth, travel, sorted.spare);
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).

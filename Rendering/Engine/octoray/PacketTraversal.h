@@ -78,6 +78,42 @@ struct RayPacket
   bool lodOn = false;                                  // in any lane
   unsigned signs = 0;
   std::uint64_t lanes = 0; // bytes of 0xFF for the lanes taking part
+
+  // Lane `lane` takes the ray, whose span through the root is `root`.
+  void Take(int lane, const Ray& ray, const NodeHit& root, const LevelOfDetail& lod)
+  {
+    lanes |= std::uint64_t{ 0xFF } << (8 * lane);
+    for (int a = 0; a < 3; ++a)
+    {
+      origin[a][lane] = ray.origin[a];
+      inverse[a][lane] = ray.inverse[a];
+    }
+    tMin[lane] = ray.tMin;
+    tMax[lane] = ray.tMax;
+    tEnter[lane] = root.tEnter;
+    tExit[lane] = root.tExit;
+    lodPixels[lane] = lod.pixels;
+    footprint0[lane] = lod.footprint0;
+    footprintSlope[lane] = lod.footprintSlope;
+    lodOn = lodOn || lod.pixels > 0.0f;
+  }
+  // The lanes left out get finite values, which no set of theirs reads.
+  void FillLanesLeftOut()
+  {
+    for (int lane = 0; lane < kPacketLanes; ++lane)
+    {
+      if (!((lanes >> (8 * lane)) & 1u))
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          origin[a][lane] = 0.0f;
+          inverse[a][lane] = 1.0f;
+        }
+        tMin[lane] = tMax[lane] = tEnter[lane] = tExit[lane] = 0.0f;
+        lodPixels[lane] = footprint0[lane] = footprintSlope[lane] = 0.0f;
+      }
+    }
+  }
 };
 
 // One lane's crossings.
@@ -232,21 +268,8 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
       continue;
     }
     p.signs = signs;
-    p.lanes |= std::uint64_t{ 0xFF } << (8 * lane);
+    p.Take(lane, ray, root, lods[lane]);
     packed |= 1u << lane;
-    for (int a = 0; a < 3; ++a)
-    {
-      p.origin[a][lane] = ray.origin[a];
-      p.inverse[a][lane] = ray.inverse[a];
-    }
-    p.tMin[lane] = ray.tMin;
-    p.tMax[lane] = ray.tMax;
-    p.tEnter[lane] = root.tEnter;
-    p.tExit[lane] = root.tExit;
-    p.lodPixels[lane] = lods[lane].pixels;
-    p.footprint0[lane] = lods[lane].footprint0;
-    p.footprintSlope[lane] = lods[lane].footprintSlope;
-    p.lodOn = p.lodOn || lods[lane].pixels > 0.0f;
   }
   if (__builtin_popcount(packed) < kMinPacketRays)
   {
@@ -255,20 +278,7 @@ void TracePacketOf(const OctreeView& tree, const Ray rays[kPacketLanes], const L
   }
   if (p.lanes)
   {
-    // Lanes left out keep finite values, which no set of theirs reads.
-    for (int lane = 0; lane < kPacketLanes; ++lane)
-    {
-      if (!((p.lanes >> (8 * lane)) & 1u))
-      {
-        for (int a = 0; a < 3; ++a)
-        {
-          p.origin[a][lane] = 0.0f;
-          p.inverse[a][lane] = 1.0f;
-        }
-        p.tMin[lane] = p.tMax[lane] = p.tEnter[lane] = p.tExit[lane] = 0.0f;
-        p.lodPixels[lane] = p.footprint0[lane] = p.footprintSlope[lane] = 0.0f;
-      }
-    }
+    p.FillLanesLeftOut();
     TraversePacket(tree, p, visitors);
   }
   for (int lane = 0; lane < kPacketLanes; ++lane)
