@@ -496,6 +496,36 @@ OCTORAY_HD void StartRay(Ray& ray, const Vec3f& p, const Vec3f& d, float tMin)
   ray.tMax = INFINITY;
 }
 
+// The plane on axis a through which a ray going d leaves the cell `cell`
+// of side `size`.
+OCTORAY_HD float ExitPlane(const std::uint32_t cell[3], float size, const Vec3f& d, int a)
+{
+  return (static_cast<float>(cell[a]) + (d[a] > 0.0f ? 1.0f : 0.0f)) * size;
+}
+
+// Where a ray at p going d leaves the cell `cell` of side `size`: the
+// distance, no less than 0, in tExit, and the axis of the face it leaves
+// through, returned (-1: none, d being zero).
+OCTORAY_HD int CellExit(const std::uint32_t cell[3], float size, const Vec3f& p, const Vec3f& d, float& tExit)
+{
+  tExit = INFINITY;
+  int axis = -1;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (d[a] != 0.0f)
+    {
+      const float t = (ExitPlane(cell, size, d, a) - p[a]) / d[a];
+      if (t < tExit)
+      {
+        tExit = t;
+        axis = a;
+      }
+    }
+  }
+  tExit = tExit > 0.0f ? tExit : 0.0f;
+  return axis;
+}
+
 // A ray that entered the refracting voxel `hit` through the shading normal n
 // crosses the occupied voxels of the hit's level (the medium) voxel by
 // voxel, reflecting totally inside where Snell allows no exit, until it
@@ -522,29 +552,14 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
   }
   for (int step = 0; step < kMaxMediumSteps; ++step)
   {
-    // Where the ray leaves the current cell, and through which face.
-    float tExit = INFINITY;
-    int axis = -1;
-    for (int a = 0; a < 3; ++a)
-    {
-      if (d[a] != 0.0f)
-      {
-        const float plane = (static_cast<float>(cell[a]) + (d[a] > 0.0f ? 1.0f : 0.0f)) * size;
-        const float t = (plane - p[a]) / d[a];
-        if (t < tExit)
-        {
-          tExit = t;
-          axis = a;
-        }
-      }
-    }
+    float tExit;
+    const int axis = CellExit(cell, size, p, d, tExit);
     if (axis < 0)
     {
       return false;
     }
-    tExit = tExit > 0.0f ? tExit : 0.0f;
     p += tExit * d;
-    p[axis] = (static_cast<float>(cell[axis]) + (d[axis] > 0.0f ? 1.0f : 0.0f)) * size; // exactly on the face
+    p[axis] = ExitPlane(cell, size, d, axis); // exactly on the face
     const int stepDir = d[axis] > 0.0f ? 1 : -1;
     const long long next = static_cast<long long>(cell[axis]) + stepDir;
     bool medium = false;
@@ -645,6 +660,38 @@ OCTORAY_HD void ShadeFirstHit(const FrameConstants& f, const OctreeView& tree, c
   }
 }
 
+// The mirror ray (of a reflecting voxel) and the ray through the medium (of
+// a refracting one) that `path` spawns where it hits `hit` at tHit, each
+// pushed onto the `top` pending rays where there is room.
+OCTORAY_HD void SpawnRays(const FrameConstants& f, const OctreeView& tree, const PendingRay& path, const NodeHit& hit,
+  float tHit, float reflectivity, float ior, PendingRay pending[kMaxPendingRays], int& top,
+  std::size_t& secondaryRays)
+{
+  const Vec3f n = SurfaceNormal(tree, path.ray, hit);
+  if (reflectivity > 0.0f && top < kMaxPendingRays)
+  {
+    PendingRay mirror;
+    StartRay(mirror.ray, EntryPoint(path.ray, hit), Reflect(path.ray.direction, n), 0.0f);
+    mirror.weight = path.weight * reflectivity;
+    mirror.bounces = path.bounces + 1;
+    mirror.tFromNear = path.tFromNear + tHit;
+    pending[top++] = mirror;
+    ++secondaryRays;
+  }
+  if (ior > 0.0f && top < kMaxPendingRays)
+  {
+    PendingRay through;
+    through.weight = path.weight * (1.0f - reflectivity) * RgbOf(NodeColor(f, tree, hit.node));
+    through.bounces = path.bounces + 1;
+    through.tFromNear = path.tFromNear + tHit;
+    if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
+    {
+      pending[top++] = through;
+      ++secondaryRays;
+    }
+  }
+}
+
 // A surface: the first voxel, then the mirror and refracted rays it spawns,
 // each carrying its weight in the pixel, until the bounce limit. The first
 // voxel is primaryHit, and its shadow rays primaryShadows, where the caller
@@ -693,32 +740,9 @@ OCTORAY_HD void TracedPixel(const FrameConstants& f, const OctreeView& tree, con
     // of showing its own lit colour.
     const float opaque = (1.0f - reflectivity) * (ior > 0.0f ? 0.0f : 1.0f);
     color += path.weight * opaque * rgb;
-    if (!(reflectivity > 0.0f || ior > 0.0f))
+    if (reflectivity > 0.0f || ior > 0.0f)
     {
-      continue;
-    }
-    const Vec3f n = SurfaceNormal(tree, path.ray, hit);
-    if (reflectivity > 0.0f && top < kMaxPendingRays)
-    {
-      PendingRay mirror;
-      StartRay(mirror.ray, EntryPoint(path.ray, hit), Reflect(path.ray.direction, n), 0.0f);
-      mirror.weight = path.weight * reflectivity;
-      mirror.bounces = path.bounces + 1;
-      mirror.tFromNear = path.tFromNear + tHit;
-      pending[top++] = mirror;
-      ++secondaryRays;
-    }
-    if (ior > 0.0f && top < kMaxPendingRays)
-    {
-      PendingRay through;
-      through.weight = path.weight * (1.0f - reflectivity) * RgbOf(NodeColor(f, tree, hit.node));
-      through.bounces = path.bounces + 1;
-      through.tFromNear = path.tFromNear + tHit;
-      if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
-      {
-        pending[top++] = through;
-        ++secondaryRays;
-      }
+      SpawnRays(f, tree, path, hit, tHit, reflectivity, ior, pending, top, secondaryRays);
     }
   }
   rgba[0] = color.x, rgba[1] = color.y, rgba[2] = color.z;
