@@ -17,6 +17,8 @@
 #   V="main before" [NCU="main before"] [TESTS=1|"NAME..."] [SECTION=build|render] [ROUNDS=2] \
 #     [RENDER=1] scripts/gpu/variants-check.sh OUTDIR [ARCHIVE]
 #
+# NCU=" " (a blank, not empty) profiles none.
+#
 # The variant files travel in .gpu-vtk/variants (source-variants.sh says how
 # they are made), GoogleTest in .gpu-vtk/googletest.
 set -u
