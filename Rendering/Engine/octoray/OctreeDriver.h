@@ -576,19 +576,19 @@ SortedKeys SortKeysWithIndices(Device& d, DriverScratch<Device>& scratch, KeyBuf
   return sorted;
 }
 
-// Sorts the leaf keys of `depth` levels that the keys kernel entered
-// (SortInput): with the records that travel with them, else with the
-// points' indices; returns the sorted keys and the array the sort left free.
+// Sorts the leaf keys of `bits` bits that the keys kernel entered into
+// `input`: with the records that travel with them where it holds no
+// indices, else with the indices; returns the sorted keys and the array
+// the sort left free.
 template <class Device>
-SortedKeys SortLeafKeys(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, int depth, bool travel,
-  std::uint32_t*& spare)
+SortedKeys SortLeafKeys(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const SortInput& input,
+  int bits, std::uint32_t*& spare)
 {
-  const int bits = 3 * depth;
-  if (travel)
+  if (!input.index)
   {
     return SortNarrowKeys(d, scratch, pts, bits, spare);
   }
-  if (SortedKeys::Narrow(depth))
+  if (input.narrowKey)
   {
     return SortKeysWithIndices(d, scratch, scratch.narrowKey, pts.count, bits, spare);
   }
@@ -695,7 +695,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
 
   SortedPoints sorted;
   sorted.depth = sortDepth;
-  sorted.keys = SortLeafKeys(d, scratch, pts, sortDepth, travel, sorted.spare);
+  sorted.keys = SortLeafKeys(d, scratch, pts, input, 3 * sortDepth, sorted.spare);
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
