@@ -39,6 +39,12 @@ typedef std::uint8_t PacketBytes __attribute__((vector_size(kPacketLanes)));
 // A byte per lane in a 64-bit word: lane i is byte i.
 constexpr std::uint64_t kEveryLaneByte = 0x0101010101010101ull;
 
+// Lane `lane` alone, as a set of lanes in bytes of 0xFF.
+constexpr std::uint64_t OneLane(int lane)
+{
+  return std::uint64_t{ 0xFF } << (8 * lane);
+}
+
 // Lanes where a comparison held, as bytes of 0xFF.
 inline std::uint64_t LaneBytes(PacketInts comparison)
 {
@@ -82,7 +88,7 @@ struct RayPacket
   // Lane `lane` takes the ray, whose span through the root is `root`.
   void Take(int lane, const Ray& ray, const NodeHit& root, const LevelOfDetail& lod)
   {
-    lanes |= std::uint64_t{ 0xFF } << (8 * lane);
+    lanes |= OneLane(lane);
     for (int a = 0; a < 3; ++a)
     {
       origin[a][lane] = ray.origin[a];
@@ -102,7 +108,7 @@ struct RayPacket
   {
     for (int lane = 0; lane < kPacketLanes; ++lane)
     {
-      if (!((lanes >> (8 * lane)) & 1u))
+      if (!(lanes & OneLane(lane)))
       {
         for (int a = 0; a < 3; ++a)
         {
@@ -153,12 +159,12 @@ std::uint64_t VisitLanes(std::uint64_t drawn, const Crossings<PacketFloats>& c, 
   std::uint64_t stopped = 0;
   for (int lane = 0; lane < kPacketLanes; ++lane)
   {
-    if ((drawn >> (8 * lane)) & 1u)
+    if (drawn & OneLane(lane))
     {
       const float tEnter = span.tEnter[lane], tExit = span.tExit[lane];
       if (visitors[lane].Visit(child.Hit(tEnter, tExit, EntryAxis(LaneOf(c, lane), m, tEnter))))
       {
-        stopped |= std::uint64_t{ 0xFF } << (8 * lane);
+        stopped |= OneLane(lane);
       }
     }
   }
