@@ -67,9 +67,7 @@ inline std::vector<std::uint64_t> RandomKeys(std::size_t n, int bits, std::uint6
   return keys;
 }
 
-// ForEach calls every item once, Reduce combines every item, Histogram adds
-// each item to its two bins (or one: -1 is none) on top of what the counts
-// held.
+// ForEach calls every item once, Reduce combines every item.
 template <class Device>
 void ExpectLoopsCoverEveryItemOnce(Device& d, std::size_t n)
 {
@@ -88,23 +86,6 @@ void ExpectLoopsCoverEveryItemOnce(Device& d, std::size_t n)
     expected += i * i;
   }
   EXPECT_EQ(sum, expected);
-
-  constexpr int kBins = 7;
-  std::vector<std::uint64_t> reference(kBins, 0);
-  reference[0] = 5; // added to, not replaced
-  DeviceArray<Device, std::uint64_t> counts(d, reference);
-  d.template Histogram<kBins>("test", n, OCTORAY_LAMBDA(std::size_t i) {
-    return BinPair{ static_cast<int>(i % 3), i % 2 ? -1 : 3 + static_cast<int>(i % 4) };
-  }, counts.Get());
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    ++reference[i % 3];
-    if (i % 2 == 0)
-    {
-      ++reference[3 + i % 4];
-    }
-  }
-  EXPECT_EQ(counts.Host(), reference);
 }
 
 // Select keeps the selected items in order and writes their count.
@@ -128,44 +109,28 @@ void ExpectSelectKeepsOrderAndCounts(Device& d, std::size_t n)
   EXPECT_TRUE(std::equal(expected.begin(), expected.end(), kept.begin()));
 }
 
-// Nested lists against their definition, item by item: list l holds, in
-// order, the items whose first list is l or less (the last list the items
-// themselves, each other list an item's place in the next), then the size
-// of the next list; the counts are those of each first list. First lists
-// past the last (an item in no list) come too. The lists before the last
-// go end to end, and only where they fit: with one entry too few, the last
-// list alone.
-template <class Device>
-void ExpectNestedListsHoldEachItemFromItsFirstListOn(Device& d, std::size_t n)
+// The first `lists` of the `counted` lists that `tally` holds placed
+// (ExpectNestedListsHoldEachItemFromItsFirstListOn).
+template <class Device, typename FirstList, typename Tally>
+void ExpectNestedListsPlaced(Device& d, std::size_t n, FirstList firstList, const Tally& tally, int counted, int lists)
 {
-  constexpr int kLists = 5;
-  const auto firstList = OCTORAY_LAMBDA(std::size_t i) { return static_cast<int>((i * 7919 + i / 3) % 7); };
-  typename Device::template Buffer<std::uint32_t> tally;
-  DeviceArray<Device, std::uint64_t> counts(d, kLists, 0);
-  d.CountNested("test", n, kLists, firstList, tally, counts.Get());
-  std::vector<std::vector<std::uint32_t>> expected(kLists);
-  std::vector<std::uint64_t> expectedCounts(kLists, 0);
+  std::vector<std::vector<std::uint32_t>> expected(lists);
   for (std::size_t i = 0; i < n; ++i)
   {
-    const int first = firstList(i);
     std::uint32_t below = static_cast<std::uint32_t>(i);
-    for (int l = kLists - 1; l >= first; --l)
+    for (int l = lists - 1; l >= firstList(i); --l)
     {
       expected[l].push_back(below);
       below = static_cast<std::uint32_t>(expected[l].size() - 1);
     }
-    if (first < kLists)
-    {
-      ++expectedCounts[first];
-    }
   }
-  for (int l = kLists - 1; l >= 0; --l) // after its items, the next list's size (without its own end)
+  for (int l = lists - 1; l >= 0; --l) // after its items, the next list's size (without its own end)
   {
-    expected[l].push_back(l + 1 < kLists ? static_cast<std::uint32_t>(expected[l + 1].size() - 1)
-                                         : static_cast<std::uint32_t>(n));
+    expected[l].push_back(l + 1 < lists ? static_cast<std::uint32_t>(expected[l + 1].size() - 1)
+                                        : static_cast<std::uint32_t>(n));
   }
   std::vector<std::uint32_t> packed;
-  for (int l = 0; l + 1 < kLists; ++l)
+  for (int l = 0; l + 1 < lists; ++l)
   {
     packed.insert(packed.end(), expected[l].begin(), expected[l].end());
   }
@@ -173,13 +138,66 @@ void ExpectNestedListsHoldEachItemFromItsFirstListOn(Device& d, std::size_t n)
   {
     DeviceArray<Device, std::uint32_t> last(d, n + 1, 0xDEADBEEFu);
     DeviceArray<Device, std::uint32_t> packedOut(d, packed.size(), 0xDEADBEEFu);
-    d.PlaceNested("test", n, firstList, tally, NestedLists{ kLists, last.Get(), packedOut.Get(), room });
+    d.PlaceNested("test", n, firstList, tally, counted, NestedLists{ lists, last.Get(), packedOut.Get(), room });
     const std::vector<std::uint32_t> lastOut = last.Host();
-    EXPECT_TRUE(std::equal(expected[kLists - 1].begin(), expected[kLists - 1].end(), lastOut.begin())) << room;
+    EXPECT_TRUE(std::equal(expected[lists - 1].begin(), expected[lists - 1].end(), lastOut.begin())) << room;
     EXPECT_EQ(packedOut.Host() == packed, room == packed.size()) << room;
   }
-  EXPECT_EQ(counts.Host(), expectedCounts);
 }
+
+// A side histogram's bins: runs that lanes of a warp share, as in sorted
+// points, in every other 32 items, and -1 (none) among the others.
+struct TestSideBins
+{
+  static constexpr int kBins = 7;
+  OCTORAY_HD int operator()(std::size_t i) const
+  {
+    return i % 64 < 32 ? static_cast<int>(i / 40 % kBins) : static_cast<int>((i * 13 + i / 7) % (kBins + 1)) - 1;
+  }
+};
+
+// Nested lists against their definition, item by item: list l holds, in
+// order, the items whose first list is l or less (the last list the items
+// themselves, each other list an item's place in the next), then the size
+// of the next list; the counts are those of each first list, and a side
+// histogram's counts those of each bin, added to what they held. First
+// lists past the last (an item in no list) come too. The lists before the
+// last go end to end, and only where they fit: with one entry too few,
+// the last list alone. Lists counted with more after them are placed as
+// if counted alone.
+template <class Device>
+void ExpectNestedListsHoldEachItemFromItsFirstListOn(Device& d, std::size_t n)
+{
+  constexpr int kLists = 5;
+  const auto firstList = OCTORAY_LAMBDA(std::size_t i) { return static_cast<int>((i * 7919 + i / 3) % 7); };
+  for (const int counted : { kLists, kLists + 1 })
+  {
+    SCOPED_TRACE("lists counted: " + std::to_string(counted));
+    typename Device::template Buffer<std::uint32_t> tally;
+    std::vector<std::uint64_t> expectedCounts(counted, 0);
+    std::vector<std::uint64_t> expectedSide(TestSideBins::kBins, 0);
+    expectedSide[0] = 5; // added to, not replaced
+    DeviceArray<Device, std::uint64_t> counts(d, counted, 0);
+    DeviceArray<Device, std::uint64_t> side(d, expectedSide);
+    d.CountNested("test", n, counted, firstList, tally, counts.Get(),
+      SideHistogram<TestSideBins::kBins, TestSideBins>{ {}, side.Get() });
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (firstList(i) < counted)
+      {
+        ++expectedCounts[firstList(i)];
+      }
+      if (TestSideBins()(i) >= 0)
+      {
+        ++expectedSide[TestSideBins()(i)];
+      }
+    }
+    EXPECT_EQ(counts.Host(), expectedCounts);
+    EXPECT_EQ(side.Host(), expectedSide);
+    ExpectNestedListsPlaced(d, n, firstList, tally, counted, kLists);
+  }
+}
+
 
 // Keys and values sorted stably by the key's low `bits` bits: the
 // reference the sorts are held to.

@@ -34,7 +34,7 @@ void OnEverySize(Check&& check)
 
 using CudaDeviceCUDA = CudaOnlyTest;
 
-TEST_F(CudaDeviceCUDA, ForEachReduceAndHistogramCoverEveryItemOnce)
+TEST_F(CudaDeviceCUDA, ForEachAndReduceCoverEveryItemOnce)
 {
   OnEverySize([](std::size_t n, CudaDevice& d) { checks::ExpectLoopsCoverEveryItemOnce(d, n); });
 }

@@ -129,10 +129,10 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
   staged.refraction.clear();
   BuildOptions fixedDepth;
   fixedDepth.depth = 6;
-  BuildOptions automaticDepth; // depth 0: the depth histogram runs too
+  BuildOptions automaticDepth; // depth 0: the count of the levels' run starts adds up the depth's histograms too
 
-  for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "NeighbourHistogramKernel",
-         "LevelCountKernel", "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
+  for (const char* kernel : { "ReduceRangeKernel", "PointRecordsKernel", "KeysKernel", "LevelCountKernel",
+         "LevelStartsKernel", "LeafKernel", "InnerKernel", "SmallLevelsKernel" })
   {
     const std::string name = kernel;
     const std::vector<const Cloud*> seconds =

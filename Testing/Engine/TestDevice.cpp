@@ -45,7 +45,7 @@ void OnEverySplit(Check&& check)
 }
 }
 
-TEST(CpuDevice, ForEachReduceAndHistogramCoverEveryItemOnce)
+TEST(CpuDevice, ForEachAndReduceCoverEveryItemOnce)
 {
   OnEverySplit([](std::size_t n, CpuDevice& d) { checks::ExpectLoopsCoverEveryItemOnce(d, n); });
 }

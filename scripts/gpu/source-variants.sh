@@ -22,7 +22,10 @@
 # engine's tests (both backends); TESTS="main NAME..." names the variants
 # that do (those whose files still fit the tree's tests).
 #
-#   SOURCE_VARIANTS="main NAME..." [SECTION=render|build] [ROUNDS=N] [TESTS=1|"NAME..."] \
+# BENCH="octoray_bench_build ARGS..." runs another of the project's
+# benchmarks in place of the section (built in each variant's folder).
+#
+#   SOURCE_VARIANTS="main NAME..." [SECTION=render|build] [ROUNDS=N] [TESTS=1|"NAME..."] [BENCH=...] \
 #     scripts/gpu/source-variants.sh OUTDIR
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -32,6 +35,7 @@ out=$(realpath -m "$1")
 mkdir -p "$out"
 vtk=/tmp/vtk-egl
 section=${SECTION:-render}
+bench=(${BENCH:-octoray_bench_cuda --only $section})
 if [ -f "$vtk/lib/cmake/vtk-9.2/vtk-config.cmake" ]; then
   with_vtk=(-DVTK_DIR="$vtk/lib/cmake/vtk-9.2")
 else
@@ -56,7 +60,7 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
     done
   done
   # The tests belong to the tree's own headers: built in the variants TESTS names.
-  targets=(octoray_bench_cuda)
+  targets=("${bench[0]}")
   [[ "$tested" == *" $v "* ]] && targets+=(octoray_engine_tests)
   { cmake -S "$src" -B "$src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DOCTORAY_ENABLE_CUDA=ON \
       -DCMAKE_CUDA_ARCHITECTURES=90 "${with_vtk[@]}" -DCMAKE_CXX_FLAGS='-include cstdint' \
@@ -75,11 +79,12 @@ for v in $SOURCE_VARIANTS; do
 done
 for r in $(seq "${ROUNDS:-1}"); do
   for v in $SOURCE_VARIANTS; do
-    /tmp/src-$v/build/bin/octoray_bench_cuda --only "$section" >> "$out/source-$v.log" 2>&1
+    "/tmp/src-$v/build/bin/${bench[0]}" "${bench[@]:1}" >> "$out/source-$v.log" 2>&1
   done
 done
 for v in $SOURCE_VARIANTS; do
   echo "== source variant $v"
+  [ -n "${BENCH:-}" ] && grep -E "^ *[0-9]" "$out/source-$v.log" && continue
   grep -E "^(render depth|upload of|build n=.*depth=10)" "$out/source-$v.log"
   [ "$section" = build ] && python3 scripts/gpu/build-ratios.py "$out/source-$v.log" | tail -n +2
   [ "$section" = render ] && python3 scripts/gpu/render-rates.py "$out/source-$v.log" | tail -n +2

@@ -84,4 +84,25 @@ struct NestedLists
   // Whether the packed lists, of `packedItems` items together, fit.
   OCTORAY_HD bool PackedFit(std::size_t packedItems) const { return packedItems + (count - 1) <= packedRoom; }
 };
+
+// A histogram that a device's CountNested adds up in the same pass over
+// the items as its lists: counts[binOf(i)] += 1 for each item i whose bin
+// is in [0, Bins) (-1: none). The automatic depth's lone points
+// (DepthChoice.h's LoneLevels) are counted so, beside the levels' run
+// starts, where a histogram pass of their own read the sorted keys once
+// more.
+template <int Bins, typename BinOf>
+struct SideHistogram
+{
+  static constexpr int kBins = Bins;
+  BinOf binOf;
+  std::uint64_t* counts;
+};
+
+// No histogram beside the lists: what a build of a requested depth counts.
+struct NoBin
+{
+  OCTORAY_HD int operator()(std::size_t) const { return -1; }
+};
+using NoSideHistogram = SideHistogram<0, NoBin>;
 }

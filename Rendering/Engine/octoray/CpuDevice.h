@@ -203,21 +203,23 @@ public:
   }
 
   // Each chunk counts its items by their first list (tally[c * lists + f]:
-  // chunk c's items of first list f), then places them after the chunks
-  // before it, in each of their lists from the last one up, so that each
-  // list records the item's place in the list after it.
-  template <typename FirstList>
+  // chunk c's items of first list f), and into `side`'s bins, then places
+  // them after the chunks before it, in each of their lists from the last
+  // one up, so that each list records the item's place in the list after it.
+  template <typename FirstList, typename Side = NoSideHistogram>
   void CountNested(const char*, std::size_t n, int lists, FirstList firstList, Buffer<std::uint32_t>& tally,
-    std::uint64_t* counts)
+    std::uint64_t* counts, Side side = {})
   {
     const int chunks = NestedChunks(n);
     tally.Reserve(static_cast<std::size_t>(chunks) * lists);
+    std::vector<std::uint64_t> sideTally(static_cast<std::size_t>(chunks) * Side::kBins, 0);
     // Each chunk counts and places in arrays of its own: the chunks' rows
     // share cache lines. Counting and placing in them, the level phase of a
     // 10 M-point build on two threads took 104-109 ms, 90-95 so
     // (octoray_bench_build --points 1e7 --backend cpu).
     ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
       std::uint32_t count[NestedLists::kMaxLists] = {};
+      std::uint64_t sideCount[Side::kBins > 0 ? Side::kBins : 1] = {};
       for (std::size_t i = begin; i < end; ++i)
       {
         const int first = firstList(i);
@@ -225,17 +227,31 @@ public:
         {
           ++count[first];
         }
+        if constexpr (Side::kBins > 0)
+        {
+          const int bin = side.binOf(i);
+          if (bin >= 0)
+          {
+            ++sideCount[bin];
+          }
+        }
       }
       std::copy_n(count, lists, tally.Get() + static_cast<std::size_t>(c) * lists);
+      std::copy_n(sideCount, Side::kBins, sideTally.data() + static_cast<std::size_t>(c) * Side::kBins);
     });
     for (std::size_t k = 0; k < tally.Count(); ++k)
     {
       counts[k % lists] += tally.Get()[k];
     }
+    for (std::size_t k = 0; k < sideTally.size(); ++k)
+    {
+      side.counts[k % Side::kBins] += sideTally[k];
+    }
   }
 
+  // The first out.count of the `counted` lists that CountNested counted.
   template <typename FirstList>
-  void PlaceNested(const char*, std::size_t n, FirstList firstList, const Buffer<std::uint32_t>& tally,
+  void PlaceNested(const char*, std::size_t n, FirstList firstList, const Buffer<std::uint32_t>& tally, int counted,
     const NestedLists& out)
   {
     const int lists = out.count;
@@ -248,7 +264,7 @@ public:
       std::uint32_t inList = 0;
       for (int l = 0; l < lists; ++l)
       {
-        inList += tally.Get()[static_cast<std::size_t>(c) * lists + l];
+        inList += tally.Get()[static_cast<std::size_t>(c) * counted + l];
         next[static_cast<std::size_t>(c + 1) * lists + l] = next[static_cast<std::size_t>(c) * lists + l] + inList;
       }
     }
@@ -303,35 +319,6 @@ public:
       sum = combine(sum, p);
     }
     return sum;
-  }
-
-  template <int Bins, typename Fn>
-  void Histogram(const char*, std::size_t n, Fn binsOf, std::uint64_t* counts)
-  {
-    const int chunks = n < kParallelPassMinItems ? 1 : threads;
-    std::vector<std::uint64_t> local(static_cast<std::size_t>(chunks) * Bins, 0);
-    ParallelChunks(n, chunks, [&](std::size_t begin, std::size_t end, int c) {
-      std::uint64_t* h = local.data() + static_cast<std::size_t>(c) * Bins;
-      for (std::size_t i = begin; i < end; ++i)
-      {
-        const auto bins = binsOf(i);
-        if (bins.first >= 0)
-        {
-          ++h[bins.first];
-        }
-        if (bins.second >= 0)
-        {
-          ++h[bins.second];
-        }
-      }
-    });
-    for (int c = 0; c < chunks; ++c)
-    {
-      for (int b = 0; b < Bins; ++b)
-      {
-        counts[b] += local[static_cast<std::size_t>(c) * Bins + b];
-      }
-    }
   }
 
   template <typename Predicate>

@@ -29,7 +29,6 @@ namespace octoray
 namespace cuda
 {
 constexpr int kBlock = 256;
-static_assert(kBlock % 32 == 0, "HistogramKernel adds its counts up in full warps");
 
 inline unsigned Blocks(std::size_t n)
 {
@@ -170,24 +169,58 @@ static_assert(kNestedItemsPerLane < 32, "a lane's count of one list fits FirstLi
 static_assert(kNestedWarpTile < (1u << 16), "a tile's count of one list fits a 16-bit half");
 static_assert(NestedLists::kMaxLists < 2 * FirstListFields::kPerWord, "every first list, none too, has a field");
 
+// The items of this lane's warp tile counted into the side histogram's
+// bins in the block's `blockCount`: the lanes of a round that share a bin
+// (most do, in sorted points) add to it once.
+template <typename Side>
+__device__ inline void CountSideBins(std::size_t n, std::size_t tile, const Side& side, std::uint32_t* blockCount)
+{
+  const int lane = threadIdx.x & 31u;
+  const std::size_t begin = tile * kNestedWarpTile + lane;
+#pragma unroll
+  for (int r = 0; r < kNestedItemsPerLane; ++r)
+  {
+    const std::size_t i = begin + 32 * std::size_t(r);
+    const int bin = i < n ? side.binOf(i) : -1;
+    const unsigned peers = __match_any_sync(0xFFFFFFFFu, bin);
+    if (bin >= 0 && lane == __ffs(peers) - 1)
+    {
+      atomicAdd(&blockCount[bin], static_cast<std::uint32_t>(__popc(peers)));
+    }
+  }
+}
+
 // counts[l * tiles + tile]: warp tile `tile`'s items in list l (those of
 // first list l and less); then one 0, so that the scan's last entry is the
 // size of every list together. histogram[f] += the items of first list f,
-// added up in the block first. The warp adds its lanes' fields up two
-// lists at a time, in 16-bit halves (kNestedWarpTile items a tile at most).
-template <typename FirstList>
-__global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, FirstList firstList,
+// and side.counts[b] += the items of side bin b, added up in the block
+// first. The warp adds its lanes' fields up two lists at a time, in 16-bit
+// halves (kNestedWarpTile items a tile at most).
+template <typename FirstList, typename Side>
+__global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, FirstList firstList, Side side,
   std::uint32_t* counts, unsigned long long* histogram)
 {
   __shared__ std::uint32_t blockCount[NestedLists::kMaxLists];
+  __shared__ std::uint32_t sideCount[Side::kBins > 0 ? Side::kBins : 1];
   if (threadIdx.x < NestedLists::kMaxLists)
   {
     blockCount[threadIdx.x] = 0;
+  }
+  if constexpr (Side::kBins > 0)
+  {
+    for (int b = threadIdx.x; b < Side::kBins; b += blockDim.x)
+    {
+      sideCount[b] = 0;
+    }
   }
   __syncthreads();
   int first[kNestedItemsPerLane];
   const std::size_t tile = LoadFirstLists(n, lists, firstList, first);
   const int lane = threadIdx.x & 31u;
+  if constexpr (Side::kBins > 0)
+  {
+    CountSideBins(n, tile, side, sideCount);
+  }
   FirstListFields fields;
 #pragma unroll
   for (int r = 0; r < kNestedItemsPerLane; ++r)
@@ -227,6 +260,17 @@ __global__ void NestedCountKernel(std::size_t n, int lists, std::size_t tiles, F
   if (threadIdx.x < lists && blockCount[threadIdx.x])
   {
     atomicAdd(&histogram[threadIdx.x], static_cast<unsigned long long>(blockCount[threadIdx.x]));
+  }
+  if constexpr (Side::kBins > 0)
+  {
+    for (int b = threadIdx.x; b < Side::kBins; b += blockDim.x)
+    {
+      if (sideCount[b])
+      {
+        atomicAdd(reinterpret_cast<unsigned long long*>(&side.counts[b]),
+          static_cast<unsigned long long>(sideCount[b]));
+      }
+    }
   }
 }
 
@@ -281,62 +325,6 @@ __global__ void NestedPlaceKernel(std::size_t n, std::size_t tiles, FirstList fi
         below = place;
       }
       next += lane == l ? __popc(in) : 0;
-    }
-  }
-}
-
-// Counts per block in shared memory first, each thread in a column of
-// 16-bit counters of its own, over a grid that strides through the items: a
-// few dozen bins hit by every thread would serialise on atomics, in shared
-// memory too (sorted keys give neighbouring threads the same bins). The
-// grid has at least as many threads as n / kMaxHistogramSteps, so that no
-// counter (two bins an item, at most) passes 16 bits.
-constexpr unsigned kHistogramBlocks = 1024;
-constexpr std::size_t kMaxHistogramSteps = 32767;
-
-inline unsigned HistogramBlocks(std::size_t n)
-{
-  return std::min(Blocks(n), std::max(kHistogramBlocks, Blocks((n + kMaxHistogramSteps - 1) / kMaxHistogramSteps)));
-}
-
-template <int Bins, typename Fn>
-__global__ void HistogramKernel(std::size_t n, Fn binsOf, unsigned long long* counts)
-{
-  __shared__ std::uint16_t local[Bins][kBlock];
-  for (int b = 0; b < Bins; ++b)
-  {
-    local[b][threadIdx.x] = 0;
-  }
-  const std::size_t stride = gridDim.x * std::size_t(blockDim.x);
-  for (std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; i < n; i += stride)
-  {
-    const auto bins = binsOf(i);
-    if (bins.first >= 0)
-    {
-      ++local[bins.first][threadIdx.x];
-    }
-    if (bins.second >= 0)
-    {
-      ++local[bins.second][threadIdx.x];
-    }
-  }
-  __syncthreads();
-  // Each warp adds up the columns of some bins.
-  const unsigned lane = threadIdx.x & 31u;
-  for (int b = threadIdx.x / 32; b < Bins; b += blockDim.x / 32)
-  {
-    unsigned sum = 0;
-    for (unsigned t = lane; t < kBlock; t += 32)
-    {
-      sum += local[b][t];
-    }
-    for (int offset = 16; offset > 0; offset /= 2)
-    {
-      sum += __shfl_down_sync(0xFFFFFFFFu, sum, offset);
-    }
-    if (lane == 0 && sum)
-    {
-      atomicAdd(&counts[b], static_cast<unsigned long long>(sum));
     }
   }
 }
@@ -667,9 +655,9 @@ public:
 
   // As CpuDevice's: `tally` holds the warp tiles' counts and their scan,
   // lists * tiles + 1 entries each.
-  template <typename FirstList>
+  template <typename FirstList, typename Side = NoSideHistogram>
   void CountNested(const char* name, std::size_t n, int lists, FirstList firstList, Buffer<std::uint32_t>& tally,
-    std::uint64_t* counts)
+    std::uint64_t* counts, Side side = {})
   {
     static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit counts");
     const std::size_t tiles = cuda::NestedWarpTiles(n);
@@ -679,18 +667,20 @@ public:
     CudaCheck(cub::DeviceScan::ExclusiveSum(nullptr, scanBytes, none, none, entries), "cub::DeviceScan");
     Reserve(tally, 2 * entries, "nested lists");
     std::uint32_t* tileCounts = tally.Get();
-    Launch(name, cuda::NestedCountKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, lists, tiles,
-      firstList, tileCounts, reinterpret_cast<unsigned long long*>(counts));
+    Launch(name, cuda::NestedCountKernel<FirstList, Side>, cuda::Blocks(32 * tiles), cuda::kBlock, n, lists, tiles,
+      firstList, side, tileCounts, reinterpret_cast<unsigned long long*>(counts));
     CudaCheck(cub::DeviceScan::ExclusiveSum(Temporary(scanBytes), scanBytes, tileCounts, tileCounts + entries, entries),
       "cub::DeviceScan");
   }
 
   template <typename FirstList>
   void PlaceNested(const char* name, std::size_t n, FirstList firstList, const Buffer<std::uint32_t>& tally,
-    const NestedLists& out)
+    int counted, const NestedLists& out)
   {
     const std::size_t tiles = cuda::NestedWarpTiles(n);
-    const std::size_t entries = static_cast<std::size_t>(out.count) * tiles + 1;
+    // The scan follows the counts of every list counted; the places of the
+    // first out.count lists are where they would be had those alone been.
+    const std::size_t entries = static_cast<std::size_t>(counted) * tiles + 1;
     Launch(name, cuda::NestedPlaceKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, tiles, firstList,
       out, tally.Get() + entries);
   }
@@ -707,17 +697,6 @@ public:
     T result;
     ToHost(out, 1, &result, "cub::DeviceReduce");
     return result;
-  }
-
-  template <int Bins, typename Fn>
-  void Histogram(const char* name, std::size_t n, Fn binsOf, std::uint64_t* counts)
-  {
-    static_assert(sizeof(std::uint64_t) == sizeof(unsigned long long), "64-bit counts");
-    if (n)
-    {
-      Launch(name, cuda::HistogramKernel<Bins, Fn>, cuda::HistogramBlocks(n), cuda::kBlock,
-        n, binsOf, reinterpret_cast<unsigned long long*>(counts));
-    }
   }
 
   template <typename Predicate>

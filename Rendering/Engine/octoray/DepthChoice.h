@@ -17,10 +17,10 @@ namespace octoray
 // depth; full-depth keys by default) have the same ancestor (0..depth - 1),
 // or kMaxLevel when a == b: equal keys of a depth short of kMaxLevel count
 // as sharing the levels below it too, which were not told apart. Keys of 32
-// bits take 32-bit arithmetic: the build's histogram of neighbouring keys
-// runs this three times a point, and on an H100 it ran a fifth faster so,
-// where more reads in flight had not made it faster
-// (Benchmarks/gpu/variants-histogram-32bit.txt).
+// bits take 32-bit arithmetic: the automatic depth's count runs this three
+// times a point, and on an H100 the histogram of neighbouring keys that did
+// so before (Benchmarks/gpu/variants-histogram-32bit.txt) ran a fifth
+// faster with it, where more reads in flight had not made it faster.
 template <typename Key>
 OCTORAY_HD int SharedLevels(Key a, Key b, int depth = kMaxLevel)
 {
@@ -30,26 +30,27 @@ OCTORAY_HD int SharedLevels(Key a, Key b, int depth = kMaxLevel)
 
 constexpr int kDepthHistogramBins = kMaxLevel + 2; // levels -1..21
 
-// Up to two histogram entries of one item; -1: none.
-struct BinPair
-{
-  int first, second;
-};
-
-// Where sorted key i of n counts in the two histograms, newNode (entries
-// 0..kDepthHistogramBins-1) and alone (the next kDepthHistogramBins):
-// newNode's bin is the level shared with the previous key (not counted for
-// i == 0), alone's the deeper of the levels shared with either neighbour
-// (-1 when there is none). Bin b is entry b + 1. `keys` are leaf keys of
-// `depth` levels (32 or 64 bits).
+// Where sorted key i of n counts in the alone histogram: the deeper of the
+// levels it shares with either neighbour (-1 where it has none), as entry
+// that + 1. Every level below that one holds the key alone. The newNode
+// histogram, the level each key shares with the previous one, is
+// FirstNewLevels' lists, counted beside (Device::CountNested). `keys` are
+// leaf keys of `depth` levels (32 or 64 bits).
 template <typename Key>
-OCTORAY_HD BinPair DepthHistogramEntries(const Key* keys, std::size_t n, std::size_t i, int depth)
+struct LoneLevels
 {
-  const Key key = keys[i];
-  const int withPrev = i > 0 ? SharedLevels(keys[i - 1], key, depth) : -1;
-  const int withNext = i + 1 < n ? SharedLevels(key, keys[i + 1], depth) : -1;
-  return BinPair{ i > 0 ? withPrev + 1 : -1, kDepthHistogramBins + (withPrev > withNext ? withPrev : withNext) + 1 };
-}
+  const Key* keys;
+  std::size_t n;
+  int depth;
+
+  OCTORAY_HD int operator()(std::size_t i) const
+  {
+    const Key key = keys[i];
+    const int withPrev = i > 0 ? SharedLevels(keys[i - 1], key, depth) : -1;
+    const int withNext = i + 1 < n ? SharedLevels(key, keys[i + 1], depth) : -1;
+    return (withPrev > withNext ? withPrev : withNext) + 1;
+  }
+};
 
 // The shallowest level at which sorted key i of n starts a node, which it
 // starts at every level from there to the leaves: 0 for the first key,
@@ -85,13 +86,15 @@ inline std::uint64_t NodesAtLevel(const std::uint64_t newNode[kDepthHistogramBin
 }
 
 // The depth from the histograms of keys sorted down to level `known`
-// (newNode[b + 1] and alone[b + 1] count keys per bin b in -1..21; with
-// known < kMaxLevel the bins from `known` on lump keys whose deeper levels
-// were not sorted). The bins below `known` are exact, and they settle the
-// rule at a level up to `known` unless no level up to it holds half
-// singletons and one of them already has as many nodes as level `known`:
-// whether a deeper level would separate more points is then not known, and
-// the answer is 0. With known == kMaxLevel, never 0.
+// (newNode[b + 1]: the keys that share b levels with the previous one,
+// read for b < known; alone[b + 1]: the keys whose nearer neighbour shares
+// b levels with them, b in -1..21; with known < kMaxLevel the bins from
+// `known` on lump keys whose deeper levels were not sorted). The bins
+// below `known` are exact, and they settle the rule at a level up to
+// `known` unless no level up to it holds half singletons and one of them
+// already has as many nodes as level `known`: whether a deeper level
+// would separate more points is then not known, and the answer is 0. With
+// known == kMaxLevel, never 0.
 inline int ChooseDepthWithin(const std::uint64_t newNode[kDepthHistogramBins],
   const std::uint64_t alone[kDepthHistogramBins], int known)
 {

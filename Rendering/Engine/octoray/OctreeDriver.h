@@ -22,16 +22,17 @@
 //   ForEach(name, n, fn)              fn(i) for i in [0, n); on CUDA the kernel `name` (FaultInjection.h), at
 //                                     the blocks a multiprocessor fn asks for where it is Occupying (Config.h)
 //   Reduce(n, identity, map, combine) combine over every map(i), returned to the host
-//   Histogram<Bins>(name, n, binsOf, counts)   counts[b] += the items whose BinPair names b
 //   Select(n, selected, out, count)   the i in [0, n) with selected(i), in order; their count into *count
-//   CountNested(name, n, lists, firstList, tally, counts)   nested selections: i in [0, n) belongs to every list
-//                                     from firstList(i) to lists - 1 (none where firstList(i) >= lists);
-//                                     counts[f] += the items of first list f, and `tally` (a 32-bit buffer)
-//                                     what PlaceNested needs
-//   PlaceNested(name, n, firstList, tally, out)   those lists, in order, into the NestedLists `out`: the last
-//                                     holds the items, list l < lists - 1 each item's place in list l + 1
-//                                     (written only where out's room holds them), and after its items each
-//                                     list the size of the next (the last: n)
+//   CountNested(name, n, lists, firstList, tally, counts, side)   nested selections: i in [0, n) belongs to
+//                                     every list from firstList(i) to lists - 1 (none where firstList(i) >=
+//                                     lists); counts[f] += the items of first list f, and `tally` (a 32-bit
+//                                     buffer) what PlaceNested needs; in the same pass, a SideHistogram
+//                                     (Config.h), if given
+//   PlaceNested(name, n, firstList, tally, counted, out)   the first out.count of the `counted` lists, in
+//                                     order, into the NestedLists `out`: the last holds the items, list l <
+//                                     out.count - 1 each item's place in list l + 1 (written only where out's
+//                                     room holds them), and after its items each list the size of the next
+//                                     (the last: n)
 //   SortPairs(keys[2], values[2], n, bits, what)   stable; returns which of the two arrays holds the result
 //                                     (64-bit keys with 32-bit values; 32-bit keys with 32- or 64-bit values)
 //   SortPairsFrom(keys[2], valuesIn, valuesOut, n, bits, what)   the same, the values read from valuesIn (left as
@@ -445,8 +446,9 @@ struct SortedPoints
   SortedKeys keys;
   std::uint32_t* spare; // a 32-bit array the sort left free (n + 1 entries): room for run starts
   int depth;
-  bool counted;          // the levels' run starts counted at `depth` (CountLevelStarts), with the histogram
-  std::size_t placedRoom; // and placed, the inner levels' where they fit this room (PlaceLevelStarts); 0: not placed
+  int countedDepth;       // the levels' run starts counted at this depth (CountLevelStarts), with the histogram
+  std::size_t placedRoom; // and placed at `depth`, the inner levels' where they fit this room (PlaceLevelStarts);
+                          // 0: not placed
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
@@ -610,41 +612,36 @@ void WithKeyWords(const SortedKeys& keys, Fn&& fn)
   }
 }
 
-// Counts the n sorted leaf keys of `depth` levels in DepthChoice's two
-// histograms (DepthHistogramEntries), which the automatic depth reads.
-template <class Device, typename Key>
-void QueueDepthHistograms(Device& d, const Key* keys, std::size_t n, int depth, std::uint64_t* counts)
-{
-  d.template Histogram<2 * kDepthHistogramBins>("NeighbourHistogramKernel", n,
-    OCTORAY_LAMBDA(std::size_t i) { return DepthHistogramEntries(keys, n, i, depth); }, counts);
-}
-
 // The levels' run starts of the n sorted points at `depth` (keys shifted
 // right by `shift` bits), counted for PlaceLevelStarts: every level's size
 // goes to the newNode histogram `counts` (DepthChoice.h's FirstNewLevels is
-// each key's bin, and the first key's 0, which NodesAtLevel leaves out).
-template <class Device, typename Key>
+// each key's bin, and the first key's 0, which NodesAtLevel leaves out),
+// and `side`'s histogram in the same pass.
+template <class Device, typename Key, typename Side = NoSideHistogram>
 void CountLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth, int shift,
-  std::uint64_t* counts)
+  std::uint64_t* counts, Side side = {})
 {
   d.CountNested("LevelCountKernel", n, depth + 1, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally,
-    counts);
+    counts, side);
 }
 
-// Every level's run starts, as counted: the leaves' first points in
-// `leafStarts` (n + 1 entries), the inner levels' first children end to
-// end in scratch.levelStarts, level l's from levelBegin[l] + l on, where
-// they fit the room it has (NestedLists); returns that room.
+// Every level's run starts, as counted at `countedDepth` (at least
+// `depth`: a level's run starts are the same whatever the depth below it):
+// the leaves' first points in `leafStarts` (n + 1 entries), the inner
+// levels' first children end to end in scratch.levelStarts, level l's from
+// levelBegin[l] + l on, where they fit the room it has (NestedLists);
+// returns that room.
 template <class Device, typename Key>
 std::size_t PlaceLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth,
-  int shift, std::uint32_t* leafStarts)
+  int shift, int countedDepth, std::uint32_t* leafStarts)
 {
   NestedLists out;
   out.count = depth + 1;
   out.last = leafStarts;
   out.packed = scratch.levelStarts.Get();
   out.packedRoom = scratch.levelStarts.Bytes() / sizeof(std::uint32_t);
-  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally, out);
+  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally,
+    countedDepth + 1, out);
   return out.packedRoom;
 }
 
@@ -659,14 +656,14 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 
 // Queues the sort of the points `pts` by their keys at `sortDepth`
 // (kMaxLevel: full depth): the keys, computed from the positions, the
-// sort, and the histogram of neighbouring sorted keys. Records that fit
-// travel with the keys (SortedKeys::RecordsTravel); where a record layout
-// is given but its records have not landed (pts.records null), the points'
-// indices do, through which the leaf loop reads the records (SortedKeys).
-// chooseDepth: the histograms the automatic depth reads, else the levels'
-// run starts counted (CountLevelStarts), their sizes in the histogram, and
-// placed where they fit. Marks on `clock`: marks[0] after the keys,
-// marks[1] after the histograms or the run starts.
+// sort, and the levels' run starts counted (CountLevelStarts), their sizes
+// in the newNode histogram. Records that fit travel with the keys
+// (SortedKeys::RecordsTravel); where a record layout is given but its
+// records have not landed (pts.records null), the points' indices do,
+// through which the leaf loop reads the records (SortedKeys). chooseDepth:
+// in the same pass, the alone histogram, which the automatic depth reads
+// with the newNode one; else the run starts placed where they fit. Marks
+// on `clock`: marks[0] after the keys, marks[1] after the run starts.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
@@ -699,16 +696,20 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
-  sorted.counted = !chooseDepth;
+  sorted.countedDepth = sortDepth;
   sorted.placedRoom = 0;
   WithKeyWords(sorted.keys, [&](const auto* keys) {
+    using Key = std::remove_const_t<std::remove_pointer_t<decltype(keys)>>;
+    std::uint64_t* newNode = counters + kCounterHistogram;
     if (chooseDepth)
     {
-      QueueDepthHistograms(d, keys, n, sortDepth, counters + kCounterHistogram);
+      const SideHistogram<kDepthHistogramBins, LoneLevels<Key>> alone{ { keys, n, sortDepth },
+        newNode + kDepthHistogramBins };
+      CountLevelStarts(d, scratch, keys, n, sortDepth, 0, newNode, alone);
     }
     else
     {
-      CountLevelStarts(d, scratch, keys, n, sortDepth, 0, counters + kCounterHistogram);
+      CountLevelStarts(d, scratch, keys, n, sortDepth, 0, newNode);
     }
   });
   // The histograms and the key check on their way to the host (ReadHistogram).
@@ -721,7 +722,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
   if (!chooseDepth && LevelListsFitWord(n, sortDepth))
   {
     WithKeyWords(sorted.keys, [&](const auto* keys) {
-      sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
+      sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sortDepth, sorted.spare);
     });
   }
   marks[1] = clock.Mark();
@@ -838,7 +839,7 @@ NestedLists LevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeS
   {
     d.Reserve(scratch.levelStarts, innerEntries, "level starts");
     WithKeyWords(sorted.keys, [&](const auto* words) {
-      PlaceLevelStarts(d, scratch, words, s.count, depth, sorted.keys.keyShift, sorted.spare);
+      PlaceLevelStarts(d, scratch, words, s.count, depth, sorted.keys.keyShift, sorted.countedDepth, sorted.spare);
     });
   }
   NestedLists lists;
@@ -892,12 +893,6 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   s.depth = depth;
   s.cube = cube;
   const SortedKeys keys = sorted.keys;
-  if (!sorted.counted) // the automatic depth: its histograms gave the sizes
-  {
-    WithKeyWords(keys, [&](const auto* words) {
-      CountLevelStarts(d, scratch, words, s.count, depth, keys.keyShift, scratch.counters.Get() + kCounterHistogram);
-    });
-  }
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
   ForEachNodeArray([&](auto a) {
