@@ -69,7 +69,7 @@ for v in ${SOURCE_VARIANTS:?name the variants}; do
 done
 wait
 for v in $SOURCE_VARIANTS; do
-  [ -x /tmp/src-$v/build/bin/octoray_bench_cuda ] || { echo "== $v: build failed"; tail -5 "$out/build-$v.log"; }
+  [ -x "/tmp/src-$v/build/bin/${bench[0]}" ] || { echo "== $v: build failed"; tail -5 "$out/build-$v.log"; }
 done
 for v in $SOURCE_VARIANTS; do
   tests=/tmp/src-$v/build/bin/octoray_engine_tests

@@ -895,6 +895,9 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   const SortedKeys keys = sorted.keys;
   SetLevelBegins(sorted.histogram, depth, s.levelBegin);
   const std::size_t nodes = s.levelBegin[depth + 1];
+  // Where the sort did not place the run starts (the automatic depth's),
+  // the device places them while the host reserves the node arrays.
+  const NestedLists starts = LevelStarts(d, scratch, s, sorted);
   ForEachNodeArray([&](auto a) {
     const std::string what = MemoryReport::NodeArray(a.kLabel);
     if (Present(a, s.attributes, depth))
@@ -912,7 +915,6 @@ void LinkLevels(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
   {
     d.FillBytes(s.nodes.childMasks.Get() + (nodes - 1) / 8, 1, 0);
   }
-  const NestedLists starts = LevelStarts(d, scratch, s, sorted);
   const OctreeView view = s.View();
   const PointArraysView pts = s.Points();
   if (((s.attributes | pts.layout.Attributes()) & ~kLeanAttributes) == 0)
