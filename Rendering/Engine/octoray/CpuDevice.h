@@ -243,9 +243,12 @@ public:
     {
       counts[k % lists] += tally.Get()[k];
     }
-    for (std::size_t k = 0; k < sideTally.size(); ++k)
+    if constexpr (Side::kBins > 0)
     {
-      side.counts[k % Side::kBins] += sideTally[k];
+      for (std::size_t k = 0; k < sideTally.size(); ++k)
+      {
+        side.counts[k % Side::kBins] += sideTally[k];
+      }
     }
   }
 
