@@ -44,7 +44,13 @@ fi
 
 # Each variant gets a copy of the source tree, so that the builds can run
 # side by side.
+# A variant without its files would run main's engine under its name.
 for v in ${SOURCE_VARIANTS:?name the variants}; do
+  if [ "$v" != main ] && ! compgen -G ".gpu-vtk/variants/*.$v.*" > /dev/null; then
+    echo "== $v: no .gpu-vtk/variants/*.$v.* (carried?)" >&2; exit 1
+  fi
+done
+for v in $SOURCE_VARIANTS; do
   src=/tmp/src-$v
   rm -rf "$src" && mkdir -p "$src"
   # Tracked files and new ones not yet in the index the copy arrived with.
