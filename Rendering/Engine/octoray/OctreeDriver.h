@@ -445,10 +445,9 @@ struct SortedPoints
 {
   SortedKeys keys;
   std::uint32_t* spare; // a 32-bit array the sort left free (n + 1 entries): room for run starts
-  int depth;
-  int countedDepth;       // the levels' run starts counted at this depth (CountLevelStarts), with the histogram
-  std::size_t placedRoom; // and placed at `depth`, the inner levels' where they fit this room (PlaceLevelStarts);
-                          // 0: not placed
+  int depth;              // the leaf level: the sort's, or one the automatic depth chose above it (keys.keyShift)
+  std::size_t placedRoom; // the levels' run starts placed with the sort, the inner levels' where they fit this
+                          // room (PlaceLevelStarts); 0: not placed
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
@@ -625,23 +624,25 @@ void CountLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys
     counts, side);
 }
 
-// Every level's run starts, as counted at `countedDepth` (at least
-// `depth`: a level's run starts are the same whatever the depth below it):
-// the leaves' first points in `leafStarts` (n + 1 entries), the inner
+// Every level's run starts, as CountLevelStarts counted them on the keys
+// as the sort left them, `shift` bits (shift / 3 levels) deeper than
+// `depth`: a level's run starts are the same whatever the depth below it.
+// The leaves' first points go in `leafStarts` (n + 1 entries), the inner
 // levels' first children end to end in scratch.levelStarts, level l's from
 // levelBegin[l] + l on, where they fit the room it has (NestedLists);
 // returns that room.
 template <class Device, typename Key>
 std::size_t PlaceLevelStarts(Device& d, DriverScratch<Device>& scratch, const Key* keys, std::size_t n, int depth,
-  int shift, int countedDepth, std::uint32_t* leafStarts)
+  int shift, std::uint32_t* leafStarts)
 {
+  const int counted = depth + shift / 3 + 1;
   NestedLists out;
   out.count = depth + 1;
   out.last = leafStarts;
   out.packed = scratch.levelStarts.Get();
   out.packedRoom = scratch.levelStarts.Bytes() / sizeof(std::uint32_t);
-  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally,
-    countedDepth + 1, out);
+  d.PlaceNested("LevelStartsKernel", n, FirstNewLevels<Key>{ keys, depth, shift }, scratch.levelTally, counted,
+    out);
   return out.packedRoom;
 }
 
@@ -696,7 +697,6 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
   std::uint64_t* counters = scratch.counters.Get();
   d.FillBytes(counters + kCounterHistogram, 2 * kDepthHistogramBins, 0);
   // The sorted keys as the sort left them: leaf keys of sortDepth (keyShift 0).
-  sorted.countedDepth = sortDepth;
   sorted.placedRoom = 0;
   WithKeyWords(sorted.keys, [&](const auto* keys) {
     using Key = std::remove_const_t<std::remove_pointer_t<decltype(keys)>>;
@@ -722,7 +722,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
   if (!chooseDepth && LevelListsFitWord(n, sortDepth))
   {
     WithKeyWords(sorted.keys, [&](const auto* keys) {
-      sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sortDepth, sorted.spare);
+      sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
     });
   }
   marks[1] = clock.Mark();
@@ -839,7 +839,7 @@ NestedLists LevelStarts(Device& d, DriverScratch<Device>& scratch, const OctreeS
   {
     d.Reserve(scratch.levelStarts, innerEntries, "level starts");
     WithKeyWords(sorted.keys, [&](const auto* words) {
-      PlaceLevelStarts(d, scratch, words, s.count, depth, sorted.keys.keyShift, sorted.countedDepth, sorted.spare);
+      PlaceLevelStarts(d, scratch, words, s.count, depth, sorted.keys.keyShift, sorted.spare);
     });
   }
   NestedLists lists;
