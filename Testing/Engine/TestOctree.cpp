@@ -43,23 +43,27 @@ TEST_P(OctreeBuild, GaussianClusters)
   ExpectDepthRule(t, c);
 }
 
-// The automatic depth sorts 32-bit keys down to level 10 first and sorts
-// the full keys only where those levels do not settle the depth rule
-// (OctreeDriver.h): clouds whose rule lands deeper than 10, at 10, and on
-// coincident points, which no level separates further, against the
-// brute-force octree and the rule worked out from it.
-TEST_P(OctreeBuild, AutomaticDepthBeyondTheProvisionalSort)
+// The automatic depth sorts 32-bit keys down to level 10 first, then keys
+// of 16 levels where those do not settle the depth rule, then full-depth
+// keys where neither does (OctreeDriver.h's kAutomaticSortDepths): clouds
+// whose rule lands on each sort's last level, between them and beyond the
+// second, and on coincident points, which no level separates further,
+// against the brute-force octree and the rule worked out from it.
+TEST_P(OctreeBuild, AutomaticDepthSettledByEachSort)
 {
   std::mt19937_64 rng(47);
-  const Cloud deep = TightClusters(300, 1e-5, 47);
   const Cloud tenth = TightClusters(300, 2e-3, 48); // the rule lands on level 10 itself
+  const Cloud between = TightClusters(300, 2.5e-4, 49);
+  const Cloud sixteenth = TightClusters(300, 2e-5, 50);
+  const Cloud deep = TightClusters(300, 1e-5, 47);
   Cloud coincident;
   for (int i = 0; i < 600; ++i)
   {
     const double corner = i % 3 == 0 ? 0.0 : (i % 3 == 1 ? 1.0 : 0.25);
     coincident.Add(corner, corner, 1.0 - corner, rng);
   }
-  const std::pair<const Cloud*, int> cases[] = { { &deep, 17 }, { &tenth, 10 }, { &coincident, 2 } };
+  const std::pair<const Cloud*, int> cases[] = { { &tenth, 10 }, { &between, 13 }, { &sixteenth, 16 },
+    { &deep, 17 }, { &coincident, 2 } };
   for (const auto& [c, depth] : cases)
   {
     SCOPED_TRACE("expected depth " + std::to_string(depth));
@@ -108,7 +112,7 @@ TEST_P(OctreeBuild, RecordsOfEveryWidth)
     { "colours, scalars and reflectivity (3 words)", only(every, true, true, true, false, false) },
     { "colours, scalars and normals (3 words)", only(every, true, true, false, true, false) },
     { "every attribute (5 words)", every },
-    // Its automatic depth lies beyond the provisional sort's: the full-depth
+    // Its automatic depth lies beyond the sort of 16 levels: the full-depth
     // sort reads the records again.
     { "deep clusters, colours and reflectivity (2 words)",
       only(TightClusters(300, 1e-5, 47), true, false, true, false, false) },

@@ -451,10 +451,27 @@ struct SortedPoints
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
-// The automatic depth first sorts 32-bit keys of this depth: the levels
-// down to it settle the depth rule for most scenes (ChooseDepthWithin).
-constexpr int kProvisionalDepth = 10;
+// The automatic depth sorts the points' keys at these depths in turn, until
+// the levels down to one settle the depth rule (ChooseDepthWithin). 32-bit
+// keys of 10 levels settle it for most scenes. Keys of 16 levels are 48
+// bits: CUB sorts them in six passes of 8-bit digits where full-depth keys
+// take eight, the CPU's RadixSort in five of up to 11 bits against six.
+// Full depth settles every scene.
+constexpr int kAutomaticSortDepths[] = { 10, 16, kMaxLevel };
+constexpr int kProvisionalDepth = kAutomaticSortDepths[0];
+constexpr int kAutomaticSorts = static_cast<int>(std::size(kAutomaticSortDepths));
 static_assert(SortedKeys::Narrow(kProvisionalDepth), "the provisional sort has 32-bit keys");
+static_assert(kAutomaticSortDepths[kAutomaticSorts - 1] == kMaxLevel, "the last sort settles the depth rule");
+
+// Where one of a build's sorts began, where its keys were made and where
+// its levels' run starts were counted, as marks on the build's clock (-1:
+// the sort did not run).
+struct SortMarks
+{
+  int begin = -1;
+  int keys = -1;
+  int counted = -1;
+};
 
 // Where the keys kernel writes each point's leaf key, and its index where
 // the records do not travel with the keys.
@@ -663,12 +680,12 @@ inline bool LevelListsFitWord(std::size_t n, int depth)
 // records have not landed (pts.records null), the points' indices do,
 // through which the leaf loop reads the records (SortedKeys). chooseDepth:
 // in the same pass, the alone histogram, which the automatic depth reads
-// with the newNode one; else the run starts placed where they fit. Marks
-// on `clock`: marks[0] after the keys, marks[1] after the run starts.
+// with the newNode one; else the run starts placed where they fit.
 template <class Device>
 SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
-  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, int marks[2])
+  int sortDepth, bool chooseDepth, const FirstFailure& outside, typename Device::Clock& clock, SortMarks& marks)
 {
+  marks.begin = clock.Mark();
   const std::size_t n = pts.count;
   const bool narrow = SortedKeys::Narrow(sortDepth);
   const int stride = pts.layout.stride;
@@ -689,7 +706,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
     }
     input.Enter(i, key);
   });
-  marks[0] = clock.Mark();
+  marks.keys = clock.Mark();
 
   SortedPoints sorted;
   sorted.depth = sortDepth;
@@ -725,7 +742,7 @@ SortedPoints QueueSort(Device& d, DriverScratch<Device>& scratch, const PointArr
       sorted.placedRoom = PlaceLevelStarts(d, scratch, keys, n, sortDepth, 0, sorted.spare);
     });
   }
-  marks[1] = clock.Mark();
+  marks.counted = clock.Mark();
   return sorted;
 }
 
@@ -747,62 +764,61 @@ void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
 
 // A build's sort, queued (QueueBuildSort) from the positions alone,
 // while the points' records may still be on their way, and finished
-// (FinishBuild) once they are in the state. Marks on `clock`: the keys
-// [0, 1] and the sort [1, 2]; the automatic depth's full-depth sort, keys
-// [3, 4] and sort [4, 5]; -1: none.
+// (FinishBuild) once they are in the state: its sorts' marks on `clock`,
+// the automatic depth's in the order of kAutomaticSortDepths.
 template <class Device>
 struct QueuedBuild
 {
   typename Device::Clock clock;
-  int marks[6];
+  SortMarks marks[kAutomaticSorts];
   FirstFailure outside;
   int requestedDepth;
   SortedPoints sorted;
 };
 
 // Queues the sort of the points `pts` inside `cube` at the requested
-// depth, or, for the automatic one (requestedDepth 0), 32-bit keys at
-// kProvisionalDepth first: the levels down to it settle the depth rule for
-// most scenes (ChooseDepthWithin).
+// depth, or, for the automatic one (requestedDepth 0), the first of
+// kAutomaticSortDepths.
 template <class Device>
 void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int requestedDepth, QueuedBuild<Device>& q)
 {
-  std::fill(std::begin(q.marks), std::end(q.marks), -1);
-  q.marks[0] = q.clock.Mark();
+  std::fill(std::begin(q.marks), std::end(q.marks), SortMarks{});
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
   q.outside = ArmFirstFailure(d, scratch);
   q.requestedDepth = requestedDepth;
   const bool chooseDepth = requestedDepth == 0;
   q.sorted = QueueSort(d, scratch, pts, cube, chooseDepth ? kProvisionalDepth : requestedDepth, chooseDepth,
-    q.outside, q.clock, q.marks + 1);
+    q.outside, q.clock, q.marks[0]);
 }
 
 // The state's points sorted as QueueBuildSort queued, with every level's
-// node count; for the automatic depth, where the levels down to
-// kProvisionalDepth do not settle the depth rule, the full-depth keys
-// sorted too, with the points' indices. One copy brings each histogram.
+// node count; for the automatic depth, where the levels down to the sort's
+// depth do not settle the depth rule, sorted again at the next of
+// kAutomaticSortDepths, with the points' indices (64-bit keys). One copy
+// brings each sort's histograms.
 template <class Device>
 void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
   QueuedBuild<Device>& q)
 {
   SortedPoints& sorted = q.sorted;
   ReadHistogram(d, s, sorted);
-  if (q.requestedDepth == 0)
+  if (q.requestedDepth != 0)
   {
-    int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sorted.depth);
-    if (depth == 0)
-    {
-      q.marks[3] = q.clock.Mark();
-      sorted = QueueSort(d, scratch, s.Points(), cube, kMaxLevel, true, q.outside, q.clock, q.marks + 4);
-      ReadHistogram(d, s, sorted);
-      depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, kMaxLevel);
-    }
-    // The leaf keys: the sorted keys (at sorted.depth) without their bits below the depth.
-    sorted.keys.keyShift += 3 * (sorted.depth - depth);
-    sorted.depth = depth;
+    return;
   }
+  int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sorted.depth);
+  for (int next = 1; depth == 0; ++next) // the last depth, full depth, settles the rule
+  {
+    const int sortDepth = kAutomaticSortDepths[next];
+    sorted = QueueSort(d, scratch, s.Points(), cube, sortDepth, true, q.outside, q.clock, q.marks[next]);
+    ReadHistogram(d, s, sorted);
+    depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
+  }
+  // The leaf keys: the sorted keys (at sorted.depth) without their bits below the depth.
+  sorted.keys.keyShift += 3 * (sorted.depth - depth);
+  sorted.depth = depth;
 }
 
 // levelBegin[l]: the first node of level l, from the newNode histogram;
@@ -941,11 +957,14 @@ BuildStats FinishBuild(Device& d, DriverScratch<Device>& scratch, OctreeState<De
   LinkLevels(d, scratch, s, q.sorted, cube);
   const int levelsEnd = q.clock.Mark();
   d.Synchronize("octree build");
-  const auto span = [&](int from, int to) {
-    return q.marks[from] >= 0 ? q.clock.Seconds(q.marks[from], q.marks[to]) : 0.0;
-  };
-  stats.keySeconds = span(0, 1) + span(3, 4);
-  stats.sortSeconds = span(1, 2) + span(4, 5);
+  for (const SortMarks& m : q.marks)
+  {
+    if (m.begin >= 0)
+    {
+      stats.keySeconds += q.clock.Seconds(m.begin, m.keys);
+      stats.sortSeconds += q.clock.Seconds(m.keys, m.counted);
+    }
+  }
   stats.levelSeconds = q.clock.Seconds(levelsBegin, levelsEnd);
   stats.depth = s.depth;
   stats.cube = cube;
