@@ -120,6 +120,23 @@ TEST(DepthChoice, SharedLevelsOfLeafKeysAsOfTheirFullDepthKeys)
   }
 }
 
+// After the provisional sort, keys of 13 levels where the occupied level-10
+// cells hold 64 points or fewer on average, else full-depth keys; after the
+// 13 levels' sort, full-depth keys whatever the cells hold.
+TEST(DepthChoice, NextSortDepthByThePointsALevel10CellHolds)
+{
+  const std::uint64_t points = 6400;
+  for (const std::uint64_t cells : { std::uint64_t(1), std::uint64_t(99), std::uint64_t(100), std::uint64_t(6400) })
+  {
+    std::uint64_t newNode[kDepthHistogramBins] = {};
+    newNode[kProvisionalDepth] = cells - 1; // the first key starts the first cell
+    ASSERT_EQ(NodesAtLevel(newNode, kProvisionalDepth), cells);
+    SCOPED_TRACE(testing::Message() << cells << " cells of level 10");
+    EXPECT_EQ(NextSortDepth(newNode, points, kProvisionalDepth), cells >= 100 ? kMiddleDepth : kMaxLevel);
+    EXPECT_EQ(NextSortDepth(newNode, points, kMiddleDepth), kMaxLevel);
+  }
+}
+
 #include <octoray/RenderKernels.h>
 
 TEST(PortablePow, AgreesWithLibmToAFewUlps)

@@ -44,26 +44,39 @@ TEST_P(OctreeBuild, GaussianClusters)
 }
 
 // The automatic depth sorts 32-bit keys down to level 10 first, then keys
-// of 16 levels where those do not settle the depth rule, then full-depth
-// keys where neither does (OctreeDriver.h's kAutomaticSortDepths): clouds
-// whose rule lands on each sort's last level, between them and beyond the
-// second, and on coincident points, which no level separates further,
-// against the brute-force octree and the rule worked out from it.
+// of 13 levels where those do not settle the depth rule and the cloud's
+// level-10 cells hold few points, then full-depth keys where neither does
+// (DepthChoice.h's NextSortDepth): clouds whose rule lands on level 10,
+// between it and 13, on 13 and past it (8 points a cluster: every sort),
+// past it with 200 points a cluster (full depth after level 10), and on
+// coincident points, which no level separates further, against the
+// brute-force octree and the rule worked out from it.
 TEST_P(OctreeBuild, AutomaticDepthSettledByEachSort)
 {
   std::mt19937_64 rng(47);
-  const Cloud tenth = TightClusters(300, 2e-3, 48); // the rule lands on level 10 itself
-  const Cloud between = TightClusters(300, 2.5e-4, 49);
-  const Cloud sixteenth = TightClusters(300, 2e-5, 50);
+  const Cloud tenth = TightClusters(300, 2e-3, 48);
+  const Cloud twelfth = TightClusters(300, 5e-4, 49);
+  const Cloud thirteenth = TightClusters(300, 2.5e-4, 50);
+  const Cloud sixteenth = TightClusters(300, 2e-5, 51);
   const Cloud deep = TightClusters(300, 1e-5, 47);
+  Cloud dense;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 12; ++k)
+  {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    for (int i = 0; i < 200; ++i)
+    {
+      dense.Add(x + 1e-5 * u(rng), y + 1e-5 * u(rng), z + 1e-5 * u(rng), rng);
+    }
+  }
   Cloud coincident;
   for (int i = 0; i < 600; ++i)
   {
     const double corner = i % 3 == 0 ? 0.0 : (i % 3 == 1 ? 1.0 : 0.25);
     coincident.Add(corner, corner, 1.0 - corner, rng);
   }
-  const std::pair<const Cloud*, int> cases[] = { { &tenth, 10 }, { &between, 13 }, { &sixteenth, 16 },
-    { &deep, 17 }, { &coincident, 2 } };
+  const std::pair<const Cloud*, int> cases[] = { { &tenth, 10 }, { &twelfth, 12 }, { &thirteenth, 13 },
+    { &sixteenth, 16 }, { &deep, 17 }, { &dense, 19 }, { &coincident, 2 } };
   for (const auto& [c, depth] : cases)
   {
     SCOPED_TRACE("expected depth " + std::to_string(depth));
@@ -112,7 +125,7 @@ TEST_P(OctreeBuild, RecordsOfEveryWidth)
     { "colours, scalars and reflectivity (3 words)", only(every, true, true, true, false, false) },
     { "colours, scalars and normals (3 words)", only(every, true, true, false, true, false) },
     { "every attribute (5 words)", every },
-    // Its automatic depth lies beyond the sort of 16 levels: the full-depth
+    // Its automatic depth lies beyond the sort of 13 levels: the full-depth
     // sort reads the records again.
     { "deep clusters, colours and reflectivity (2 words)",
       only(TightClusters(300, 1e-5, 47), true, false, true, false, false) },

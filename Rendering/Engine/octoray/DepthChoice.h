@@ -85,6 +85,34 @@ inline std::uint64_t NodesAtLevel(const std::uint64_t newNode[kDepthHistogramBin
   return nodes;
 }
 
+// The automatic depth sorts 32-bit keys of kProvisionalDepth levels first:
+// their levels settle the depth rule for most clouds (ChooseDepthWithin).
+// Where they do not, it sorts keys of kMiddleDepth levels where those may
+// settle it (NextSortDepth), then full-depth keys, which always do.
+constexpr int kProvisionalDepth = 10;
+constexpr int kMiddleDepth = 13;
+constexpr int kMostAutomaticSorts = 3;
+
+// The depth of the automatic depth's next sort, after one of `sortedDepth`
+// levels whose newNode histogram did not settle the rule. Keys of 13 levels
+// (39 bits) take five passes of CUB's 8-bit digits where full-depth keys
+// take eight, and four of the CPU's digits of up to 11 bits against six; but
+// where they do not settle the rule either, their sort is wasted. So they
+// are sorted where the provisional sort's occupied cells hold on average no
+// more points than a cell of a surface splits into by kMiddleDepth (4 a
+// level: 64). On an H200 the whole call for 100 M clustered points (5 a
+// cell; depth 11) took 35.1-35.4 ms so against 38.1-39.2 with full-depth
+// keys at once; clusters a ten-thousandth of the cube wide (depth 17 at
+// 10 M points, 19 at 100 M; 5e4 points a cell) go to full depth at once,
+// where keys of 16 levels first had taken 18-20 % longer
+// (Benchmarks/gpu/variants-middle-sort.txt).
+inline int NextSortDepth(const std::uint64_t newNode[kDepthHistogramBins], std::uint64_t points, int sortedDepth)
+{
+  constexpr int kSurfaceSplitBits = 2 * (kMiddleDepth - kProvisionalDepth);
+  const bool sparse = points <= (NodesAtLevel(newNode, kProvisionalDepth) << kSurfaceSplitBits);
+  return sortedDepth == kProvisionalDepth && sparse ? kMiddleDepth : kMaxLevel;
+}
+
 // The depth from the histograms of keys sorted down to level `known`
 // (newNode[b + 1]: the keys that share b levels with the previous one,
 // read for b < known; alone[b + 1]: the keys whose nearer neighbour shares

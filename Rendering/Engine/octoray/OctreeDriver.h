@@ -451,17 +451,7 @@ struct SortedPoints
   std::uint64_t histogram[2 * kDepthHistogramBins];
 };
 
-// The automatic depth sorts the points' keys at these depths in turn, until
-// the levels down to one settle the depth rule (ChooseDepthWithin). 32-bit
-// keys of 10 levels settle it for most scenes. Keys of 16 levels are 48
-// bits: CUB sorts them in six passes of 8-bit digits where full-depth keys
-// take eight, the CPU's RadixSort in five of up to 11 bits against six.
-// Full depth settles every scene.
-constexpr int kAutomaticSortDepths[] = { 10, 16, kMaxLevel };
-constexpr int kProvisionalDepth = kAutomaticSortDepths[0];
-constexpr int kAutomaticSorts = static_cast<int>(std::size(kAutomaticSortDepths));
 static_assert(SortedKeys::Narrow(kProvisionalDepth), "the provisional sort has 32-bit keys");
-static_assert(kAutomaticSortDepths[kAutomaticSorts - 1] == kMaxLevel, "the last sort settles the depth rule");
 
 // Where one of a build's sorts began, where its keys were made and where
 // its levels' run starts were counted, as marks on the build's clock (-1:
@@ -765,20 +755,20 @@ void ReadHistogram(Device& d, OctreeState<Device>& s, SortedPoints& sorted)
 // A build's sort, queued (QueueBuildSort) from the positions alone,
 // while the points' records may still be on their way, and finished
 // (FinishBuild) once they are in the state: its sorts' marks on `clock`,
-// the automatic depth's in the order of kAutomaticSortDepths.
+// the automatic depth's in the order it sorts.
 template <class Device>
 struct QueuedBuild
 {
   typename Device::Clock clock;
-  SortMarks marks[kAutomaticSorts];
+  SortMarks marks[kMostAutomaticSorts];
   FirstFailure outside;
   int requestedDepth;
   SortedPoints sorted;
 };
 
 // Queues the sort of the points `pts` inside `cube` at the requested
-// depth, or, for the automatic one (requestedDepth 0), the first of
-// kAutomaticSortDepths.
+// depth, or, for the automatic one (requestedDepth 0), kProvisionalDepth
+// (DepthChoice.h).
 template <class Device>
 void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int requestedDepth, QueuedBuild<Device>& q)
@@ -795,9 +785,9 @@ void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArrays
 
 // The state's points sorted as QueueBuildSort queued, with every level's
 // node count; for the automatic depth, where the levels down to the sort's
-// depth do not settle the depth rule, sorted again at the next of
-// kAutomaticSortDepths, with the points' indices (64-bit keys). One copy
-// brings each sort's histograms.
+// depth do not settle the depth rule, sorted again deeper (NextSortDepth),
+// with the points' indices (64-bit keys). One copy brings each sort's
+// histograms.
 template <class Device>
 void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& s, const RootCube& cube,
   QueuedBuild<Device>& q)
@@ -809,9 +799,9 @@ void FinishSort(Device& d, DriverScratch<Device>& scratch, OctreeState<Device>& 
     return;
   }
   int depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sorted.depth);
-  for (int next = 1; depth == 0; ++next) // the last depth, full depth, settles the rule
+  for (int next = 1; depth == 0; ++next) // full depth settles the rule
   {
-    const int sortDepth = kAutomaticSortDepths[next];
+    const int sortDepth = NextSortDepth(sorted.histogram, s.count, sorted.depth);
     sorted = QueueSort(d, scratch, s.Points(), cube, sortDepth, true, q.outside, q.clock, q.marks[next]);
     ReadHistogram(d, s, sorted);
     depth = ChooseDepthWithin(sorted.histogram, sorted.histogram + kDepthHistogramBins, sortDepth);
