@@ -977,6 +977,18 @@ def _cuda(ctx):
         "keys of 10 levels do not settle the depth and are sorted again at full depth (100 M clustered points, "
         "13.58–13.63 ms against 13.46–13.53): there the count of 22 lists with the histogram took 585 µs in ncu "
         "where the histogram alone took 416 (Benchmarks/gpu/variants-auto-depth-count.txt). "
+        "Since ba501c9 such a cloud's keys are sorted again at 13 levels first (39 bits: five passes of CUB's 8-bit "
+        "digits where full-depth keys take eight) where its level-10 cells hold 64 points or fewer on average, as "
+        "a surface's cells split into by then; denser clouds go to full depth at once (DepthChoice.h's "
+        "NextSortDepth). Built beside 9fe3050's engine and run in turn, the device phases for 100 M clustered "
+        "points took 10.47 ms against 13.52, the whole call 35.7–36.4 ms against 39.0–39.4; clusters a "
+        "ten-thousandth of the cube wide (octoray_bench_build's narrow set: depth 17 at 10 M points, 19 at 100 M, "
+        "5·10⁴ points a level-10 cell) ran alike, where keys of 16 levels sorted first for every cloud had made "
+        "their whole call 16–24 % longer. Sorting the points of each level-10 run alone "
+        "(cub::DeviceSegmentedSort, after reading each point's full-depth key through its index) took as long as "
+        "the 16-level sort at 100 M clustered points and five to seven times the full-depth sort for the narrow "
+        "clusters, "
+        "whose runs hold up to 3 M points (Benchmarks/gpu/variants-middle-sort.txt). "
         "Nodes of one point or one child storing its values as they are, without the sums in double, made the "
         "leaf kernel slower: 1.77 ms at 100 M points in ncu against 1.60 "
         "(Benchmarks/gpu/variants-one-value-nodes.txt, not kept). "
@@ -1467,9 +1479,10 @@ Reading these figures:
 - The sort is the largest phase and gains little from a second thread on this VM: the automatic depth first sorts
   32-bit keys of 10 levels, 30 bits = 3 passes of 10-bit digits (RadixSort.cpp), each with its point's record where
   that is one or two words, else with its index (OctreeKernels.h's SortedKeys), bound by the scattered writes rather
-  than by compute; only where those levels do not settle the depth does it sort the full-depth keys too (63 bits, 6
-  passes, with indices). 2-thread medians on this shared machine swing from run to run; read the 1-thread column
-  for ratios.
+  than by compute; only where those levels do not settle the depth does it sort again, with indices: keys of 13
+  levels (39 bits, 4 passes) where its level-10 cells hold few points, and full-depth keys (63 bits, 6 passes) where
+  those do not settle it either or the cells are dense (DepthChoice.h's NextSortDepth). 2-thread medians on this
+  shared machine swing from run to run; read the 1-thread column for ratios.
 - B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, the sort's keys and their second
   buffer, the records in sorted order; the points' keys are not kept: a rebuild computes them again from the
   positions); the node arrays alone are ~20 B/point. The dense skeleton is smaller than

@@ -112,8 +112,8 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
 {
   const Cloud first = UniformCloud(1500, 61);
   // Its automatic depth lies beyond level 13: the sorts of 13 levels and of
-  // full depth run too, their keys computed again. Records of two words (colours and
-  // reflectivity) travel with the first sort's keys.
+  // full depth run too, their keys computed again. Records of two words
+  // (colours and reflectivity) travel with the first sort's keys.
   Cloud tight = TightClusters(300, 1e-5, 47);
   tight.scalar.clear();
   tight.normal.clear();

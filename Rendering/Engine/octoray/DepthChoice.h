@@ -100,12 +100,15 @@ constexpr int kMostAutomaticSorts = 3;
 // where they do not settle the rule either, their sort is wasted. So they
 // are sorted where the provisional sort's occupied cells hold on average no
 // more points than a cell of a surface splits into by kMiddleDepth (4 a
-// level: 64). On an H200 the whole call for 100 M clustered points (5 a
-// cell; depth 11) took 35.1-35.4 ms so against 38.1-39.2 with full-depth
-// keys at once; clusters a ten-thousandth of the cube wide (depth 17 at
-// 10 M points, 19 at 100 M; 5e4 points a cell) go to full depth at once,
-// where keys of 16 levels first had taken 18-20 % longer
-// (Benchmarks/gpu/variants-middle-sort.txt).
+// level: 64). On an H200 the device phases for 100 M clustered points (5
+// a cell; depth 11) took 10.5 ms so against 13.5 with full-depth keys at
+// once, the whole call 35.7-36.4 ms against 39.0-39.4. Clusters a
+// ten-thousandth of the cube wide (depth 17 at 10 M points, 19 at 100 M;
+// 5e4 points a cell) go to full depth at once, where keys of 13 levels
+// first had made the whole call 13-21 % longer, of 16 levels 16-24 %
+// (Benchmarks/gpu/variants-middle-sort.txt). A cloud of sparse cells whose
+// rule lands deeper than 13 (pairs of near-coincident points, say) still
+// sorts both.
 inline int NextSortDepth(const std::uint64_t newNode[kDepthHistogramBins], std::uint64_t points, int sortedDepth)
 {
   constexpr int kSurfaceSplitBits = 2 * (kMiddleDepth - kProvisionalDepth);
