@@ -209,6 +209,24 @@ def gpu_check_heading(text):
     return heading.groups() if heading else None
 
 
+# The gpu-check.sh summaries the GPU sections read: the report's call
+# (summary.txt), then the calls that ran compute-sanitizer apart from it
+# (COMMAND.md says which): its other tools where the report's call left
+# them out, and racecheck, the slowest.
+GPU_SUMMARIES = ("summary.txt", "summary-sanitize.txt", "summary-racecheck.txt")
+
+
+def gpu_summaries(folder):
+    """[(file name, text)] of the GPU_SUMMARIES present in `folder`."""
+    found = []
+    for name in GPU_SUMMARIES:
+        path = os.path.join(folder, name)
+        if os.path.exists(path):
+            with open(path) as f:
+                found.append((name, f.read()))
+    return found
+
+
 def file_parts(path):
     """{header: [lines]} of a GPU record whose parts start with "== header"
     (Benchmarks/gpu's tests and variants files); lines before the first

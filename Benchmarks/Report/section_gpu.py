@@ -6,7 +6,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section, file_parts, gpu_check_heading
+from make_report import Section, file_parts, gpu_check_heading, gpu_summaries
 
 TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
 
@@ -40,8 +40,6 @@ def test_counts(xml_path):
             c[2 if failed else 3 if skipped else 1] += 1
     return counts
 
-
-RACECHECK_SUMMARY = "summary-racecheck.txt"
 
 # The CUDA device's primitives against the CPU device's checks, on an H200
 # (the twenty-seventh session's calls, COMMAND.md): a part "== call N, what"
@@ -117,14 +115,9 @@ def render(ctx):
     if not summary_path:
         return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
-    # The report's call is summary.txt; racecheck, the slowest, ran in a
-    # call of its own (COMMAND.md), whose file the row names.
-    folder = os.path.dirname(summary_path)
-    summaries = []
-    for name in ("summary.txt", RACECHECK_SUMMARY):
-        if os.path.exists(os.path.join(folder, name)):
-            with open(os.path.join(folder, name)) as f:
-                summaries.append((name, f.read()))
+    # The report's call is summary.txt; a tool that ran in a call of its own
+    # (COMMAND.md) is read from that call's file, which its row names.
+    summaries = gpu_summaries(os.path.dirname(summary_path))
     summary = summaries[0][1]
     device = ""
     if ctx.gpu_file("gpu.txt"):

@@ -5,10 +5,11 @@ VTK's own GPU mappers.
 Nothing is measured here: the files come from scripts/gpu/gpu-check.sh on a
 GPU machine (VTK with EGL on the NVIDIA driver), committed in
 Benchmarks/gpu/ with COMMAND.md."""
+import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section
+from make_report import Section, gpu_summaries
 
 TITLE = "The CUDA mapper in VTK windows (from the GPU run)"
 
@@ -98,16 +99,17 @@ def render(ctx):
     if not (summary_path and xml):
         return Section("Not run on a GPU yet: `scripts/gpu/gpu-check.sh OUTDIR` on a GPU machine writes the "
                        "files this section reads.")
-    with open(summary_path) as f:
-        summary = f.read()
     device = open(ctx.gpu_file("gpu.txt")).read().strip() if ctx.gpu_file("gpu.txt") else "the GPU machine"
     counts = mapper_test_counts(xml)
     test_rows = [(label, f"{c[0]} passed, {c[1]} failed, {c[2]} skipped of {c[3]}"
                   + (f" (failed: {', '.join(c[4])})" if c[4] else "")) for label, c in counts.items()]
-    memcheck = re.search(r"^memcheck-mapper:\s+(\d+) =+ ERROR SUMMARY: (.*)$", summary, re.M)
-    if memcheck:
-        test_rows.append(("compute-sanitizer memcheck over every CUDA mapper test",
-                          f"{memcheck.group(1)} runs, each: {memcheck.group(2)}"))
+    for name, text in gpu_summaries(os.path.dirname(summary_path)):
+        memcheck = re.search(r"^memcheck-mapper:\s+(\d+) =+ ERROR SUMMARY: (.*)$", text, re.M)
+        if memcheck:
+            test_rows.append(("compute-sanitizer memcheck over every CUDA mapper test",
+                              f"{memcheck.group(1)} runs, each: {memcheck.group(2)}"
+                              + ("" if name == "summary.txt" else f" ([gpu/{name}](gpu/{name}))")))
+            break
     text = [
         f"Device: {device}. Command: `{ctx.gpu_command() or 'scripts/gpu/gpu-check.sh OUTDIR'}` "
         "(it builds VTK 9.2 with EGL from ParaView 5.11's sources, or unpacks the build "
