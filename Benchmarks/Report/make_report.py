@@ -227,6 +227,12 @@ def gpu_summaries(folder):
     return found
 
 
+def gpu_summary_link(name):
+    """What a row adds to a figure from summary file `name`: nothing for the
+    report's call, else a link to the call's file."""
+    return "" if name == GPU_SUMMARIES[0] else f" ([gpu/{name}](gpu/{name}))"
+
+
 def file_parts(path):
     """{header: [lines]} of a GPU record whose parts start with "== header"
     (Benchmarks/gpu's tests and variants files); lines before the first

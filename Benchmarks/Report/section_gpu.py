@@ -6,7 +6,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section, file_parts, gpu_check_heading, gpu_summaries
+from make_report import Section, file_parts, gpu_check_heading, gpu_summaries, gpu_summary_link
 
 TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
 
@@ -140,7 +140,7 @@ def render(ctx):
                 step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", text, re.M)
                 result = found.group(1) + (f" (exit status: {step.group(1)})" if step else "")
                 clean += found.group(1).startswith("0 ")
-                result += "" if name == "summary.txt" else f" ([gpu/{name}](gpu/{name}))"
+                result += gpu_summary_link(name)
                 break
         rows.append((what, result))
     steps = [line for line in summary.splitlines() if re.match(r"^[a-z0-9-]+\s+(pass|FAIL)\s+\d+ ms$", line)]

@@ -9,7 +9,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import Section, gpu_summaries
+from make_report import Section, gpu_summaries, gpu_summary_link
 
 TITLE = "The CUDA mapper in VTK windows (from the GPU run)"
 
@@ -108,7 +108,7 @@ def render(ctx):
         if memcheck:
             test_rows.append(("compute-sanitizer memcheck over every CUDA mapper test",
                               f"{memcheck.group(1)} runs, each: {memcheck.group(2)}"
-                              + ("" if name == "summary.txt" else f" ([gpu/{name}](gpu/{name}))")))
+                              + gpu_summary_link(name)))
             break
     text = [
         f"Device: {device}. Command: `{ctx.gpu_command() or 'scripts/gpu/gpu-check.sh OUTDIR'}` "
