@@ -773,7 +773,6 @@ template <class Device>
 void QueueBuildSort(Device& d, DriverScratch<Device>& scratch, const PointArraysView& pts, const RootCube& cube,
   int requestedDepth, QueuedBuild<Device>& q)
 {
-  std::fill(std::begin(q.marks), std::end(q.marks), SortMarks{});
   // The cube holds every point (fitted or checked): a point outside is a
   // bug, read after the sort with the histogram.
   q.outside = ArmFirstFailure(d, scratch);
