@@ -492,6 +492,32 @@ def _staging_pieces(ctx):
     return [text + _dma_pieces(ctx, per_piece), ""]
 
 
+# The thirty-ninth session's probe of ways around the staging
+# (scripts/gpu/pageable-access.cu): its first line says whether the device
+# reads pageable memory itself; then lines "huge|register  register R ms,
+# copy C ms, unregister U ms" per size, the first size 190 MB.
+PAGEABLE_FILE = "pageable-access.txt"
+
+
+def _page_locking(ctx):
+    """What page-locking a caller's array in place costs beside its copy,
+    from the H200 probe, for the "Where the whole call goes" paragraph."""
+    path = ctx.gpu_file(PAGEABLE_FILE)
+    if not path:
+        return ""
+    lines = open(path).read().splitlines()
+    pattern = re.compile(r"^(register|huge) +register ([0-9.]+) ms, copy ([0-9.]+) ms, unregister ([0-9.]+) ms")
+    first = {}
+    for m in filter(None, map(pattern.search, lines)):
+        first.setdefault(m.group(1), [float(x) for x in m.group(2, 3, 4)])
+    if len(first) < 2 or not any(line.startswith("pageable memory access 0") for line in lines):
+        return ""
+    return (" (on an H200 the register and the unregister of 190 MB took %.1f and %.1f ms around its %.1f ms "
+            "copy, the register %.1f ms on an array of 2 MB pages; that device cannot read pageable memory itself: "
+            "[gpu/%s](gpu/%s))" % (first["register"][0], first["register"][2], first["register"][1],
+                                   first["huge"][0], PAGEABLE_FILE, PAGEABLE_FILE))
+
+
 # The thirty-first session's copies from page-locked memory alone, whole
 # and in pieces (scripts/gpu/pinned-pieces.cu, three runs): lines
 # "pieces of K kB on S stream(s): ..., U us a piece beyond the whole".
@@ -1065,11 +1091,12 @@ def _cuda(ctx):
             + "*upload* is the host's "
             "time in those copies, the median of the 7 builds as are the device phases above (in runs of the "
             "benchmark before 25da958, the last build's own); *plain cudaMemcpy* is what it did before, *cudaHostRegister* page-locks the caller's "
-            "arrays in place for the copy, *pinned* is the floor above%s. GPU bytes per point: the arrays alone; "
+            "arrays in place for the copy%s, *pinned* is the floor above%s. GPU bytes per point: the arrays alone; "
             "with the memory that the engine's allocator keeps for the next build (with the points kept, a "
             "rebuild fills a new octree beside the old one and then reuses the old one's memory instead of "
             "mapping new memory); and built without the points (`BuildOptions::keepPoints` off: node arrays "
             "only, the allocator's cache given back), with that build's whole call." % (
+                _page_locking(ctx),
                 ("; *host copy* is the host's half of the staging alone: the caller's arrays copied piece by "
                  "piece into the same threads' page-locked buffers, no DMA (octoray_bench_cuda's "
                  "HostHalfOfStaging). "
