@@ -191,18 +191,52 @@ double BuildSortSeconds(std::size_t n, int depth)
   return SortedKeys::Narrow(depth) ? SortSeconds<std::uint32_t, std::uint64_t>(n, 3 * depth) : 0.0;
 }
 
-// A caller's host array the build reads.
+// A caller's host array the build reads; of unit values (the
+// reflectivity: Attributes.h's UnitInput), whose codes the staging lands,
+// half its bytes.
 struct HostArray
 {
   void* data;
   std::size_t bytes;
+  bool unitCodes = false;
+
+  std::size_t StagedBytes() const { return unitCodes ? bytes / 2 : bytes; }
+  // The engine's staging's part for it, landing at `to`.
+  octoray::cuda::CopyPart Part(void* to) const
+  {
+    octoray::cuda::CopyPart part{ to, data, StagedBytes(), "staged copy peer", nullptr };
+    part.unitCodes = unitCodes;
+    return part;
+  }
 };
 
 // The cloud's arrays as the build reads them, in the order it copies them.
 std::array<HostArray, 3> InputArrays(Cloud& c)
 {
   return { HostArray{ c.xyz.data(), c.xyz.size() * sizeof(float) }, HostArray{ c.rgb.data(), c.rgb.size() },
-    HostArray{ c.reflectivity.data(), c.reflectivity.size() * sizeof(float) } };
+    HostArray{ c.reflectivity.data(), c.reflectivity.size() * sizeof(float), true } };
+}
+
+// The parts of the engine's staged copy of the arrays, landing end to end
+// from `device` (null: the host's half alone).
+std::vector<octoray::cuda::CopyPart> StagedParts(Cloud& c, void* device)
+{
+  std::vector<octoray::cuda::CopyPart> parts;
+  char* to = static_cast<char*>(device);
+  for (const HostArray& a : InputArrays(c))
+  {
+    parts.push_back(a.Part(to));
+    to += device ? a.StagedBytes() : 0;
+  }
+  return parts;
+}
+
+std::size_t StagedBytes(Cloud& c)
+{
+  std::size_t total = 0;
+  for (const HostArray& a : InputArrays(c))
+    total += a.StagedBytes();
+  return total;
 }
 
 std::size_t InputBytes(Cloud& c)
@@ -258,8 +292,9 @@ private:
 // The host's half of the engine's staging alone (CudaUpload.h): the
 // caller's arrays, laid end to end, cut and dealt to the threads as the
 // staging does it (StagingPieces.h), copied piece by piece into each
-// thread's two page-locked buffers in turn; no DMA. No upload through such
-// buffers takes less than the longer of this and the pinned copy.
+// thread's two page-locked buffers in turn (the reflectivity as its
+// codes, FillPiece); no DMA. No upload through such buffers takes less
+// than the longer of this and a pinned copy of what they hold.
 class HostHalfOfStaging
 {
 public:
@@ -293,14 +328,16 @@ public:
     {
       return 0.0;
     }
-    const std::array<HostArray, 3> arrays = InputArrays(c);
-    const octoray::cuda::StagingRun run({ arrays[0].bytes, arrays[1].bytes, arrays[2].bytes });
+    const std::vector<octoray::cuda::CopyPart> parts = StagedParts(c, nullptr);
+    std::vector<std::size_t> bytes;
+    for (const octoray::cuda::CopyPart& part : parts)
+      bytes.push_back(part.bytes);
+    const octoray::cuda::StagingRun run(bytes);
     const auto t0 = std::chrono::steady_clock::now();
     octoray::cuda::PieceDealer dealer(octoray::cuda::CutPieces(run, Threads.Chunks()));
     Threads.Run(Threads.Chunks(), [&](std::size_t thread, std::size_t, int) {
       dealer.Take([&](const octoray::cuda::Piece& piece, int b) {
-        std::memcpy(Buffers[2 * thread + b], static_cast<const char*>(arrays[piece.array].data) + piece.offset,
-          piece.bytes);
+        octoray::cuda::FillPiece(parts[piece.array], piece.offset, piece.bytes, Buffers[2 * thread + b]);
       });
     });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -330,18 +367,12 @@ double HostHalfBesidePinnedCopy(HostHalfOfStaging& half, PinnedCopy& copy, Cloud
 double StagedCopySeconds(Cloud& c)
 {
   void* device = nullptr;
-  if (cudaMalloc(&device, InputBytes(c)) != cudaSuccess)
+  if (cudaMalloc(&device, StagedBytes(c)) != cudaSuccess)
   {
     cudaGetLastError();
     return 0.0;
   }
-  std::vector<octoray::cuda::CopyPart> parts;
-  char* to = static_cast<char*>(device);
-  for (const HostArray& a : InputArrays(c))
-  {
-    parts.push_back(octoray::cuda::CopyPart{ to, a.data, a.bytes, "staged copy peer", nullptr });
-    to += a.bytes;
-  }
+  const std::vector<octoray::cuda::CopyPart> parts = StagedParts(c, device);
   octoray::cuda::HostStaging staging;
   const double seconds = TimeMedian(5, [&] { staging.Copy(parts); });
   cudaFree(device);
@@ -752,9 +783,11 @@ int Run(int argc, char** argv)
     const DeviceCloud onDevice(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "
-                "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms\n",
+                "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms (landing %.0f MB: "
+                "the reflectivity as 16-bit codes)\n",
       n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
-      hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged * 1e3);
+      hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged * 1e3,
+      StagedBytes(c) / 1e6);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })

@@ -329,16 +329,40 @@ void CopyOnDevice(Device& d, const T* from, T* to, std::size_t count)
 
 // The bytes of the arrays ExpectStageReducedCopiesReducesAndCallsBack
 // stages for n items: the reduced one of three floats an item, an 8-bit
-// and a float array along.
+// and a float array along, and the 16-bit codes of unit values.
 inline std::vector<std::size_t> StagedArrayBytes(std::size_t n)
 {
-  return { 3 * n * sizeof(float), n * sizeof(std::uint8_t), n * sizeof(float) };
+  return { 3 * n * sizeof(float), n * sizeof(std::uint8_t), n * sizeof(float), n * sizeof(std::uint16_t) };
+}
+
+// n unit values (Attributes.h's UnitInput): a sweep of 0..1 and, every
+// seventh, one of the values its code clamps or keeps apart.
+inline std::vector<float> UnitValues(std::size_t n)
+{
+  const float odd[] = { -0.5f, 1.5f, -0.0f, 1.0f, INFINITY, -INFINITY, NAN };
+  std::vector<float> values(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    values[i] = i % 7 == 3 ? odd[(i / 7) % 7] : static_cast<float>(i % 1000) / 999.0f;
+  }
+  return values;
+}
+
+// Their codes one value at a time (Scalar16.h's EncodeUnitScalar).
+inline std::vector<std::uint16_t> UnitCodesOf(const std::vector<float>& values)
+{
+  std::vector<std::uint16_t> codes;
+  for (float v : values)
+  {
+    codes.push_back(EncodeUnitScalar(v).code);
+  }
+  return codes;
 }
 
 // StageReduced: the array where the device's loops read it, the reduction
 // of its items of three floats (their largest value: exact in any order),
-// and the arrays Prepare adds along (an 8-bit and a float one) copied in
-// the same call. whenReduced runs where `expectWhenReduced` says (CUDA's
+// and the arrays Prepare adds along (an 8-bit and a float one, and the codes
+// PrepareUnitCodes makes of unit values) copied in the same call. whenReduced runs where `expectWhenReduced` says (CUDA's
 // staged copy in one pass of several arrays), with the final result, and
 // the loop it queues, while the arrays along are still on their way, reads
 // the whole array: a copy of it made there must miss no piece.
@@ -359,8 +383,10 @@ void ExpectStageReducedCopiesReducesAndCallsBack(Device& d, std::size_t n, bool 
   const float none = -std::numeric_limits<float>::infinity();
   const float largest = xyz.empty() ? none : *std::max_element(xyz.begin(), xyz.end());
 
+  const std::vector<float> units = UnitValues(n);
   typename Device::template Staged<std::uint8_t> bytesStaged;
   typename Device::template Staged<float> valuesStaged;
+  typename Device::template Staged<std::uint16_t> codesStaged;
   DeviceArray<Device, float> copied(d, 3 * n, 0.0f);
   float* copy = copied.Get();
   bool called = false;
@@ -376,6 +402,7 @@ void ExpectStageReducedCopiesReducesAndCallsBack(Device& d, std::size_t n, bool 
     [&](typename Device::Fills& fills) {
       bytesStaged = d.Prepare(bytes.data(), n, "test bytes", fills);
       valuesStaged = d.Prepare(values.data(), n, "test values", fills);
+      codesStaged = d.PrepareUnitCodes(units.data(), n, "test unit values", fills);
     },
     std::function<void(const float&, const float*)>([&](const float& r, const float* landed) {
       called = true;
@@ -387,6 +414,7 @@ void ExpectStageReducedCopiesReducesAndCallsBack(Device& d, std::size_t n, bool 
   EXPECT_EQ(HostCopy(d, staged.Get(), 3 * n), xyz);
   EXPECT_EQ(HostCopy(d, bytesStaged.Get(), n), bytes);
   EXPECT_EQ(HostCopy(d, valuesStaged.Get(), n), values);
+  EXPECT_EQ(HostCopy(d, codesStaged.Get(), n), UnitCodesOf(units));
   ASSERT_EQ(called, expectWhenReduced);
   if (called)
   {

@@ -7,6 +7,7 @@
 #include "DeviceChecks.h"
 
 #include <octoray/CudaDevice.h>
+#include <octoray/FaultInjection.h>
 
 // In octoray's namespace, not with a using-directive: nvcc's generated host
 // code names CUDA's own `cuda` namespace, which octoray::cuda would hide.
@@ -48,6 +49,49 @@ TEST_F(CudaDeviceCUDA, StageReducedCopiesReducesAndCallsBack)
     const bool staged = cuda::StagingRun(checks::StagedArrayBytes(n)).Length() >= cuda::kStagingThreshold;
     checks::ExpectStageReducedCopiesReducesAndCallsBack(d, n, staged);
   });
+}
+
+// Unit values the device reads itself (a caller's device or page-locked
+// array): their codes made by a loop there, with nothing to stage.
+TEST_F(CudaDeviceCUDA, UnitCodesOfValuesTheDeviceReads)
+{
+  OnEverySize([](std::size_t n, CudaDevice& d) {
+    const std::vector<float> units = checks::UnitValues(n);
+    checks::DeviceArray<CudaDevice, float> onDevice(d, units);
+    float* pageLocked = nullptr;
+    ASSERT_EQ(cudaMallocHost(&pageLocked, (n + 1) * sizeof(float)), cudaSuccess);
+    std::copy(units.begin(), units.end(), pageLocked);
+    for (const float* source : { static_cast<const float*>(onDevice.Get()), static_cast<const float*>(pageLocked) })
+    {
+      CudaDevice::Fills fills;
+      const auto codes = d.PrepareUnitCodes(n ? source : nullptr, n, "test unit values", fills);
+      EXPECT_TRUE(fills.empty()) << "nothing to stage";
+      EXPECT_EQ(checks::HostCopy(d, codes.Get(), n), checks::UnitCodesOf(units));
+    }
+    cudaFreeHost(pageLocked);
+  });
+}
+
+// That loop refused: the error names it, and nothing sticks.
+TEST_F(CudaDeviceCUDA, UnitCodesLoopRefusedIsNamed)
+{
+  CudaDevice d(-1);
+  const std::vector<float> units = checks::UnitValues(1000);
+  checks::DeviceArray<CudaDevice, float> onDevice(d, units);
+  CudaDevice::Fills fills;
+  InjectCudaLaunchFailure("UnitCodesKernel");
+  try
+  {
+    d.PrepareUnitCodes(onDevice.Get(), units.size(), "test unit values", fills);
+    ADD_FAILURE() << "the refused launch went unreported";
+  }
+  catch (const Error& e)
+  {
+    EXPECT_EQ(std::string(e.what()).rfind("octoray: CUDA launch of UnitCodesKernel failed: ", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(cudaGetLastError(), cudaSuccess);
+  const auto codes = d.PrepareUnitCodes(onDevice.Get(), units.size(), "test unit values", fills);
+  EXPECT_EQ(checks::HostCopy(d, codes.Get(), units.size()), checks::UnitCodesOf(units));
 }
 
 TEST_F(CudaDeviceCUDA, SmallLevelsReduceEachLevelAfterTheOneBelow)

@@ -357,6 +357,37 @@ TEST(Scalar16, ErrorsStayWithinHalfAStepOfTheRange)
   EXPECT_EQ(AttributeValue<Scalar16>::Mean(bothInf, 0.5).code, kScalarNaN);
 }
 
+// The host's loop of codes (EncodeUnitScalars, built so that it
+// vectorises) makes the codes that EncodeUnitScalar makes of each value,
+// and those round as the floor of the scaled value and a half: values
+// across 0..1 and beyond, every step's midpoint and its neighbours.
+TEST(Scalar16, CodesOfManyValuesAreTheCodesOfEach)
+{
+  std::vector<float> values = checks::UnitValues(70001);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> around(-0.25f, 1.25f);
+  for (int i = 0; i < 100000; ++i)
+  {
+    values.push_back(around(rng));
+  }
+  for (int step = 0; step < kScalarSteps; step += 7)
+  {
+    const float middle = (step + 0.5f) / kScalarSteps;
+    values.insert(values.end(), { std::nextafter(middle, 0.0f), middle, std::nextafter(middle, 1.0f) });
+  }
+  std::vector<std::uint16_t> codes(values.size());
+  EncodeUnitScalars(values.data(), values.size(), codes.data());
+  EXPECT_EQ(codes, checks::UnitCodesOf(values));
+  for (std::size_t i = 0; i < values.size(); ++i)
+  {
+    if (std::isfinite(values[i]))
+    {
+      const float clamped = std::min(std::max(values[i], 0.0f), 1.0f);
+      ASSERT_EQ(codes[i], static_cast<std::uint16_t>(std::floor(clamped * kScalarSteps + 0.5f))) << values[i];
+    }
+  }
+}
+
 // Normals on the octahedron (OctahedralNormal.h): the axes exactly, every
 // direction within the stated angle, every vector no longer than 1 within
 // the stated distance, a stored vector unmoved when stored again.

@@ -190,6 +190,33 @@ TEST_P(OctreeBuild, TwoOppositeCorners)
   EXPECT_EQ(t.depth, 1);
 }
 
+// Reflectivity weighs a mirror ray, 0 to 1 (Attributes.h's UnitInput):
+// values beyond are clamped before they are averaged, and each is kept in
+// Scalar16's unit steps; NaN stays NaN.
+TEST_P(OctreeBuild, ReflectivityClampedAndKeptInUnitSteps)
+{
+  std::mt19937_64 rng(29);
+  Cloud c;
+  const double corners[4][3] = { { -1, -1, -1 }, { 1, -1, -1 }, { -1, 1, -1 }, { 1, 1, 1 } };
+  for (const auto& p : corners)
+  {
+    c.Add(p[0], p[1], p[2], rng);
+  }
+  c.reflectivity = { 1.5f, -0.5f, 0.3f, NAN };
+  BuildOptions options;
+  options.depth = 1;
+  engine->Build(c.View(), options);
+  HostOctree t;
+  engine->CopyToHost(t);
+  ASSERT_EQ(t.levelBegin[2] - t.levelBegin[1], 4u);
+  // The leaves by octant (x, y and z from bit 0 up): 0, 1, 2 and 7.
+  EXPECT_EQ(t.reflectivity[t.levelBegin[1]], 1.0f);
+  EXPECT_EQ(t.reflectivity[t.levelBegin[1] + 1], 0.0f);
+  EXPECT_EQ(t.reflectivity[t.levelBegin[1] + 2], std::floor(0.3f * kScalarSteps + 0.5f) / kScalarSteps);
+  EXPECT_NE(t.reflectivity[t.levelBegin[1] + 2], 0.3f) << "0.3 lies between two steps";
+  EXPECT_TRUE(std::isnan(t.reflectivity[t.levelBegin[1] + 3]));
+}
+
 TEST_P(OctreeBuild, EveryDepth)
 {
   const Cloud c = GaussianClusters(3000, 19);

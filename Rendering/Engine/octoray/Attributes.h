@@ -64,8 +64,12 @@ OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* 
 // (PointCloudView) become the engine's: CopiedInput as given, the colour
 // inputs as RGBA in the caller's precision (floats, HDR allowed, or bytes: a
 // quarter of the memory, the means rounded to bytes), ScalarInput in 16 bits
-// over the build's range (Scalar16.h), UnitNormalInput scaled to unit length
-// (OctreeDriver.h) and stored in one word (OctahedralNormal.h).
+// over the build's range (Scalar16.h), UnitInput clamped to 0..1 and rounded
+// to Scalar16's unit steps (at most 7.7e-6 off, far below what a mirror
+// weight shows in an 8-bit picture; means of those values stored as
+// floats), so that its staged copy moves 2 bytes a point where the caller's
+// floats take 4, UnitNormalInput scaled to unit length (OctreeDriver.h) and
+// stored in one word (OctahedralNormal.h).
 // The mean of unit normals is shorter than 1 where they disagree and zero
 // where they cancel. Labels name the arrays in memory reports ("node
 // colours", "point colours") and out-of-memory errors.
@@ -73,12 +77,13 @@ OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* 
   X(color, Color, Rgba, FloatColorInput, "colours")                                                                  \
   X(color8, Color8, Rgba8, ByteColorInput, "8-bit colours")                                                          \
   X(scalar, Scalar, Scalar16, ScalarInput, "scalars")                                                                \
-  X(reflectivity, Reflectivity, float, CopiedInput, "reflectivities")                                                \
+  X(reflectivity, Reflectivity, float, UnitInput, "reflectivities")                                                  \
   X(refraction, Refraction, float, CopiedInput, "refraction indices")                                                \
   X(normal, Normal, OctNormal, UnitNormalInput, "normals")
 
 struct CopiedInput;
 struct ScalarInput;
+struct UnitInput;
 struct FloatColorInput;
 struct ByteColorInput;
 struct UnitNormalInput;

@@ -7,6 +7,7 @@
 #include "Config.h"
 #include "Parallel.h"
 #include "RadixSort.h"
+#include "Scalar16.h"
 
 #include <algorithm>
 #include <chrono>
@@ -58,11 +59,13 @@ public:
   template <typename T>
   using Buffer = HostBuffer<T>;
 
-  // The caller's array, read in place: host memory is this device's memory.
+  // The caller's array, read in place: host memory is this device's memory;
+  // or values made from it, which it owns (PrepareUnitCodes).
   template <typename T>
   struct Staged
   {
     const T* data = nullptr;
+    std::shared_ptr<const std::vector<T>> made;
     const T* Get() const { return data; }
   };
 
@@ -129,6 +132,17 @@ public:
   Staged<T> Prepare(const T* host, std::size_t n, const char* what, Fills&)
   {
     return Stage(host, n, what);
+  }
+  // The Scalar16 codes of a caller's unit values (Attributes.h's UnitInput).
+  Staged<std::uint16_t> PrepareUnitCodes(const float* host, std::size_t n, const char*, Fills&)
+  {
+    if (!host)
+    {
+      return {};
+    }
+    auto codes = std::make_shared<std::vector<std::uint16_t>>(n);
+    EncodeUnitScalars(host, n, codes->data());
+    return Staged<std::uint16_t>{ codes->data(), std::move(codes) };
   }
   template <typename T>
   void Adopt(const Staged<T>& staged, Buffer<T>& buffer, std::size_t n)

@@ -579,6 +579,29 @@ public:
     }
     return staged;
   }
+  // The Scalar16 codes of a caller's unit values (Attributes.h's UnitInput):
+  // made by the staging threads as they copy pageable memory, so that half
+  // the bytes cross the bus; made by a loop where the device reads the
+  // values itself (a caller's device or page-locked arrays).
+  Staged<std::uint16_t> PrepareUnitCodes(const float* source, std::size_t n, const char* what, Fills& fills)
+  {
+    Staged<std::uint16_t> codes;
+    if (!source)
+    {
+      return codes;
+    }
+    Reserve(codes, n, what);
+    std::uint16_t* to = codes.Get();
+    if (const float* values = static_cast<const float*>(cuda::DeviceReadable(source)))
+    {
+      ForEach("UnitCodesKernel", n, OCTORAY_LAMBDA(std::size_t i) { to[i] = EncodeUnitScalar(values[i]).code; });
+      return codes;
+    }
+    cuda::CopyPart part{ to, source, n * sizeof(std::uint16_t), what, nullptr };
+    part.unitCodes = true;
+    fills.push_back(std::move(part));
+    return codes;
+  }
   template <typename T>
   void Adopt(Staged<T>&& staged, Buffer<T>& buffer, std::size_t)
   {

@@ -18,6 +18,7 @@
 
 #include "CudaSupport.h"
 #include "Parallel.h"
+#include "Scalar16.h"
 #include "StagingPieces.h"
 
 #include <algorithm>
@@ -41,21 +42,29 @@ constexpr std::size_t kStagingThreshold = std::size_t(1) << 20;
 // once it has landed: on `stream`, in whose order the piece's copy ran.
 using Landed = std::function<void(std::size_t begin, std::size_t end, cudaStream_t stream)>;
 
-// Whether CUDA can copy from `p` without staging: device, managed or
-// page-locked host memory.
-inline bool DirectlyCopyable(const void* p)
+// Where the device reads `p` if CUDA can copy from it without staging
+// (device, managed or page-locked host memory); else null.
+inline const void* DeviceReadable(const void* p)
 {
   cudaPointerAttributes attributes;
   if (cudaPointerGetAttributes(&attributes, p) != cudaSuccess)
   {
     cudaGetLastError();
-    return false;
+    return nullptr;
   }
-  return attributes.type != cudaMemoryTypeUnregistered;
+  return attributes.type != cudaMemoryTypeUnregistered ? attributes.devicePointer : nullptr;
+}
+
+inline bool DirectlyCopyable(const void* p)
+{
+  return DeviceReadable(p) != nullptr;
 }
 
 // One array of a copy: `bytes` from `source` (host or device memory) to
-// `device`, and the work to queue on each of its pieces as it lands.
+// `device`, and the work to queue on each of its pieces as it lands. A part
+// of unit codes takes floats from pageable host memory and lands their
+// Scalar16 codes (EncodeUnitScalars, made as each piece is staged; `bytes`
+// counts the codes): half the bytes over the bus.
 struct CopyPart
 {
   void* device;
@@ -63,7 +72,21 @@ struct CopyPart
   std::size_t bytes;
   std::string what; // names the array in an error
   Landed landed;
+  bool unitCodes = false;
 };
+
+// The bytes [offset, offset + bytes) of a part as they land, written to
+// `to` on the host: the source's, or the codes of its floats.
+inline void FillPiece(const CopyPart& part, std::size_t offset, std::size_t bytes, void* to)
+{
+  if (part.unitCodes)
+  {
+    EncodeUnitScalars(static_cast<const float*>(part.source) + offset / sizeof(std::uint16_t),
+      bytes / sizeof(std::uint16_t), static_cast<std::uint16_t*>(to));
+    return;
+  }
+  std::memcpy(to, static_cast<const char*>(part.source) + offset, bytes);
+}
 
 class HostStaging
 {
@@ -101,6 +124,10 @@ public:
     {
       if (DirectlyCopyable(part.source))
       {
+        if (part.unitCodes)
+        {
+          throw Error("octoray: the codes of " + part.what + " are made on the device from device-readable memory");
+        }
         CopyDirectly(part);
       }
       else
@@ -186,7 +213,15 @@ private:
   // bounce buffer, and the part's landed work on the default stream.
   static void CopyDirectly(const CopyPart& part)
   {
-    CudaCheck(cudaMemcpy(part.device, part.source, part.bytes, cudaMemcpyDefault), part.what.c_str());
+    std::vector<std::uint16_t> codes;
+    const void* source = part.source;
+    if (part.unitCodes)
+    {
+      codes.resize(part.bytes / sizeof(std::uint16_t));
+      FillPiece(part, 0, part.bytes, codes.data());
+      source = codes.data();
+    }
+    CudaCheck(cudaMemcpy(part.device, source, part.bytes, cudaMemcpyDefault), part.what.c_str());
     if (part.landed)
     {
       part.landed(0, part.bytes, 0);
@@ -210,7 +245,7 @@ private:
       const std::size_t offset = piece.offset, n = piece.bytes;
       what = part.what.c_str();
       CudaCheck(cudaEventSynchronize(lane.copied[b]), what); // the DMA from this buffer is done
-      std::memcpy(lane.pinned[b], static_cast<const char*>(part.source) + offset, n);
+      FillPiece(part, offset, n, lane.pinned[b]);
       CudaCheck(cudaMemcpyAsync(static_cast<char*>(part.device) + offset, lane.pinned[b], n,
                   cudaMemcpyHostToDevice, lane.stream),
         what);

@@ -266,26 +266,15 @@ InputFloats InputFloatsOf(ByteColorInput, A, const PointCloudView&)
   return InputFloats{ nullptr, 0 }; // staged as color8
 }
 
-// A caller's attribute arrays, as given, where the device's loops read them.
+// A caller's attribute arrays where the device's loops read them: as
+// given, or (UnitInput) as Scalar16 codes, made as they are staged.
 template <class Device>
 struct StagedAttributes
 {
   typename Device::template Staged<std::uint8_t> color8;
   typename Device::template Staged<float> values[kAttributeCount];
+  typename Device::template Staged<std::uint16_t> unitCodes[kAttributeCount];
 };
-
-// Calls fn(staged array, caller's array, its length, label) for the 8-bit
-// colours and for each attribute's float array.
-template <class Device, class Fn>
-void ForEachStagedInput(const PointCloudView& points, StagedAttributes<Device>& staged, Fn&& fn)
-{
-  fn(staged.color8, points.color8, points.colorComponents * points.count, std::string("point colours"));
-  ForEachAttribute([&](auto a) {
-    using A = decltype(a);
-    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
-    fn(staged.values[A::kIndex], in.data, in.count, std::string("point ") + A::kLabel);
-  });
-}
 
 // Room for the attributes' staged arrays, whose copies (added to `fills`)
 // go with the positions': one pass of the CUDA staging for all the arrays.
@@ -293,8 +282,19 @@ template <class Device>
 StagedAttributes<Device> PrepareAttributes(Device& d, const PointCloudView& points, typename Device::Fills& fills)
 {
   StagedAttributes<Device> staged;
-  ForEachStagedInput(points, staged, [&](auto& array, const auto* data, std::size_t count, const std::string& label) {
-    array = d.Prepare(data, count, label.c_str(), fills);
+  staged.color8 = d.Prepare(points.color8, points.colorComponents * points.count, "point colours", fills);
+  ForEachAttribute([&](auto a) {
+    using A = decltype(a);
+    const InputFloats in = InputFloatsOf(typename A::Input(), a, points);
+    const std::string label = std::string("point ") + A::kLabel;
+    if constexpr (std::is_same<typename A::Input, UnitInput>::value)
+    {
+      staged.unitCodes[A::kIndex] = d.PrepareUnitCodes(in.data, in.count, label.c_str(), fills);
+    }
+    else
+    {
+      staged.values[A::kIndex] = d.Prepare(in.data, in.count, label.c_str(), fills);
+    }
   });
   return staged;
 }
@@ -321,6 +321,7 @@ struct AttributeInputs
 {
   const std::uint8_t* color8;
   const float* values[kAttributeCount];
+  const std::uint16_t* unitCodes[kAttributeCount];
   int colorComponents;
   ScalarRange scalarRange;
 };
@@ -333,6 +334,14 @@ OCTORAY_HD void StoreInput(CopiedInput, A, const AttributeInputs& in, std::size_
 {
   static_assert(std::is_same<typename A::Type, float>::value, "a copied attribute is stored as its float");
   StoreInRecord(records, layout, i, A::kIndex, in.values[A::kIndex][i]);
+}
+
+template <class A>
+OCTORAY_HD void StoreInput(UnitInput, A, const AttributeInputs& in, std::size_t i, std::uint32_t* records,
+  const PointRecordLayout& layout)
+{
+  static_assert(std::is_same<typename A::Type, float>::value, "a unit input is stored as the float of its code");
+  StoreInRecord(records, layout, i, A::kIndex, UnitScalar(Scalar16{ in.unitCodes[A::kIndex][i] }));
 }
 
 template <class A>
@@ -381,8 +390,11 @@ void IngestAttributes(Device& d, const PointCloudView& points, const StagedAttri
   {
     return;
   }
-  AttributeInputs in{ staged.color8.Get(), {}, points.colorComponents, scalarRange };
-  ForEachAttribute([&](auto a) { in.values[a.kIndex] = staged.values[a.kIndex].Get(); });
+  AttributeInputs in{ staged.color8.Get(), {}, {}, points.colorComponents, scalarRange };
+  ForEachAttribute([&](auto a) {
+    in.values[a.kIndex] = staged.values[a.kIndex].Get();
+    in.unitCodes[a.kIndex] = staged.unitCodes[a.kIndex].Get();
+  });
   std::uint32_t* records = s.records.Get();
   d.ForEach("PointRecordsKernel", points.count, OCTORAY_LAMBDA(std::size_t i) {
     ForEachAttribute([&](auto a) {

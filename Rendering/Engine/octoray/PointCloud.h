@@ -24,6 +24,9 @@ struct CopiedInput // one value per point, in the member of the attribute's name
 struct ScalarInput : CopiedInput // one float per point, any value
 {
 };
+struct UnitInput : CopiedInput // one float per point, 0..1 (others clamped)
+{
+};
 struct UnitNormalInput : CopiedInput // 3 floats per point, of any length
 {
 };
@@ -51,7 +54,7 @@ struct PointCloudView
   int colorComponents = 0;
 
   const float* scalar = nullptr;
-  const float* reflectivity = nullptr; // 0..1, the weight of the mirror ray
+  const float* reflectivity = nullptr; // 0..1, the weight of the mirror ray (UnitInput)
   const float* refraction = nullptr;   // index of refraction; 0 = opaque
   const float* normal = nullptr;       // 3 values per point, need not be unit length
 
