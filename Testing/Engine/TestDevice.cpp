@@ -357,33 +357,39 @@ TEST(Scalar16, ErrorsStayWithinHalfAStepOfTheRange)
   EXPECT_EQ(AttributeValue<Scalar16>::Mean(bothInf, 0.5).code, kScalarNaN);
 }
 
-// The host's loop of codes (EncodeUnitScalars, built so that it
-// vectorises) makes the codes that EncodeUnitScalar makes of each value,
-// and those round as the floor of the scaled value and a half: values
-// across 0..1 and beyond, every step's midpoint and its neighbours.
+// The host's loop of codes (EncodeUnitScalars, eight values at a time)
+// makes the codes that EncodeUnitScalar makes of each value, and those
+// round as the floor of the scaled value and a half: finite values across
+// 0..1 and beyond, every seventh step's midpoint and its neighbours (a
+// length that leaves a tail of six), then values with NaN and infinities
+// among them, which the loop codes again one at a time.
 TEST(Scalar16, CodesOfManyValuesAreTheCodesOfEach)
 {
-  std::vector<float> values = checks::UnitValues(70001);
+  std::vector<float> finite;
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> around(-0.25f, 1.25f);
   for (int i = 0; i < 100000; ++i)
   {
-    values.push_back(around(rng));
+    finite.push_back(around(rng));
   }
   for (int step = 0; step < kScalarSteps; step += 7)
   {
     const float middle = (step + 0.5f) / kScalarSteps;
-    values.insert(values.end(), { std::nextafter(middle, 0.0f), middle, std::nextafter(middle, 1.0f) });
+    finite.insert(finite.end(), { std::nextafter(middle, 0.0f), middle, std::nextafter(middle, 1.0f) });
   }
-  std::vector<std::uint16_t> codes(values.size());
-  EncodeUnitScalars(values.data(), values.size(), codes.data());
-  EXPECT_EQ(codes, checks::UnitCodesOf(values));
-  for (std::size_t i = 0; i < values.size(); ++i)
+  ASSERT_EQ(finite.size() % 8, 6u);
+  for (const std::vector<float>& values : { finite, checks::UnitValues(70001) })
   {
-    if (std::isfinite(values[i]))
+    std::vector<std::uint16_t> codes(values.size());
+    EncodeUnitScalars(values.data(), values.size(), codes.data());
+    EXPECT_EQ(codes, checks::UnitCodesOf(values));
+    for (std::size_t i = 0; i < values.size(); ++i)
     {
-      const float clamped = std::min(std::max(values[i], 0.0f), 1.0f);
-      ASSERT_EQ(codes[i], static_cast<std::uint16_t>(std::floor(clamped * kScalarSteps + 0.5f))) << values[i];
+      if (std::isfinite(values[i]))
+      {
+        const float clamped = std::min(std::max(values[i], 0.0f), 1.0f);
+        ASSERT_EQ(codes[i], static_cast<std::uint16_t>(std::floor(clamped * kScalarSteps + 0.5f))) << values[i];
+      }
     }
   }
 }

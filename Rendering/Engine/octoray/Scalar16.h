@@ -44,16 +44,14 @@ OCTORAY_HD Scalar16 EncodeUnitScalar(float u)
   {
     return Scalar16{ u > 0.0f ? kScalarPlusInfinity : kScalarMinusInfinity };
   }
-  // Rounded by truncation, which is floor for these non-negative values and
-  // which the host's compiler vectorises (EncodeUnitScalars).
   const float clamped = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
-  return Scalar16{ static_cast<std::uint16_t>(static_cast<int>(clamped * kScalarSteps + 0.5f)) };
+  return Scalar16{ static_cast<std::uint16_t>(floorf(clamped * kScalarSteps + 0.5f)) };
 }
 
 // EncodeUnitScalar of n values into their codes, on the host: the CUDA
 // staging codes each piece of a unit-valued input (Attributes.h's
-// UnitInput) as it copies it, at the speed of a copy. Scalar16.cpp, built so
-// that the loop vectorises.
+// UnitInput) as it copies it, faster than it would copy the floats
+// (Scalar16.cpp).
 void EncodeUnitScalars(const float* values, std::size_t n, std::uint16_t* codes);
 
 OCTORAY_HD float UnitScalar(Scalar16 s)
