@@ -329,10 +329,7 @@ public:
       return 0.0;
     }
     const std::vector<octoray::cuda::CopyPart> parts = StagedParts(c, nullptr);
-    std::vector<std::size_t> bytes;
-    for (const octoray::cuda::CopyPart& part : parts)
-      bytes.push_back(part.bytes);
-    const octoray::cuda::StagingRun run(bytes);
+    const octoray::cuda::StagingRun run = octoray::cuda::RunOf(parts);
     const auto t0 = std::chrono::steady_clock::now();
     octoray::cuda::PieceDealer dealer(octoray::cuda::CutPieces(run, Threads.Chunks()));
     Threads.Run(Threads.Chunks(), [&](std::size_t thread, std::size_t, int) {

@@ -106,14 +106,15 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
 // The CUDA backend's staged copy lays a copy's arrays end to end, cuts the
 // run into pieces and deals them to its threads as each becomes free
 // (StagingPieces.h). For runs of one to four arrays of many sizes (empty
-// ones among them), cut for 1 to kMaxStagingThreads threads: the pieces
-// cover every array once, in order; none is empty or larger than a
-// page-locked buffer; each starts at a whole multiple of kPieceAlignment
-// into its array, so that no piece splits a point; no array gets more
-// pieces than MaxPieces, which sizes the partial bounds of its pieces; and
-// the pieces only grow along the run (each costs the copy time beyond its
-// bytes: PieceBytes), a piece smaller than one before it the last of its
-// array, cut where the array ends. Dealt to as many threads (ChunkWorkers),
+// ones among them, some made from twice their bytes and cut in pieces half
+// as long), cut for 1 to kMaxStagingThreads threads: the pieces cover every
+// array once, in order; none is empty or larger than a page-locked buffer;
+// each starts at a whole multiple of kPieceAlignment into its array, so
+// that no piece splits a point; no array gets more pieces than MaxPieces
+// of the bytes its pieces read, which sizes the partial bounds of its
+// pieces; and the bytes the pieces read only grow along the run (each piece
+// costs the copy time beyond its bytes: PieceBytes), a piece that reads
+// fewer than one before it the last of its array, cut where the array ends. Dealt to as many threads (ChunkWorkers),
 // every piece is taken once, and each thread's buffers alternate.
 TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
 {
@@ -121,24 +122,31 @@ TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
   std::mt19937_64 rng(7);
   std::vector<std::vector<std::size_t>> runs = { { 1 }, { kPieceAlignment }, { kEdgePiece + 1 }, { kStagingPiece },
     { 3 * kStagingPiece + 5 }, { 0, 5 }, { 5, 0 }, { 120000000, 30000000, 40000000 },
-    { 1200000000, 300000000, 400000000 } };
+    { 1200000000, 300000000, 400000000 }, { 120000000, 30000000, 20000000 } };
+  std::vector<std::vector<bool>> halves(runs.size());
+  halves.back() = { false, false, true }; // a build's positions, colours and reflectivity codes
   for (int i = 0; i < 300; ++i)
   {
     std::vector<std::size_t> run(1 + rng() % 4);
+    std::vector<bool> halved;
     for (std::size_t& bytes : run)
     {
       bytes = rng() % 8 == 0 ? rng() % 3 : std::size_t(1) + rng() % (std::size_t(1) << (10 + rng() % 21));
+      halved.push_back(rng() % 3 == 0);
     }
     runs.push_back(run);
+    halves.push_back(halved);
   }
   for (int threads = 1; threads <= kMaxStagingThreads; threads += 3)
   {
     ChunkWorkers workers(threads);
-    for (const std::vector<std::size_t>& arrays : runs)
+    for (std::size_t r = 0; r < runs.size(); ++r)
     {
+      const std::vector<std::size_t>& arrays = runs[r];
+      StagingRun run(arrays, halves[r]);
       SCOPED_TRACE("first array " + std::to_string(arrays[0]) + " bytes of " + std::to_string(arrays.size()) +
         ", threads " + std::to_string(threads));
-      const std::vector<Piece> pieces = CutPieces(StagingRun(arrays), threads);
+      const std::vector<Piece> pieces = CutPieces(run, threads);
       std::vector<std::size_t> covered(arrays.size(), 0), count(arrays.size(), 0);
       int bad = 0, shrunk = 0;
       std::size_t largest = 0; // of the pieces so far not cut where their array ends
@@ -150,8 +158,12 @@ TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
         bad += !inOrder || p.array >= arrays.size() || p.bytes == 0 || p.bytes > kStagingPiece ||
           p.offset + p.bytes > arrays[p.array] || p.offset % kPieceAlignment != 0;
         const bool endsItsArray = p.array < arrays.size() && p.offset + p.bytes == arrays[p.array];
-        shrunk += !endsItsArray && p.bytes < largest;
-        largest = std::max(largest, endsItsArray ? 0 : p.bytes);
+        // A piece half as long reads twice its bytes, up to kPieceAlignment
+        // short of a whole piece: its length stays a multiple of that.
+        const bool halved = p.array < arrays.size() && run.halfPieces[p.array];
+        const std::size_t read = halved ? 2 * p.bytes + kPieceAlignment : p.bytes;
+        shrunk += !endsItsArray && read < largest;
+        largest = std::max(largest, endsItsArray ? 0 : halved ? 2 * p.bytes : p.bytes);
         covered[p.array] += p.bytes;
         ++count[p.array];
       }
@@ -160,7 +172,7 @@ TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
       for (std::size_t a = 0; a < arrays.size(); ++a)
       {
         EXPECT_EQ(covered[a], arrays[a]) << "array " << a;
-        EXPECT_LE(count[a], MaxPieces(arrays[a])) << "array " << a;
+        EXPECT_LE(count[a], MaxPieces(arrays[a] * (run.halfPieces[a] ? 2 : 1))) << "array " << a;
       }
 
       PieceDealer dealer(pieces);

@@ -88,6 +88,20 @@ inline void FillPiece(const CopyPart& part, std::size_t offset, std::size_t byte
   std::memcpy(to, static_cast<const char*>(part.source) + offset, bytes);
 }
 
+// The staged parts laid end to end (StagingPieces.h), the pieces of unit
+// codes half as long.
+inline StagingRun RunOf(const std::vector<CopyPart>& parts)
+{
+  std::vector<std::size_t> bytes;
+  std::vector<bool> halved;
+  for (const CopyPart& part : parts)
+  {
+    bytes.push_back(part.bytes);
+    halved.push_back(part.unitCodes);
+  }
+  return StagingRun(bytes, halved);
+}
+
 class HostStaging
 {
 public:
@@ -118,7 +132,6 @@ public:
   bool Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
   {
     std::vector<CopyPart> staged;
-    std::vector<std::size_t> stagedBytes;
     bool firstStaged = false;
     for (const CopyPart& part : parts)
     {
@@ -134,10 +147,9 @@ public:
       {
         firstStaged = firstStaged || &part == &parts.front();
         staged.push_back(part);
-        stagedBytes.push_back(part.bytes);
       }
     }
-    const StagingRun run(stagedBytes);
+    const StagingRun run = RunOf(staged);
     if (run.Length() < kStagingThreshold || !Allocate())
     {
       std::for_each(staged.begin(), staged.end(), CopyDirectly);

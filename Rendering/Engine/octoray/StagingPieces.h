@@ -65,14 +65,22 @@ inline std::size_t AlignedBytes(std::size_t bytes)
 // whole points), which the threads copy in one pass: each pass pays the
 // ramps at its ends once, whatever the number of arrays
 // (Benchmarks/gpu/variants-one-pass.txt).
+//
+// An array the threads make from twice as many bytes of the caller's (the
+// codes of unit values: CudaUpload.h's CopyPart) is cut into pieces half as
+// long, so that a thread's piece reads no more of the caller's memory than
+// any other: its last pieces hold up the copy's end.
 struct StagingRun
 {
   std::vector<std::size_t> start; // each array's first byte in the run
   std::vector<std::size_t> bytes; // each array's length
+  std::vector<bool> halfPieces;   // each array's pieces half as long
 
-  explicit StagingRun(std::vector<std::size_t> arrayBytes)
+  explicit StagingRun(std::vector<std::size_t> arrayBytes, std::vector<bool> halved = {})
     : bytes(std::move(arrayBytes))
+    , halfPieces(std::move(halved))
   {
+    halfPieces.resize(bytes.size(), false);
     std::size_t at = 0;
     for (std::size_t b : bytes)
     {
@@ -109,7 +117,8 @@ inline std::vector<Piece> CutPieces(const StagingRun& run, int threads)
       offset = run.start[array]; // past a gap
       continue;
     }
-    const std::size_t n = std::min(PieceBytes(offset, threads), run.End(array) - offset);
+    const std::size_t most = PieceBytes(offset, threads) / (run.halfPieces[array] ? 2 : 1);
+    const std::size_t n = std::min(most / kPieceAlignment * kPieceAlignment, run.End(array) - offset);
     pieces.push_back(Piece{ array, offset - run.start[array], n });
     offset += n;
   }
