@@ -10,9 +10,10 @@
 // The distances are measured on the engine's own octree (Quantisation.h)
 // and checked against the analytic bound, half the leaf voxel's diagonal;
 // a distance past it fails the run. Where the scene has 8-bit colours,
-// scalars or normals, their rounding in the nodes (to bytes; to 16 bits
-// over the range; to the octahedron's 4-byte code) is measured too, against the exact means, and checked
-// against its bound (Attributes.h).
+// scalars, normals or reflectivity, their rounding in the nodes (to bytes;
+// to 16 bits over the range; to the octahedron's 4-byte code; the points'
+// reflectivities to 16-bit unit steps) is measured too, against the exact
+// means, and checked against its bound (Attributes.h).
 //
 //   octoray_bench_quantisation [--backend cpu|cuda] [--depths 1-21]
 //                              [--ct PATH] [--lidar PATH] [--sphere-points N]
@@ -99,8 +100,8 @@ int main(int argc, char** argv)
       std::printf("\nscene %s, %zu points\n", scene.name.c_str(), scene.points.count);
       std::printf("| depth | leaf side | max distance | mean distance | bound | max/bound | nodes | build ms | MB | "
                   "colour steps leaf / inner / bound | scalar steps leaf / inner / bound | "
-                  "normal distance x1e-3 leaf / inner / bound |\n");
-      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+                  "normal distance x1e-3 leaf / inner / bound | reflectivity x1e-6 leaf / inner / bound |\n");
+      std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
       for (int depth = first; depth <= last; ++depth)
       {
         // A fresh engine per depth: one reused across depths keeps the
@@ -116,14 +117,16 @@ int main(int argc, char** argv)
         const QuantisationError q = MeasureQuantisation(tree, scene.points);
         const double bytes = double(engine->Memory().Total());
         const bool colours = !tree.color8.empty(), scalars = !tree.scalar.empty(), normals = !tree.normal.empty();
+        const bool mirrors = !tree.reflectivity.empty();
         const RoundingError colour = colours ? MeasureColourQuantisation(tree, scene.points) : RoundingError{};
         const RoundingError scalar = scalars ? MeasureScalarQuantisation(tree, scene.points) : RoundingError{};
         const RoundingError normal = normals ? MeasureNormalQuantisation(tree, scene.points) : RoundingError{};
+        const RoundingError mirror = mirrors ? MeasureReflectivityQuantisation(tree, scene.points) : RoundingError{};
         // The bound, less a relative 1e-12 for the rounding of the centre.
         const bool ok = q.max <= q.bound * (1 + 1e-12) && colour.withinBound && scalar.withinBound &&
-          normal.withinBound;
+          normal.withinBound && mirror.withinBound;
         withinBound = withinBound && ok;
-        char colourText[64] = "-", scalarText[64] = "-", normalText[64] = "-";
+        char colourText[64] = "-", scalarText[64] = "-", normalText[64] = "-", mirrorText[64] = "-";
         if (colours)
         {
           std::snprintf(colourText, sizeof colourText, "%.3f / %.3f / %.1f", colour.leafMax, colour.innerMax,
@@ -139,9 +142,14 @@ int main(int argc, char** argv)
           std::snprintf(normalText, sizeof normalText, "%.2f / %.2f / %.1f", 1e3 * normal.leafMax,
             1e3 * normal.innerMax, 1e3 * normal.rootBound);
         }
-        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s | %s | %s |%s\n", depth,
+        if (mirrors)
+        {
+          std::snprintf(mirrorText, sizeof mirrorText, "%.2f / %.2f / %.1f", 1e6 * mirror.leafMax,
+            1e6 * mirror.innerMax, 1e6 * mirror.rootBound);
+        }
+        std::printf("| %d | %.6g | %.6g | %.6g | %.6g | %.3f | %zu | %.2f | %.2f | %s | %s | %s | %s |%s\n", depth,
           q.leafSide, q.max, q.mean, q.bound, q.max / q.bound, stats.nodes, t.median * 1e3, bytes / 1e6, colourText,
-          scalarText, normalText, ok ? "" : " PAST THE BOUND");
+          scalarText, normalText, mirrorText, ok ? "" : " PAST THE BOUND");
         std::fflush(stdout);
         Record r{ "quantisation/" + scene.name, backend, scene.points.count, depth, t.median, "", 0.0 };
         r.With("max_distance", q.max)
@@ -171,6 +179,12 @@ int main(int argc, char** argv)
             .With("normal_inner_distance", normal.innerMax)
             .With("normal_root_bound", normal.rootBound);
         }
+        if (mirrors)
+        {
+          r.With("reflectivity_leaf_error", mirror.leafMax)
+            .With("reflectivity_inner_error", mirror.innerMax)
+            .With("reflectivity_root_bound", mirror.rootBound);
+        }
         records.push_back(r);
       }
     }
@@ -178,7 +192,7 @@ int main(int argc, char** argv)
     if (!withinBound)
     {
       std::fprintf(stderr, "octoray_bench_quantisation: a distance exceeds half the leaf diagonal, or a colour, "
-                           "a scalar or a normal its bound\n");
+                           "a scalar, a normal or a reflectivity its bound\n");
       return 1;
     }
   }

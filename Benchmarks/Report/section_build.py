@@ -153,16 +153,14 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measured: the thirty-fifth
-# session's rounds of "direct" (call 2, whose kernels are b422446's:
-# b422446 releases the sort's record array where indices sort, on the
-# host, and takes the gather out of a test) and "final" (call 4, the tree
-# after the report's run) in its variants file, on H200 machines
+# More rounds of the engine this report's run measured: the thirty-ninth
+# session's rounds of "avx2" (call 5, at c9c93d4, the report's commit, on
+# the machine the report's call then ran on) in its variants file
 # (COMMAND.md).
-ROUNDS_ENGINE = "b422446"
-ROUNDS_SESSION = "thirty-fifth"
-ROUNDS_FILE = "variants-direct-records.txt"
-ROUNDS_VARIANTS = ("direct", "final")
+ROUNDS_ENGINE = "c9c93d4"
+ROUNDS_SESSION = "thirty-ninth"
+ROUNDS_FILE = "variants-unit-codes.txt"
+ROUNDS_VARIANTS = ("avx2",)
 
 
 def more_rounds(ctx, n):
@@ -1068,7 +1066,7 @@ def _cuda(ctx):
                     and r.get("call_over_pinned_copy")] for n in rounds}
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
-            "this run and %s in %d rounds of %s's engine on other H200 machines in the %s session "
+            "this run and %s in %d rounds of %s's engine on an H200 machine in the %s session "
             "([gpu/%s](gpu/%s), the rounds of %s); at 100 M, %s here and %s there." % (
                 ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
                 len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_SESSION, ROUNDS_FILE, ROUNDS_FILE,
@@ -1098,8 +1096,9 @@ def _cuda(ctx):
             "only, the allocator's cache given back), with that build's whole call." % (
                 _page_locking(ctx),
                 ("; *host copy* is the host's half of the staging alone: the caller's arrays copied piece by "
-                 "piece into the same threads' page-locked buffers, no DMA (octoray_bench_cuda's "
-                 "HostHalfOfStaging). "
+                 "piece into the same threads' page-locked buffers (since c9c93d4 the reflectivity as its 16-bit "
+                 "codes: 170 MB of the 190 at 10 M points; the pinned copy stays the input's, the goal's "
+                 "measure), no DMA (octoray_bench_cuda's HostHalfOfStaging). "
                  "No upload through page-locked buffers takes less than the longer of the host copy and the pinned "
                  "copy" if host_copy else "")
                 + ("; nor less than the two at once (*host copy and pinned copy at once*: both read the host's "
@@ -1326,6 +1325,7 @@ def _quantisation(ctx):
     worst_colour = [0.0, 0.0]  # steps of 1/255: leaves, inner nodes
     worst_normal = [0.0, 0.0]  # distance between vectors: leaves, inner nodes
     worst_scalar = [0.0, 0.0]  # steps of the scalar range / 65532: leaves, inner nodes
+    worst_mirror = [0.0, 0.0]  # reflectivity, absolute: leaves, inner nodes
     gpu_same = True
     for s in scenes_in:
         rows = []
@@ -1343,6 +1343,10 @@ def _quantisation(ctx):
             if normal:
                 worst_normal = [max(worst_normal[0], r["normal_leaf_distance"]),
                                 max(worst_normal[1], r["normal_inner_distance"])]
+            mirror = "reflectivity_leaf_error" in r
+            if mirror:
+                worst_mirror = [max(worst_mirror[0], r["reflectivity_leaf_error"]),
+                                max(worst_mirror[1], r["reflectivity_inner_error"])]
             g = gpu_by.get((r["name"], r["depth"]))
             if g is not None:
                 gpu_same = gpu_same and abs(g["max_distance"] - r["max_distance"]) <= 1e-12 * r["cube_size"] \
@@ -1357,25 +1361,31 @@ def _quantisation(ctx):
                              ("%.2f / %.2f / %.1f" % (r["scalar_leaf_steps"], r["scalar_inner_steps"],
                                                       r["scalar_root_bound_steps"])) if scalar else "–",
                              ("%.2f / %.2f / %.1f" % (1e3 * r["normal_leaf_distance"], 1e3 * r["normal_inner_distance"],
-                                                      1e3 * r["normal_root_bound"])) if normal else "–"])
+                                                      1e3 * r["normal_root_bound"])) if normal else "–",
+                             ("%.2f / %.2f / %.1f" % (1e6 * r["reflectivity_leaf_error"],
+                                                      1e6 * r["reflectivity_inner_error"],
+                                                      1e6 * r["reflectivity_root_bound"])) if mirror else "–"])
             csv_rows.append([s, r["n"], r["depth"], r["cube_size"], r["leaf_side"], r["max_distance"],
                              r["mean_distance"], r["bound"], r["nodes"], r["seconds"], r["bytes"],
                              g["seconds"] if g else "", r.get("colour_leaf_steps", ""),
                              r.get("colour_inner_steps", ""), r.get("scalar_leaf_steps", ""),
                              r.get("scalar_inner_steps", ""), r.get("normal_leaf_distance", ""),
-                             r.get("normal_inner_distance", "")])
+                             r.get("normal_inner_distance", ""), r.get("reflectivity_leaf_error", ""),
+                             r.get("reflectivity_inner_error", "")])
         n = next(x["n"] for x in records if x["name"].endswith("/" + s))
         parts.append("**%s**, %s points, root cube side %.6g:\n\n" % (describe.get(s, s), count(n), next(
             x["cube_size"] for x in records if x["name"].endswith("/" + s))) + ctx.table(
             ["depth", "leaf side", "max distance", "mean distance", "max / bound", "nodes", "build ms (CPU)",
              "engine MB", "build ms (CUDA)", "colour error, steps: leaves / inner / bound",
              "scalar error, steps: leaves / inner / bound",
-             "normal error ×10⁻³: leaves / inner / bound"], rows, "rrrrrrrrrrrr"))
+             "normal error ×10⁻³: leaves / inner / bound",
+             "reflectivity error ×10⁻⁶: leaves / inner / bound"], rows, "rrrrrrrrrrrrr"))
     csv = ctx.write_csv("build-quantisation", ["scene", "points", "depth", "cube_size", "leaf_side", "max_distance",
                                                "mean_distance", "bound", "nodes", "build_s_cpu", "engine_bytes",
                                                "build_s_cuda", "colour_leaf_steps", "colour_inner_steps",
                                                "scalar_leaf_steps", "scalar_inner_steps",
-                                               "normal_leaf_distance", "normal_inner_distance"], csv_rows)
+                                               "normal_leaf_distance", "normal_inner_distance",
+                                               "reflectivity_leaf_error", "reflectivity_inner_error"], csv_rows)
     png, link = ctx.figure_path("build-quantisation")
     _plot_quantisation(png, records, scenes_in, describe)
     gpu_line = ("The CUDA column is from %s; its distances %s the CPU's (the same tree)." % (
@@ -1411,9 +1421,20 @@ def _quantisation(ctx):
             "the bound at the root: the points' own rounding (at most 2√6/4094 = 1.2×10⁻³ in angle), plus, at the "
             "leaves and again at each level up, that angle and half a length step (1/510). The run fails past a "
             "node's bound. Largest over every scene and depth: %.2f×10⁻³ at the leaves, %.2f×10⁻³ above them "
-            "(1×10⁻³ is 0.057° for a unit normal).\n" % (
+            "(1×10⁻³ is 0.057° for a unit normal).\n\n"
+            "Reflectivity, a mirror ray's weight from 0 to 1, arrives in 16 bits since c9c93d4 "
+            "(Rendering/Engine/octoray/Attributes.h's UnitInput): each point's value is clamped to 0..1 and "
+            "rounded to one of 65,532 equal steps (Scalar16.h's unit codes) as the CUDA staging copies it, so "
+            "that 2 bytes a point cross the bus where the caller's float took 4 (at 100 M points the whole call "
+            "took 1.18–1.24 times the pinned copy against 1.29–1.35 for the floats, in rounds in turn; at 10 M "
+            "the rounds overlapped: [gpu/variants-unit-codes.txt](gpu/variants-unit-codes.txt)); nodes keep "
+            "float means of those values. The last column measures it on the scenes with reflectivity: each "
+            "node's value against the exact mean of its points' floats (in double), beside the bound: half a step "
+            "(7.6×10⁻⁶) and the float sums' 2×10⁻⁶. The run fails past it. Largest over every scene and depth: "
+            "%.2f×10⁻⁶ at the leaves, %.2f×10⁻⁶ above them, a five-hundredth of what moves an 8-bit channel "
+            "(3.9×10⁻³).\n" % (
                 worst, gpu_line, worst_colour[0], worst_colour[1], worst_scalar[0], worst_scalar[1],
-                1e3 * worst_normal[0], 1e3 * worst_normal[1]))
+                1e3 * worst_normal[0], 1e3 * worst_normal[1], 1e6 * worst_mirror[0], 1e6 * worst_mirror[1]))
 
 
 def _plot_quantisation(png, records, scene_names, describe):

@@ -288,7 +288,8 @@ public:
   ///@{
   /**
    * Names of the optional per-point arrays read for reflectivity (0..1, the
-   * weight of the mirror ray) and index of refraction (0 = opaque).
+   * weight of the mirror ray; values outside are clamped, and each is kept
+   * to 1/65532) and index of refraction (0 = opaque).
    * Defaults: "Reflectivity" and "Refraction", as vtkParticleTextReader
    * names them.
    */

@@ -139,7 +139,8 @@ public:
       {
         if (part.unitCodes)
         {
-          throw Error("octoray: the codes of " + part.what + " are made on the device from device-readable memory");
+          // CudaDevice::PrepareUnitCodes makes those by a loop on the device.
+          throw Error("octoray: internal: the staging asked for the codes of " + part.what + " in device memory");
         }
         CopyDirectly(part);
       }

@@ -193,6 +193,20 @@ inline RoundingError MeasureScalarQuantisation(const HostOctree& tree, const Poi
   });
 }
 
+// Needs an octree of reflectivities built from `points`, in 0..1: each
+// node's mean against the exact mean of its points' floats. The points'
+// values are coded in Scalar16's unit steps (Attributes.h's UnitInput),
+// each within half a step; their means add up in float, which the engine's
+// tests hold to 2e-6 (TestSupport.h).
+inline RoundingError MeasureReflectivityQuantisation(const HostOctree& tree, const PointCloudView& points)
+{
+  auto value = [&](std::size_t i, double v[1]) { v[0] = points.reflectivity[i]; };
+  auto difference = [&](std::uint32_t n, const double mean[1]) {
+    return std::fabs(double(tree.reflectivity[n]) - mean[0]);
+  };
+  return MeasureRounding<1>(tree, points, value, difference, [](int) { return 0.5 / kScalarSteps + 2e-6; });
+}
+
 // Needs an octree of normals (tree.normal) built from `points`; the exact
 // means are of the caller's normals scaled to unit length in double.
 inline RoundingError MeasureNormalQuantisation(const HostOctree& tree, const PointCloudView& points)

@@ -69,7 +69,9 @@ inline std::size_t AlignedBytes(std::size_t bytes)
 // An array the threads make from twice as many bytes of the caller's (the
 // codes of unit values: CudaUpload.h's CopyPart) is cut into pieces half as
 // long, so that a thread's piece reads no more of the caller's memory than
-// any other: its last pieces hold up the copy's end.
+// any other, and the run's last pieces, which hold up its end, take no
+// longer. (Its effect was not told apart from that of the coding in AVX2,
+// which came with it: Benchmarks/gpu/variants-unit-codes.txt, call 5.)
 struct StagingRun
 {
   std::vector<std::size_t> start; // each array's first byte in the run
