@@ -362,7 +362,8 @@ inline std::vector<std::uint16_t> UnitCodesOf(const std::vector<float>& values)
 // StageReduced: the array where the device's loops read it, the reduction
 // of its items of three floats (their largest value: exact in any order),
 // and the arrays Prepare adds along (an 8-bit and a float one, and the codes
-// PrepareUnitCodes makes of unit values) copied in the same call. whenReduced runs where `expectWhenReduced` says (CUDA's
+// PrepareUnitCodes makes of unit values) copied in the same call.
+// whenReduced runs where `expectWhenReduced` says (CUDA's
 // staged copy in one pass of several arrays), with the final result, and
 // the loop it queues, while the arrays along are still on their way, reads
 // the whole array: a copy of it made there must miss no piece.

@@ -114,8 +114,9 @@ TEST(ChunkWorkers, SplitLikeParallelChunksPassAfterPass)
 // of the bytes its pieces read, which sizes the partial bounds of its
 // pieces; and the bytes the pieces read only grow along the run (each piece
 // costs the copy time beyond its bytes: PieceBytes), a piece that reads
-// fewer than one before it the last of its array, cut where the array ends. Dealt to as many threads (ChunkWorkers),
-// every piece is taken once, and each thread's buffers alternate.
+// fewer than one before it the last of its array, cut where the array
+// ends. Dealt to as many threads (ChunkWorkers), every piece is taken
+// once, and each thread's buffers alternate.
 TEST(StagingPieces, CoverEveryArrayInGrowingPiecesWithinTheBuffers)
 {
   using namespace octoray::cuda;

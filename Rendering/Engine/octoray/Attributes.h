@@ -65,7 +65,7 @@ OCTORAY_HD std::uint64_t NodeKey(const std::uint32_t* low, const std::uint32_t* 
 // inputs as RGBA in the caller's precision (floats, HDR allowed, or bytes: a
 // quarter of the memory, the means rounded to bytes), ScalarInput in 16 bits
 // over the build's range (Scalar16.h), UnitInput clamped to 0..1 and rounded
-// to Scalar16's unit steps (at most 7.7e-6 off, far below what a mirror
+// to Scalar16's unit steps (at most 7.6e-6 off, far below what a mirror
 // weight shows in an 8-bit picture; means of those values stored as
 // floats), so that its staged copy moves 2 bytes a point where the caller's
 // floats take 4, UnitNormalInput scaled to unit length (OctreeDriver.h) and

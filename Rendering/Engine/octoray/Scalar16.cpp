@@ -53,8 +53,8 @@ __attribute__((target("avx2"))) std::size_t EncodeFiniteAvx2(const float* values
 // Sixteen threads code as fast as they copy the floats so, one thread at
 // 1.3-1.4 times a memcpy's time on an H200's host (hence the staging's
 // pieces of codes half as long: StagingPieces.h). GCC's own vectorisation
-// of EncodeEach (SSE2, with -fno-trapping-math) was slower than the copy it
-// replaced: a staged build of 10 M points with reflectivity took 2.15-2.45
+// of this coding (SSE2, with -fno-trapping-math) was slower than the copy
+// it replaced: a staged build of 10 M points with reflectivity took 2.15-2.45
 // times the pinned copy so, where the floats' copy took 1.51-1.61
 // (Benchmarks/gpu/variants-unit-codes.txt, scripts/gpu/unit-codes-host.cpp).
 // CPUs without AVX2 code one value at a time. The tests hold both paths to

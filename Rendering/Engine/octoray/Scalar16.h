@@ -50,7 +50,7 @@ OCTORAY_HD Scalar16 EncodeUnitScalar(float u)
 
 // EncodeUnitScalar of n values into their codes, on the host: the CUDA
 // staging codes each piece of a unit-valued input (Attributes.h's
-// UnitInput) as it copies it, faster than it would copy the floats
+// UnitInput) as it copies it, about as fast as it would copy the floats
 // (Scalar16.cpp).
 void EncodeUnitScalars(const float* values, std::size_t n, std::uint16_t* codes);
 
