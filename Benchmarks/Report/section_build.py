@@ -1099,8 +1099,8 @@ def _cuda(ctx):
                  "piece into the same threads' page-locked buffers (since c9c93d4 the reflectivity as its 16-bit "
                  "codes: 170 MB of the 190 at 10 M points; the pinned copy stays the input's, the goal's "
                  "measure), no DMA (octoray_bench_cuda's HostHalfOfStaging). "
-                 "No upload through page-locked buffers takes less than the longer of the host copy and the pinned "
-                 "copy" if host_copy else "")
+                 "No upload through page-locked buffers takes less than the longer of the host copy and a pinned "
+                 "copy of what it lands (before c9c93d4, the pinned copy here)" if host_copy else "")
                 + ("; nor less than the two at once (*host copy and pinned copy at once*: both read the host's "
                    "memory); *staged copy alone* is the engine's staging of the same arrays with nothing queued on "
                    "its pieces (a build reduces the positions' bounds on them)" if one_pass else "")),
