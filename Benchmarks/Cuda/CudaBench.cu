@@ -231,19 +231,18 @@ std::vector<octoray::cuda::CopyPart> StagedParts(Cloud& c, void* device)
   return parts;
 }
 
-std::size_t StagedBytes(Cloud& c)
+// The bytes of all the cloud's arrays: as the caller holds them, or as the
+// staging lands them.
+enum class Held
+{
+  ByCaller,
+  Landed
+};
+std::size_t TotalBytes(Cloud& c, Held held)
 {
   std::size_t total = 0;
   for (const HostArray& a : InputArrays(c))
-    total += a.StagedBytes();
-  return total;
-}
-
-std::size_t InputBytes(Cloud& c)
-{
-  std::size_t total = 0;
-  for (const HostArray& a : InputArrays(c))
-    total += a.bytes;
+    total += held == Held::Landed ? a.StagedBytes() : a.bytes;
   return total;
 }
 
@@ -254,7 +253,7 @@ class PinnedCopy
 {
 public:
   explicit PinnedCopy(Cloud& c)
-    : Bytes(InputBytes(c))
+    : Bytes(TotalBytes(c, Held::ByCaller))
   {
     if (cudaMallocHost(&Host, Bytes) != cudaSuccess || cudaMalloc(&Device, Bytes) != cudaSuccess)
     {
@@ -364,7 +363,7 @@ double HostHalfBesidePinnedCopy(HostHalfOfStaging& half, PinnedCopy& copy, Cloud
 double StagedCopySeconds(Cloud& c)
 {
   void* device = nullptr;
-  if (cudaMalloc(&device, StagedBytes(c)) != cudaSuccess)
+  if (cudaMalloc(&device, TotalBytes(c, Held::Landed)) != cudaSuccess)
   {
     cudaGetLastError();
     return 0.0;
@@ -499,7 +498,7 @@ UploadPeers MeasureUploadPeers(Cloud& c)
 {
   void* device = nullptr;
   UploadPeers peers;
-  if (cudaMalloc(&device, InputBytes(c)) != cudaSuccess)
+  if (cudaMalloc(&device, TotalBytes(c, Held::ByCaller)) != cudaSuccess)
     return peers;
   auto copyAll = [&](bool registerFirst) {
     char* to = static_cast<char*>(device);
@@ -784,7 +783,7 @@ int Run(int argc, char** argv)
                 "the reflectivity as 16-bit codes)\n",
       n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
       hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged * 1e3,
-      StagedBytes(c) / 1e6);
+      TotalBytes(c, Held::Landed) / 1e6);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
