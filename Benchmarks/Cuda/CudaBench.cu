@@ -204,7 +204,7 @@ struct HostArray
   // The engine's staging's part for it, landing at `to`.
   octoray::cuda::CopyPart Part(void* to) const
   {
-    octoray::cuda::CopyPart part{ to, data, StagedBytes(), "staged copy peer", nullptr };
+    octoray::cuda::CopyPart part{ to, data, StagedBytes(), "staged copy peer" };
     part.unitCodes = unitCodes;
     return part;
   }

@@ -339,17 +339,16 @@ inline unsigned RangeBlocks(std::size_t items)
   return std::max(1u, std::min(kMaxRangeBlocks, Blocks((items + kRangeItemsPerThread - 1) / kRangeItemsPerThread)));
 }
 
-// The reduction of items [begin, end) of `data`: combine over every
+// The reduction of items [0, n) of `data`: combine over every
 // map(i, data), one result a block in partial[blockIdx.x].
 template <typename T, typename R, typename Map, typename Combine>
-__global__ void ReduceRangeKernel(const T* data, std::size_t begin, std::size_t end, R identity, Map map,
-  Combine combine, R* partial)
+__global__ void ReduceRangeKernel(const T* data, std::size_t n, R identity, Map map, Combine combine, R* partial)
 {
   using BlockReduce = cub::BlockReduce<R, kBlock>;
   __shared__ typename BlockReduce::TempStorage temp;
   R sum = identity;
   const std::size_t stride = gridDim.x * std::size_t(blockDim.x);
-  for (std::size_t i = begin + blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; i < end; i += stride)
+  for (std::size_t i = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x; i < n; i += stride)
   {
     sum = combine(sum, map(i, data));
   }
@@ -495,36 +494,33 @@ public:
   using Fills = std::vector<cuda::CopyPart>;
   // A copy of `source` (host memory, or device memory: a caller's CUDA
   // arrays, copied on the device) with the reduction of its items of
-  // `stride` elements: each piece of the copy is reduced on the stream that
-  // copied it as soon as it lands (CudaUpload.h: no piece splits an item of
-  // three floats or doubles), while the rest of the array is still on its
-  // way, and the pieces' results once the copy is complete. prepareAlong
-  // adds copies that go in the same pass. It runs once this array's memory
-  // is taken, so theirs comes after it in the pool, as before the one pass:
-  // taken first, it left the build's level phase at 10 M points 0.15 ms
-  // slower in two calls, though not with other piece sizes
-  // (Benchmarks/gpu/variants-one-pass.txt; the pool's layout, not
-  // explained). Where this array is staged with those copies,
+  // `stride` elements, one loop over the whole array once it has landed.
+  // Before, the staging threads queued a loop on each piece as it landed,
+  // on their own streams. With one loop, eight rounds each in turn on an
+  // H200, the whole call at 1 M points took 2.61-3.25 times the pinned copy
+  // against 2.78-3.46 (medians 2.80 and 2.94), at 10 M 1.29-1.39 against
+  // 1.34-1.51 (medians 1.335 and 1.355), at 100 M 1.15-1.27 against
+  // 1.16-1.25 (1.18 and 1.20) (Benchmarks/gpu/variants-whole-bounds.txt);
+  // why a loop a piece cost the staging more than one loop costs after it
+  // was not established. prepareAlong adds copies that go in the same
+  // pass. It runs once this array's memory is taken, so theirs comes after
+  // it in the pool, as before the one pass: taken first, it left the
+  // build's level phase at 10 M points 0.15 ms slower in two calls, though
+  // not with other piece sizes (Benchmarks/gpu/variants-one-pass.txt; the
+  // pool's layout, not explained). Where this array is staged with those copies,
   // whenReduced(result, staged), if given, runs on the host once it has
   // landed and been reduced, while they are still on their way
-  // (HostStaging::Copy's afterFirst): loops it queues over the array
-  // overlap their copies. Elsewhere (nothing left on its way) it does not
-  // run, and the caller queues them after the copy.
+  // (HostStaging::Copy's afterFirst): the reduction and the loops it queues
+  // over the array overlap their copies. Elsewhere (nothing left on its
+  // way) it does not run, and the caller queues them after the copy.
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
     Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
     const std::function<void(const R&, const T*)>& whenReduced = nullptr)
   {
     Fills along;
-    const std::size_t itemBytes = stride * sizeof(T);
-    if (cuda::kPieceAlignment % itemBytes != 0)
-    {
-      throw Error(std::string("octoray: the staged copy's pieces would split items of ") + what);
-    }
     Staged<T> staged;
     result = identity;
-    Buffer<R> partial;
-    std::atomic<std::size_t> used{ 0 };
     if (source)
     {
       Reserve(staged, n, what);
@@ -538,19 +534,9 @@ public:
       Staging.Copy(along);
       return staged;
     }
-    Reserve(partial, n / (cuda::kBlock * cuda::kRangeItemsPerThread) + cuda::MaxPieces(n * sizeof(T)),
-      "partial reductions");
+    along.insert(along.begin(), cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what });
     const T* data = staged.Get();
-    R* partials = partial.Get();
-    along.insert(along.begin(), cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what,
-      [&](std::size_t begin, std::size_t end, cudaStream_t stream) {
-        const unsigned blocks = cuda::RangeBlocks((end - begin) / itemBytes);
-        const std::size_t slot = used.fetch_add(blocks);
-        LaunchOn(stream, "ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock,
-          data, begin / itemBytes, end / itemBytes, identity, map, combine, partials + slot);
-      } });
-    // Every piece's partial result is queued once the array is.
-    const auto reduce = [&] { result = Reduce(used.load(), identity, cuda::PartialResult<R>{ partials }, combine); };
+    const auto reduce = [&] { result = ReduceItems(data, n / stride, identity, map, combine); };
     std::function<void()> afterArray;
     if (whenReduced)
     {
@@ -575,7 +561,7 @@ public:
     if (source)
     {
       Reserve(staged, n, what);
-      fills.push_back(cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what, nullptr });
+      fills.push_back(cuda::CopyPart{ staged.Get(), source, n * sizeof(T), what });
     }
     return staged;
   }
@@ -597,7 +583,7 @@ public:
       ForEach("UnitCodesKernel", n, OCTORAY_LAMBDA(std::size_t i) { to[i] = EncodeUnitScalar(values[i]).code; });
       return codes;
     }
-    cuda::CopyPart part{ to, source, n * sizeof(std::uint16_t), what, nullptr };
+    cuda::CopyPart part{ to, source, n * sizeof(std::uint16_t), what };
     part.unitCodes = true;
     fills.push_back(std::move(part));
     return codes;
@@ -706,6 +692,19 @@ public:
     const std::size_t entries = static_cast<std::size_t>(counted) * tiles + 1;
     Launch(name, cuda::NestedPlaceKernel<FirstList>, cuda::Blocks(32 * tiles), cuda::kBlock, n, tiles, firstList,
       out, tally.Get() + entries);
+  }
+
+  // combine over map(i, data) for every item i < items of `data`: a grid
+  // of at most kMaxRangeBlocks, then their results.
+  template <typename T, typename R, typename Map, typename Combine>
+  R ReduceItems(const T* data, std::size_t items, R identity, Map map, Combine combine)
+  {
+    const unsigned blocks = cuda::RangeBlocks(items);
+    Buffer<R> partial;
+    Reserve(partial, blocks, "partial reductions");
+    Launch("ReduceRangeKernel", cuda::ReduceRangeKernel<T, R, Map, Combine>, blocks, cuda::kBlock, data, items,
+      identity, map, combine, partial.Get());
+    return Reduce(blocks, identity, cuda::PartialResult<R>{ partial.Get() }, combine);
   }
 
   template <typename T, typename Map, typename Combine>

@@ -10,10 +10,9 @@
 // the DMA overlap and several host threads keep the bus busy; the threads
 // and buffers are made at the first such copy and kept. Arrays already in
 // device memory (a CUDA simulation's) and page-locked host arrays are
-// copied directly. A caller may queue work on each piece as it lands
-// (Landed), which then runs while the rest of the array is still on its
-// way, and on the whole first array once it has landed, while the others
-// are (Copy's afterFirst). Only compiled by nvcc.
+// copied directly. A caller may queue work on the whole first array once
+// it has landed, while the others are still on their way (Copy's
+// afterFirst). Only compiled by nvcc.
 #pragma once
 
 #include "CudaSupport.h"
@@ -38,9 +37,6 @@ namespace cuda
 // of the bus's speed) takes about as long as waking the staging threads
 // and queueing their pieces.
 constexpr std::size_t kStagingThreshold = std::size_t(1) << 20;
-// Work queued on a piece of a copy, bytes [begin, end) of the destination,
-// once it has landed: on `stream`, in whose order the piece's copy ran.
-using Landed = std::function<void(std::size_t begin, std::size_t end, cudaStream_t stream)>;
 
 // Where the device reads `p` if CUDA can copy from it without staging
 // (device, managed or page-locked host memory); else null.
@@ -61,7 +57,7 @@ inline bool DirectlyCopyable(const void* p)
 }
 
 // One array of a copy: `bytes` from `source` (host or device memory) to
-// `device`, and the work to queue on each of its pieces as it lands. A part
+// `device`. A part
 // of unit codes takes floats from pageable host memory and lands their
 // Scalar16 codes (EncodeUnitScalars, made as each piece is staged; `bytes`
 // counts the codes): half the bytes over the bus.
@@ -71,7 +67,6 @@ struct CopyPart
   const void* source;
   std::size_t bytes;
   std::string what; // names the array in an error
-  Landed landed;
   bool unitCodes = false;
 };
 
@@ -111,20 +106,19 @@ public:
   ~HostStaging() { Free(); }
 
   // Copies `bytes` from `source` (host or device memory) to `device` on the
-  // current device; returns once the copy, and the work `landed` queued on
-  // its pieces, is complete.
-  void Copy(void* device, const void* source, std::size_t bytes, const char* what, const Landed& landed = nullptr)
+  // current device; returns once the copy is complete.
+  void Copy(void* device, const void* source, std::size_t bytes, const char* what)
   {
-    Copy({ CopyPart{ device, source, bytes, what, landed } });
+    Copy({ CopyPart{ device, source, bytes, what } });
   }
 
   // Copies every part, after the loops queued on the default stream (the
   // staging streams do not wait for them by themselves); returns once the
-  // copies and the work queued on their pieces are complete. Parts CUDA
-  // copies directly go so; the others are staged in one pass.
+  // copies are complete. Parts CUDA copies directly go so; the others are
+  // staged in one pass.
   // Where the first part is staged with others, afterFirst(), if given,
-  // runs on the host as soon as that part and the work on its pieces are
-  // queued, with the default stream waiting for them, while the others are
+  // runs on the host as soon as that part's pieces are queued, with the
+  // default stream waiting for them, while the others are
   // still on their way: it can queue loops over the first part that overlap
   // the rest of the copy. It may run on a staging thread; what it throws
   // reaches the caller once every part is copied. Returns whether it ran:
@@ -223,7 +217,7 @@ private:
   };
 
   // cudaMemcpy, which goes from pageable memory through the driver's own
-  // bounce buffer, and the part's landed work on the default stream.
+  // bounce buffer.
   static void CopyDirectly(const CopyPart& part)
   {
     std::vector<std::uint16_t> codes;
@@ -235,11 +229,6 @@ private:
       source = codes.data();
     }
     CudaCheck(cudaMemcpy(part.device, source, part.bytes, cudaMemcpyDefault), part.what.c_str());
-    if (part.landed)
-    {
-      part.landed(0, part.bytes, 0);
-      CudaCheck(cudaStreamSynchronize(0), part.what.c_str());
-    }
   }
 
   // The pieces this lane's thread takes, through the lane's two pinned
@@ -263,10 +252,6 @@ private:
                   cudaMemcpyHostToDevice, lane.stream),
         what);
       CudaCheck(cudaEventRecord(lane.copied[b], lane.stream), what);
-      if (part.landed)
-      {
-        part.landed(offset, offset + n, lane.stream);
-      }
       watch.Queued(lane, piece.array, what);
     });
     CudaCheck(cudaStreamSynchronize(lane.stream), what);

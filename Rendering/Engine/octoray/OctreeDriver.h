@@ -9,7 +9,7 @@
 //   StageReduced(host, n, stride, what, identity, map, combine, result, prepareAlong, whenReduced)
 //                                     a caller's array where loops read it (the array itself on the CPU, a copy
 //                                     on CUDA), and combine over map(i, host) for every item i of `stride`
-//                                     elements into result: on CUDA reduced piece by piece as the copy lands;
+//                                     elements into result: on CUDA once the copy has landed;
 //                                     prepareAlong(fills), called once its memory is taken, adds copies
 //                                     (Prepare's) that go in the same pass; whenReduced(result, staged) runs
 //                                     once this array has landed where those are still on their way (CUDA's
@@ -132,11 +132,11 @@ std::function<void(const Bounds&, const T*)> WhenStagedBounded(const WhenBounded
 }
 
 // A caller's positions staged, with their bounds (PositionBounds, and the
-// first non-finite point) reduced as the copy lands: on CUDA they cost
-// nothing beyond the upload. prepareAlong adds copies (Device::Prepare's)
-// to make in the positions' pass, once their memory is taken, after the
-// positions; whenBounded, if given, runs once the positions have landed,
-// while those copies may still be on their way.
+// first non-finite point) reduced once they have landed: on CUDA, where
+// attributes follow, while those are on their way. prepareAlong adds
+// copies (Device::Prepare's) to make in the positions' pass, once their
+// memory is taken, after the positions; whenBounded, if given, runs once
+// the positions have landed, while those copies may still be on their way.
 template <class Device>
 StagedPositions<Device> StageBoundedPositions(Device& d, const float* xyzFloat, const double* xyzDouble,
   std::size_t n, const char* what, Bounds& bounds,

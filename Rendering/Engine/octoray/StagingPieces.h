@@ -16,8 +16,9 @@ namespace octoray
 {
 namespace cuda
 {
-// Pieces start at multiples of this (3 x 256 bytes) into their arrays, so
-// that no piece splits a point of three floats or doubles.
+// Pieces start at multiples of this (3 x 256 bytes) into their arrays: on
+// 256-byte boundaries and whole points of three floats or doubles, and a
+// piece of codes (half as long) on whole values.
 constexpr std::size_t kPieceAlignment = 768;
 // Each pinned buffer (about 4 MB, a multiple of kPieceAlignment): large
 // enough that what a piece costs beyond its bytes (about 4.5 us, PieceBytes)
