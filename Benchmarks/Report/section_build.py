@@ -153,14 +153,13 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measured: the thirty-ninth
-# session's rounds of "avx2" (call 5, at c9c93d4, the report's commit, on
-# the machine the report's call then ran on) in its variants file
-# (COMMAND.md).
-ROUNDS_ENGINE = "c9c93d4"
-ROUNDS_SESSION = "thirty-ninth"
-ROUNDS_FILE = "variants-unit-codes.txt"
-ROUNDS_VARIANTS = ("avx2",)
+# More rounds of the engine this report's run measured: the fortieth
+# session's rounds of "wholebounds" (calls 2 and 3, 42ed685 with the patch
+# that a74e097 keeps, on one machine) in its variants file (COMMAND.md).
+ROUNDS_ENGINE = "a74e097"
+ROUNDS_SESSION = "fortieth"
+ROUNDS_FILE = "variants-whole-bounds.txt"
+ROUNDS_VARIANTS = ("wholebounds-2", "wholebounds-3")
 
 
 def more_rounds(ctx, n):
@@ -1034,7 +1033,7 @@ def _cuda(ctx):
         "The positions' bounds, which the keys need, are reduced on the device as the staged copy "
         "lands, and count in the upload. From 064700a each piece of the positions was reduced as it landed, on "
         "the stream that had copied it, where a CUB reduction after the upload had read them again (0.46 ms at "
-        "100 M points, when the sort still waited for the whole copy); since the fortieth session the positions "
+        "100 M points, when the sort still waited for the whole copy); since a74e097 the positions "
         "are reduced in one loop once they have all landed, while the attributes are still on their way "
         "(Device::StageReduced: one ReduceRangeKernel launch in the profile). Eight rounds each in turn on an "
         "H200, the whole call at 1 M points took 2.61–3.25 times the pinned copy against 2.78–3.46 with a loop a "
