@@ -82,16 +82,19 @@ if want tests; then
   step mapper-tests bash -c "cd $build && ctest -R '$mapper_tests' --no-tests=error --output-on-failure --output-junit '$out/mapper-tests.xml'"
 fi
 
+# The engine's tests of launches the CUDA runtime refuses on purpose.
+refused='CudaFaultsLaunch*:*RefusedIsNamed'
 if want sanitize; then
-  # CudaFaultsLaunch makes the CUDA runtime refuse launches on purpose, which
-  # compute-sanitizer counts as API errors; it runs under memcheck on its
+  # The tests of refused launches (CudaFaultsLaunch, and the device checks'
+  # *RefusedIsNamed) make the CUDA runtime refuse launches on purpose, which
+  # compute-sanitizer counts as API errors; they run under memcheck on their
   # own, with API errors not reported, so the error paths are still checked.
   tests='*CUDA*:CudaFaults*'
   engine=$build/bin/octoray_engine_tests
-  step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 $engine --gtest_filter="$tests:-CudaFaultsLaunch*"
-  step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 1 $engine --gtest_filter='CudaFaultsLaunch*'
-  step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
-  step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:CudaFaultsLaunch*"
+  step memcheck compute-sanitizer --tool memcheck --error-exitcode 1 $engine --gtest_filter="$tests:-$refused"
+  step memcheck-refused compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 1 $engine --gtest_filter="$refused"
+  step initcheck compute-sanitizer --tool initcheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:$refused"
+  step synccheck compute-sanitizer --tool synccheck --error-exitcode 1 $engine --gtest_filter="$tests:-*EveryDepth*:$refused"
   # Every CUDA mapper test under memcheck, with the command CTest runs.
   (cd $build && ctest -L gpu -R "$mapper_tests" -N -V) | sed -n 's/^[0-9]*: Test command: //p' > "$out/mapper-commands.txt"
   # A test's own failure is the mapper-tests step's business: here only
@@ -100,7 +103,7 @@ if want sanitize; then
 fi
 if want racecheck; then
   step racecheck compute-sanitizer --tool racecheck --error-exitcode 1 $build/bin/octoray_engine_tests \
-    --gtest_filter='*CUDA*:CudaFaults*:-*EveryDepth*:CudaFaultsLaunch*'
+    --gtest_filter="*CUDA*:CudaFaults*:-*EveryDepth*:$refused"
 fi
 
 if want bench; then
