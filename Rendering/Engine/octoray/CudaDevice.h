@@ -19,7 +19,6 @@
 #include <thrust/iterator/transform_iterator.h>
 
 #include <algorithm>
-#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -492,27 +491,27 @@ public:
   // Copies that Prepare adds for a StageReduced to make in the same pass of
   // the staging threads as its own.
   using Fills = std::vector<cuda::CopyPart>;
-  // A copy of `source` (host memory, or device memory: a caller's CUDA
-  // arrays, copied on the device) with the reduction of its items of
-  // `stride` elements, one loop over the whole array once it has landed.
-  // Before, the staging threads queued a loop on each piece as it landed,
-  // on their own streams. With one loop, eight rounds each in turn on an
-  // H200, the whole call at 1 M points took 2.61-3.25 times the pinned copy
-  // against 2.78-3.46 (medians 2.80 and 2.94), at 10 M 1.29-1.39 against
-  // 1.34-1.51 (medians 1.335 and 1.355), at 100 M 1.15-1.27 against
-  // 1.16-1.25 (1.18 and 1.20) (Benchmarks/gpu/variants-whole-bounds.txt);
-  // why a loop a piece cost the staging more than one loop costs after it
-  // was not established. prepareAlong adds copies that go in the same
-  // pass. It runs once this array's memory is taken, so theirs comes after
-  // it in the pool, as before the one pass: taken first, it left the
-  // build's level phase at 10 M points 0.15 ms slower in two calls, though
-  // not with other piece sizes (Benchmarks/gpu/variants-one-pass.txt; the
-  // pool's layout, not explained). Where this array is staged with those copies,
-  // whenReduced(result, staged), if given, runs on the host once it has
-  // landed and been reduced, while they are still on their way
-  // (HostStaging::Copy's afterFirst): the reduction and the loops it queues
-  // over the array overlap their copies. Elsewhere (nothing left on its
-  // way) it does not run, and the caller queues them after the copy.
+  // A copy of `source` (host memory, or device memory: a caller's CUDA arrays,
+  // copied on the device) with the reduction of its items of `stride`
+  // elements, one loop over the whole array once it has landed. Before, the
+  // staging threads queued a loop on each piece as it landed, on their own
+  // streams. With one loop, eight rounds each in turn on an H200, the whole
+  // call at 1 M points took 2.61-3.25 times the pinned copy against 2.78-3.46
+  // (medians 2.80 and 2.94), at 10 M 1.29-1.39 against 1.34-1.51 (medians
+  // 1.335 and 1.355), at 100 M 1.15-1.27 against 1.16-1.25 (1.18 and 1.20)
+  // (Benchmarks/gpu/variants-whole-bounds.txt); why a loop a piece cost the
+  // staging more than one loop costs after it was not established.
+  // prepareAlong adds copies that go in the same pass. It runs once this
+  // array's memory is taken, so theirs comes after it in the pool, as before
+  // the one pass: taken first, it left the build's level phase at 10 M points
+  // 0.15 ms slower in two calls, though not with other piece sizes
+  // (Benchmarks/gpu/variants-one-pass.txt; the pool's layout, not explained).
+  // Where this array is staged with those copies, whenReduced(result, staged),
+  // if given, runs on the host once it has landed and been reduced, while they
+  // are still on their way (HostStaging::Copy's afterFirst): the reduction and
+  // the loops it queues over the array overlap their copies. Elsewhere
+  // (nothing left on its way) it does not run, and the caller queues them
+  // after the copy.
   template <typename T, typename R, typename Map, typename Combine>
   Staged<T> StageReduced(const T* source, std::size_t n, int stride, const char* what, R identity, Map map,
     Combine combine, R& result, const std::function<void(Fills&)>& prepareAlong = nullptr,
