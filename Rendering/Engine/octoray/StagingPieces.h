@@ -128,14 +128,6 @@ inline std::vector<Piece> CutPieces(const StagingRun& run, int threads)
   return pieces;
 }
 
-// The most pieces that fall in one array of `bytes`: all but its last hold
-// kEdgePiece or more (the StagingPieces test checks the bound). It sizes the
-// partial results of the pieces' reductions.
-inline std::size_t MaxPieces(std::size_t bytes)
-{
-  return bytes / kEdgePiece + 1;
-}
-
 // Deals a run's pieces to the threads that copy them: each takes the next
 // piece as it becomes free, so a thread that runs slower, sharing its core
 // with another, takes fewer. With one stripe of the run a thread, the
