@@ -57,10 +57,9 @@ inline bool DirectlyCopyable(const void* p)
 }
 
 // One array of a copy: `bytes` from `source` (host or device memory) to
-// `device`. A part
-// of unit codes takes floats from pageable host memory and lands their
-// Scalar16 codes (EncodeUnitScalars, made as each piece is staged; `bytes`
-// counts the codes): half the bytes over the bus.
+// `device`. A part of unit codes takes floats from pageable host memory and
+// lands their Scalar16 codes (EncodeUnitScalars, made as each piece is
+// staged; `bytes` counts the codes): half the bytes over the bus.
 struct CopyPart
 {
   void* device;
@@ -118,9 +117,9 @@ public:
   // staged in one pass.
   // Where the first part is staged with others, afterFirst(), if given,
   // runs on the host as soon as that part's pieces are queued, with the
-  // default stream waiting for them, while the others are
-  // still on their way: it can queue loops over the first part that overlap
-  // the rest of the copy. It may run on a staging thread; what it throws
+  // default stream waiting for them, while the others are still on their
+  // way: it can queue loops over the first part that overlap the rest of
+  // the copy. It may run on a staging thread; what it throws
   // reaches the caller once every part is copied. Returns whether it ran:
   // where nothing is left on its way, there is nothing to overlap.
   bool Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
