@@ -1155,7 +1155,7 @@ def _cuda(ctx):
                 "100 M points: with them reduced in one launch after the copy, or every four pieces, the whole call "
                 "there took 1.57–1.59 and 1.50–1.56 times the pinned copy against 1.56–1.60 (call 5), within the "
                 "host's spread (the staged copy alone moved between 38.7 and 49.2 ms from run to run); at 1 M "
-                "points, where they weigh more, one loop once the positions have landed made the call about 5 % "
+                "points, where they weigh more, one loop once the positions have landed made the call's median about 5 % "
                 "shorter in the fortieth session's rounds, and a74e097 keeps it (above).",
                 "",
                 "Where the staging's pass loses, timed piece by piece (a diagnostic build of CudaUpload.h, "

@@ -499,8 +499,11 @@ public:
   // call at 1 M points took 2.61-3.25 times the pinned copy against 2.78-3.46
   // (medians 2.80 and 2.94), at 10 M 1.29-1.39 against 1.34-1.51 (medians
   // 1.335 and 1.355), at 100 M 1.15-1.27 against 1.16-1.25 (1.18 and 1.20)
-  // (Benchmarks/gpu/variants-whole-bounds.txt); why a loop a piece cost the
-  // staging more than one loop costs after it was not established.
+  // (Benchmarks/gpu/variants-whole-bounds.txt). In ncu the one loop took
+  // 55 us at 10 M points where the 65 loops a piece took 696, and 0.45 ms at
+  // 100 M where 321 took 3.64 (Benchmarks/gpu/profile-build*.txt, the
+  // reports' runs at 1c3ac4a and c9c93d4): each small loop ran at 0.2-0.3
+  // TB/s. Whether they held up the staging, and how, was not established.
   // prepareAlong adds copies that go in the same pass. It runs once this
   // array's memory is taken, so theirs comes after it in the pool, as before
   // the one pass: taken first, it left the build's level phase at 10 M points
