@@ -119,9 +119,9 @@ public:
   // runs on the host as soon as that part's pieces are queued, with the
   // default stream waiting for them, while the others are still on their
   // way: it can queue loops over the first part that overlap the rest of
-  // the copy. It may run on a staging thread; what it throws
-  // reaches the caller once every part is copied. Returns whether it ran:
-  // where nothing is left on its way, there is nothing to overlap.
+  // the copy. It may run on a staging thread; what it throws reaches the
+  // caller once every part is copied. Returns whether it ran: where nothing
+  // is left on its way, there is nothing to overlap.
   bool Copy(const std::vector<CopyPart>& parts, const std::function<void()>& afterFirst = nullptr)
   {
     std::vector<CopyPart> staged;
