@@ -20,15 +20,13 @@ SANITIZERS = [
 ]
 
 
-# Why the report's call's memcheck step failed, where the sanitizers' own
+# Where the report's call's memcheck step failed while the sanitizers' own
 # call (summary-sanitize.txt, read first: make_report.SANITIZER_SUMMARIES)
-# ran after it.
-MEMCHECK_REFUSED_NOTE = (
-    "The memcheck step of this call failed on two API errors, both in CudaDeviceCUDA.UnitCodesLoopRefusedIsNamed, "
-    "a launch the test has the CUDA runtime refuse on purpose, which gpu-check.sh's filter did not yet set apart "
-    "from the tests that must raise none; the sanitizers found no memory error. With the filter mended (1c3ac4a: "
-    "the refused launches run under memcheck without API errors, as CudaFaultsLaunch's do) the sanitizers ran "
-    "again in the next call, on the same engine: the compute-sanitizer rows above are that call's "
+# is on record, the section says which rows stand. Why it failed is the
+# call's business, written in COMMAND.md beside its command.
+MEMCHECK_FAILED_NOTE = (
+    "The memcheck step of this call failed; COMMAND.md says why, and which call ran the sanitizers again. The "
+    "compute-sanitizer rows above are read from that call's closing table first "
     "([gpu/summary-sanitize.txt](gpu/summary-sanitize.txt)).")
 
 
@@ -156,7 +154,7 @@ def render(ctx):
         rows.append((what, result))
     steps = [line for line in summary.splitlines() if re.match(r"^[a-z0-9-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
     memcheck_failed = any(re.match(r"^memcheck\s+FAIL", line) for line in steps)
-    steps_note = [MEMCHECK_REFUSED_NOTE, ""] if memcheck_failed and ctx.gpu_file("summary-sanitize.txt") else []
+    steps_note = [MEMCHECK_FAILED_NOTE, ""] if memcheck_failed and ctx.gpu_file("summary-sanitize.txt") else []
 
     text = [
         f"Device: {device or 'see gpu/gpu.txt'}; run of {heading[0] if heading else 'unknown date'}. Command: "
