@@ -214,12 +214,6 @@ def gpu_check_heading(text):
 # (COMMAND.md says which): its other tools where the report's call left
 # them out, and racecheck, the slowest.
 GPU_SUMMARIES = ("summary.txt", "summary-sanitize.txt", "summary-racecheck.txt")
-# The compute-sanitizer rows read the sanitizers' own call first: the
-# fortieth session's ran after the report's, on the same engine, once
-# gpu-check.sh's filter set apart a refused launch that the report's call's
-# memcheck had counted (COMMAND.md).
-SANITIZER_SUMMARIES = ("summary-sanitize.txt", "summary.txt", "summary-racecheck.txt")
-
 
 def gpu_summaries(folder, names=GPU_SUMMARIES):
     """[(file name, text)] of the summaries `names` present in `folder`."""

@@ -153,56 +153,70 @@ TILED_FILE = "orbit-tiled.json"
 TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 
 
-# More rounds of the engine this report's run measured: the fortieth
-# session's rounds of "wholebounds" (calls 2 and 3, 42ed685 with the patch
-# that a74e097 keeps, on one machine) in its variants file (COMMAND.md).
+# More rounds of the engine this report's run measured, on other H200
+# machines, each (session, variants file, its parts): the fortieth session's
+# rounds of "wholebounds" (calls 2 and 3, 42ed685 with the patch that
+# a74e097 keeps, on one machine) and the forty-first's of "main" (calls 3
+# and 4, at 68179e4, beside a variant not kept) (COMMAND.md).
 ROUNDS_ENGINE = "a74e097"
-ROUNDS_SESSION = "fortieth"
-ROUNDS_FILE = "variants-whole-bounds.txt"
-ROUNDS_VARIANTS = ("wholebounds-2", "wholebounds-3")
+ROUNDS = (
+    ("fortieth", "variants-whole-bounds.txt", ("wholebounds-2", "wholebounds-3")),
+    ("forty-first", "variants-hugepages.txt", ("main-3", "main-4")),
+)
 
 
 def more_rounds(ctx, n):
-    """The whole call / pinned copy ratios of those rounds at n points."""
-    path = ctx.gpu_file(ROUNDS_FILE)
-    if not path:
-        return []
-    runs = summary_figures(path)
-    return sum((runs[(v, n)]["call"] for v in ROUNDS_VARIANTS), [])
+    """[(session, file, parts, whole call / pinned copy ratios at n points)]
+    of those rounds whose files are present."""
+    found = []
+    for session, name, parts in ROUNDS:
+        path = ctx.gpu_file(name)
+        if path:
+            runs = summary_figures(path)
+            found.append((session, name, parts, sum((runs[(p, n)]["call"] for p in parts), [])))
+    return found
 
 
 # The twenty-seventh session's runs on an NVIDIA H200 (COMMAND.md): the
 # benchmark; and the variants of that session and later ones, each built
 # beside main and run in turn, not kept. Their "summary n=..." lines are
 # scripts/gpu/build-ratios.py's, under a line "== source-NAME" for each
-# variant of a variants file ("main" the engine it was built beside).
+# variant of a variants file ("main" the engine it was built beside). Each
+# entry: the file, the parts of main's rounds, those of the variant's, and
+# what the variant tried.
 H200_BENCH_FILE = "bench-h200.txt"
 H200_VARIANTS = (
-    ("variants-staging-one-stream.txt", "one",
+    ("variants-staging-one-stream.txt", ("main",), ("one",),
      "every staging thread's DMA queued on one copy stream, where each thread has its own"),
-    ("variants-nested-tiles4.txt", "tiles4", "the nested lists in warp tiles of 4 rounds, where they hold 8"),
-    ("variants-staging-pieces.txt", "hook",
+    ("variants-nested-tiles4.txt", ("main",), ("tiles4",),
+     "the nested lists in warp tiles of 4 rounds, where they hold 8"),
+    ("variants-staging-pieces.txt", ("main",), ("hook",),
      "the thirtieth session's cube check and sort queued from a thread of their own, where the staging thread "
      "that queued the positions' last piece queues them"),
-    ("variants-gather-staged.txt", "gather-staged",
+    ("variants-gather-staged.txt", ("main",), ("gather-staged",),
      "the thirty-first session's records written in sorted order straight from the staged attribute arrays, one "
      "loop an attribute, where they are gathered from the point records (the sort phase with the gather took "
      "0.79–0.80 ms at 10 M points against 0.76–0.77, and 9.65 ms at 100 M against 7.10–7.12)"),
-    ("variants-leaf-parents.txt", "leaf-parents",
+    ("variants-leaf-parents.txt", ("main",), ("leaf-parents",),
      "the thirty-third session's leaves reduced in the loop of the level above them, a thread a parent that "
      "reads its leaves back where it has just written them (in ncu at 10 M points that launch took 376 µs where "
      "the leaves and level 9 took 164 + 101)"),
-    ("variants-overlapped-launches.txt", "overlapped",
+    ("variants-overlapped-launches.txt", ("main",), ("overlapped",),
      "the thirty-third session's build kernels launched to begin while the kernel before each ends (Hopper's "
      "programmatic dependent launch), each waiting there for that kernel's writes"),
-    ("variants-loads-first.txt", "loads-first",
+    ("variants-loads-first.txt", ("main",), ("loads-first",),
      "the thirty-third session's leaf and inner loops loading everything before they store anything (in ncu at "
      "10 M points the leaves took 164.4 µs and level 9 104.4, where they took 164.0 and 101.0)"),
-    ("variants-landed-records.txt", "landed",
+    ("variants-landed-records.txt", ("main",), ("landed",),
      "the twenty-ninth session's records stored as each piece of the attributes lands, in the caller's order and "
      "ranked by the sort during the upload, where they are made and gathered in sorted order after the copy (the "
      "staging threads were held up, for a reason not established, and at 100 M points the random writes ran "
      "9–11 ms past the copy)"),
+    ("variants-hugepages.txt", ("main-3", "main-4"), ("hugepages-3", "hugepages-4"),
+     "the forty-first session's staging buffers in one region of 2 MB pages, registered once, where each is a "
+     "page-locked allocation of its own in 4 kB pages (main's two rounds in which the host copied at about half "
+     "its speed read 1.79 and 1.89; one of the variant's read 1.98, its host's half and the pinned copy at once "
+     "6.83 ms)"),
 )
 
 
@@ -255,12 +269,13 @@ def _h200(ctx):
                 H200_BENCH_FILE, H200_BENCH_FILE, len(ten["ratio"]), spread(ten["phases"], "%.3f"),
                 spread(ten["floor"], "%.3f"), spread(ten["ratio"]), spread(hundred["ratio"]), spread(ten["call"]),
                 spread(hundred["call"])))
-    for name, variant, tried in H200_VARIANTS:
+    for name, main_parts, variant_parts, tried in H200_VARIANTS:
         path = ctx.gpu_file(name)
         if not path:
             continue
         rounds = summary_figures(path)
-        main, other = (rounds[(v, 10000000)] for v in ("main", variant))
+        main, other = ({k: sum((rounds[(p, 10000000)][k] for p in parts), []) for k in SUMMARY_FIGURES}
+                       for parts in (main_parts, variant_parts))
         text += (" Built beside main and run in turn there, %s: at 10 M points the device phases %s ms against "
                  "%s, %s times the sort against %s, the whole call %s times the pinned copy against %s; not kept "
                  "([gpu/%s](gpu/%s))." % (
@@ -1069,15 +1084,19 @@ def _cuda(ctx):
     if all(rounds.values()):
         here = {n: [r["call_over_pinned_copy"] for r in builds if r["depth"] == 10 and r["n"] == n
                     and r.get("call_over_pinned_copy")] for n in rounds}
+
+        def listed(ratios):
+            return ", ".join("%.2f" % r for r in ratios)
+
+        sessions = "; ".join(
+            "in the %s session, %s ([gpu/%s](gpu/%s), the rounds of %s)" % (
+                session, listed(ratios), name, name, " and ".join('"%s"' % p for p in parts))
+            for session, name, parts, ratios in rounds[10000000])
         text += [
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
-            "this run and %s in %d rounds of %s's engine on an H200 machine in the %s session "
-            "([gpu/%s](gpu/%s), the rounds of %s); at 100 M, %s here and %s there." % (
-                ", ".join("%.2f" % r for r in here[10000000]), ", ".join("%.2f" % r for r in rounds[10000000]),
-                len(rounds[10000000]), ROUNDS_ENGINE, ROUNDS_SESSION, ROUNDS_FILE, ROUNDS_FILE,
-                " and ".join('"%s"' % v for v in ROUNDS_VARIANTS),
-                ", ".join("%.2f" % r for r in here[100000000]),
-                ", ".join("%.2f" % r for r in rounds[100000000])),
+            "this run, and in rounds of %s's engine on other H200 machines: %s. At 100 M points, %s here and %s "
+            "there." % (listed(here[10000000]), ROUNDS_ENGINE, sessions, listed(here[100000000]),
+                        "; ".join(listed(r[3]) for r in rounds[100000000])),
             "",
         ]
     if staging:

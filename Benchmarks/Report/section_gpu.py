@@ -6,7 +6,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import SANITIZER_SUMMARIES, Section, file_parts, gpu_check_heading, gpu_summaries, gpu_summary_link
+from make_report import Section, file_parts, gpu_check_heading, gpu_summaries, gpu_summary_link
 
 TITLE = "GPU checks: tests and compute-sanitizer (from the GPU run)"
 
@@ -18,16 +18,6 @@ SANITIZERS = [
     ("initcheck", "initcheck: reads of uninitialised device memory"),
     ("synccheck", "synccheck: invalid uses of __syncthreads and warp synchronisation"),
 ]
-
-
-# Where the report's call's memcheck step failed while the sanitizers' own
-# call (summary-sanitize.txt, read first: make_report.SANITIZER_SUMMARIES)
-# is on record, the section says which rows stand. Why it failed is the
-# call's business, written in COMMAND.md beside its command.
-MEMCHECK_FAILED_NOTE = (
-    "The memcheck step of this call failed; COMMAND.md says why, and which call ran the sanitizers again. The "
-    "compute-sanitizer rows above are read from that call's closing table first "
-    "([gpu/summary-sanitize.txt](gpu/summary-sanitize.txt)).")
 
 
 def produce(ctx):
@@ -143,7 +133,7 @@ def render(ctx):
     clean = 0
     for log, what in SANITIZERS:
         result = "no summary line"
-        for name, text in gpu_summaries(os.path.dirname(summary_path), SANITIZER_SUMMARIES):
+        for name, text in gpu_summaries(os.path.dirname(summary_path)):
             found = re.search(rf"^{re.escape(log)}:\s+(?:\d+ )?=+ (?:ERROR SUMMARY|RACECHECK SUMMARY): (.*)$", text, re.M)
             if found:
                 step = re.search(rf"^{re.escape(log)}\s+(pass|FAIL)\b", text, re.M)
@@ -153,8 +143,6 @@ def render(ctx):
                 break
         rows.append((what, result))
     steps = [line for line in summary.splitlines() if re.match(r"^[a-z0-9-]+\s+(pass|FAIL)\s+\d+ ms$", line)]
-    memcheck_failed = any(re.match(r"^memcheck\s+FAIL", line) for line in steps)
-    steps_note = [MEMCHECK_FAILED_NOTE, ""] if memcheck_failed and ctx.gpu_file("summary-sanitize.txt") else []
 
     text = [
         f"Device: {device or 'see gpu/gpu.txt'}; run of {heading[0] if heading else 'unknown date'}. Command: "
@@ -178,7 +166,6 @@ def render(ctx):
         *steps,
         "```",
         "",
-        *steps_note,
         *_device_checks(ctx),
         *_staging_checks(ctx),
         "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",

@@ -9,7 +9,7 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
-from make_report import SANITIZER_SUMMARIES, Section, gpu_summaries, gpu_summary_link
+from make_report import Section, gpu_summaries, gpu_summary_link
 
 TITLE = "The CUDA mapper in VTK windows (from the GPU run)"
 
@@ -103,7 +103,7 @@ def render(ctx):
     counts = mapper_test_counts(xml)
     test_rows = [(label, f"{c[0]} passed, {c[1]} failed, {c[2]} skipped of {c[3]}"
                   + (f" (failed: {', '.join(c[4])})" if c[4] else "")) for label, c in counts.items()]
-    for name, text in gpu_summaries(os.path.dirname(summary_path), SANITIZER_SUMMARIES):
+    for name, text in gpu_summaries(os.path.dirname(summary_path)):
         memcheck = re.search(r"^memcheck-mapper:\s+(\d+) =+ ERROR SUMMARY: (.*)$", text, re.M)
         if memcheck:
             test_rows.append(("compute-sanitizer memcheck over every CUDA mapper test",
