@@ -258,6 +258,9 @@ private:
 
   // The lanes and their threads, made at the first large copy and kept;
   // false (and the plain copy taken) where page-locked memory cannot be had.
+  // Each buffer is an allocation of its own, in the host's 4 kB pages: all
+  // of them in one region of 2 MB pages staged no faster, in nine rounds on
+  // H200s (Benchmarks/gpu/variants-hugepages.txt).
   bool Allocate()
   {
     if (!Lanes.empty())
