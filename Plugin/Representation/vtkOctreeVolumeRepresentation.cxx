@@ -130,6 +130,38 @@ void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input)
     << remedy << ".");
 }
 
+namespace
+{
+// The ranks of the global controller: 1 without MPI.
+int RankCount()
+{
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  return controller ? controller->GetNumberOfProcesses() : 1;
+}
+
+// The bounds of every rank's piece together (uninitialised where no rank has
+// points), from this rank's `local` (uninitialised where it has none). Every
+// rank must call it: the reduction is collective.
+void ReduceBoundsOverRanks(const double local[6], double global[6])
+{
+  const bool valid = vtkMath::AreBoundsInitialized(local);
+  double sent[6];
+  for (int a = 0; a < 3; ++a)
+  {
+    // Minima and negated maxima: one MIN reduction gives both.
+    sent[2 * a] = valid ? local[2 * a] : VTK_DOUBLE_MAX;
+    sent[2 * a + 1] = valid ? -local[2 * a + 1] : VTK_DOUBLE_MAX;
+  }
+  double reduced[6];
+  vtkMultiProcessController::GetGlobalController()->AllReduce(sent, reduced, 6, vtkCommunicator::MIN_OP);
+  for (int a = 0; a < 3; ++a)
+  {
+    global[2 * a] = reduced[2 * a];
+    global[2 * a + 1] = -reduced[2 * a + 1];
+  }
+}
+}
+
 //----------------------------------------------------------------------------
 int vtkOctreeVolumeRepresentation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -137,80 +169,68 @@ int vtkOctreeVolumeRepresentation::RequestData(
   vtkMath::UninitializeBounds(this->DataBounds);
   this->DataSize = 0;
   this->Cache = nullptr;
-  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
-
+  const int ranks = RankCount();
   if (inputVector[0]->GetNumberOfInformationObjects() == 1)
   {
-    vtkDataObject* data = vtkDataObject::GetData(inputVector[0], 0);
-    if (IsDrawable(data))
-    {
-      vtkDataSet* input = vtkDataSet::SafeDownCast(data);
-      vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
-      if (pointSet && ranks > 1 && this->IsTranslucentBlendMode())
-      {
-        // The view will redistribute the piece for ordered compositing.
-        this->Cache = octoray::PointCloudPiece(pointSet);
-      }
-      else
-      {
-        // A shallow copy: the view may move the piece, and the upstream
-        // filter's output must stay untouched.
-        this->Cache.TakeReference(input->NewInstance());
-        this->Cache->ShallowCopy(input);
-      }
-      if (auto* cached = vtkPointSet::SafeDownCast(this->Cache))
-      {
-        if (!cached->GetPoints())
-        {
-          // An empty piece (a reader's output on the ranks it did not read
-          // on) has no vtkPoints at all; the view's redistribution and
-          // delivery expect one.
-          vtkNew<vtkPoints> none;
-          cached->SetPoints(none);
-        }
-      }
-      if (this->Cache->GetNumberOfPoints() > 0)
-      {
-        this->Cache->GetBounds(this->DataBounds);
-      }
-      this->DataSize = this->Cache->GetActualMemorySize();
-      this->ReportedType.clear();
-    }
-    else if (data)
-    {
-      this->ReportUndrawable(data);
-    }
+    this->CacheInput(vtkDataObject::GetData(inputVector[0], 0), ranks);
   }
   // Data split over ranks: every rank builds its octree in the cube around
   // the global bounds (and, with LeafDepth set, at the same depth), so the
   // ranks' voxels align and depth compositing reproduces the one-rank
   // picture. RequestData runs on every rank of the pipeline update (whatever
   // each rank holds, also nothing or an undrawable type), so the reduction
-  // is collective.
+  // is collective. On one rank the mapper takes the piece's own bounds.
   double globalBounds[6];
   vtkMath::UninitializeBounds(globalBounds);
   if (ranks > 1)
   {
-    double local[6];
-    const bool valid = vtkMath::AreBoundsInitialized(this->DataBounds);
-    for (int a = 0; a < 3; ++a)
-    {
-      // Minima and negated maxima: one MIN reduction gives both.
-      local[2 * a] = valid ? this->DataBounds[2 * a] : VTK_DOUBLE_MAX;
-      local[2 * a + 1] = valid ? -this->DataBounds[2 * a + 1] : VTK_DOUBLE_MAX;
-    }
-    double reduced[6];
-    controller->AllReduce(local, reduced, 6, vtkCommunicator::MIN_OP);
-    for (int a = 0; a < 3; ++a)
-    {
-      globalBounds[2 * a] = reduced[2 * a];
-      globalBounds[2 * a + 1] = -reduced[2 * a + 1];
-    }
+    ReduceBoundsOverRanks(this->DataBounds, globalBounds);
   }
   this->Mapper->SetRootBounds(globalBounds);
 
   return this->Superclass::RequestData(request, inputVector, outputVector);
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::CacheInput(vtkDataObject* data, int ranks)
+{
+  if (!IsDrawable(data))
+  {
+    if (data)
+    {
+      this->ReportUndrawable(data);
+    }
+    return;
+  }
+  vtkDataSet* input = vtkDataSet::SafeDownCast(data);
+  vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
+  if (pointSet && ranks > 1 && this->IsTranslucentBlendMode())
+  {
+    // The view will redistribute the piece for ordered compositing.
+    this->Cache = octoray::PointCloudPiece(pointSet);
+  }
+  else
+  {
+    // A shallow copy: the view may move the piece, and the upstream
+    // filter's output must stay untouched.
+    this->Cache.TakeReference(input->NewInstance());
+    this->Cache->ShallowCopy(input);
+  }
+  auto* cached = vtkPointSet::SafeDownCast(this->Cache);
+  if (cached && !cached->GetPoints())
+  {
+    // An empty piece (a reader's output on the ranks it did not read on)
+    // has no vtkPoints at all; the view's redistribution and delivery
+    // expect one.
+    vtkNew<vtkPoints> none;
+    cached->SetPoints(none);
+  }
+  if (this->Cache->GetNumberOfPoints() > 0)
+  {
+    this->Cache->GetBounds(this->DataBounds);
+  }
+  this->DataSize = this->Cache->GetActualMemorySize();
+  this->ReportedType.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -229,94 +249,116 @@ int vtkOctreeVolumeRepresentation::ProcessViewRequest(
   {
     return 0;
   }
-
   if (request_type == vtkPVView::REQUEST_UPDATE())
   {
-    // This rank's points, or an empty vtkPolyData where it has none (an
-    // empty piece, an input the mapper cannot draw, or no input at all).
-    vtkDataObject* piece = this->Cache ? static_cast<vtkDataObject*>(this->Cache)
-                                       : this->EmptyPiece->GetOutputDataObject(0);
-    vtkPVRenderView::SetPiece(inInfo, this, piece, this->DataSize);
-
-    // Every process traces its own points; the picture is composited, never
-    // the data gathered on the client.
-    vtkPVRenderView::SetRequiresDistributedRendering(inInfo, this, true);
-
-    vtkNew<vtkMatrix4x4> matrix;
-    this->Actor->GetMatrix(matrix);
-    vtkPVRenderView::SetGeometryBounds(inInfo, this, this->DataBounds, matrix);
-
-    const int ranks = vtkMultiProcessController::GetGlobalController()
-      ? vtkMultiProcessController::GetGlobalController()->GetNumberOfProcesses()
-      : 1;
-    if (this->IsTranslucentBlendMode() && this->Cache && this->Cache->IsA("vtkPointSet"))
-    {
-      // Blended modes: the view cuts the points into spatially disjoint
-      // pieces (k-d tree over the ranks) that IceT blends in order.
-      outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 1);
-      vtkPVRenderView::SetOrderedCompositingConfiguration(inInfo, this,
-        vtkPVRenderView::DATA_IS_REDISTRIBUTABLE | vtkPVRenderView::USE_DATA_FOR_LOAD_BALANCING);
-      vtkPVRenderView::SetRedistributionModeToUniquelyAssignBoundaryCells(inInfo, this);
-      if (ranks > 1 && !this->OrderWarningIssued)
-      {
-        this->OrderWarningIssued = true;
-        vtkWarningOnFirstRankMacro("Octree Volume: with a translucent blend mode over "
-          << ranks
-          << " ranks the points are redistributed into disjoint pieces and blended in order; "
-             "each piece has its own octree, so voxels along the cuts may differ from a "
-             "one-rank picture. The surface modes composite exactly.");
-        const std::string compat = octoray::MissingExpatCompat();
-        if (!compat.empty())
-        {
-          vtkWarningOnFirstRankMacro("Octree Volume: this libexpat defers reparsing (Debian 12's "
-            "libexpat1 2.5.0-1+deb12u2 and later), and ParaView 5.11's ranks then cannot exchange "
-            "data: the redistribution fails and ranks draw nothing. Start ParaView with LD_PRELOAD="
-            << compat << " (see the README's ParaView section).");
-        }
-      }
-    }
-    else if (this->IsTranslucentBlendMode() && ranks > 1 && !this->OrderWarningIssued)
-    {
-      // Image data is not redistributed by the view: the pieces the reader
-      // made are blended as they are.
-      this->OrderWarningIssued = true;
-      vtkWarningOnFirstRankMacro("Octree Volume: translucent blend modes on image data over "
-        << ranks << " ranks blend each rank's picture without ordering; use the surface modes "
-        << "or one rank for an exact picture.");
-    }
+    this->DeliverPiece(inInfo, outInfo);
   }
   else if (request_type == vtkPVView::REQUEST_RENDER())
   {
-    vtkAlgorithmOutput* producerPort = vtkPVRenderView::GetPieceProducer(inInfo, this);
-    vtkDataSet* piece =
-      producerPort ? vtkDataSet::SafeDownCast(producerPort->GetProducer()->GetOutputDataObject(0)) : nullptr;
-    if (!this->BackendReported)
-    {
-      // Once per representation and process: say which backend draws, so a
-      // server without a GPU tells the user it uses the CPU.
-      this->BackendReported = true;
-      if (!vtkOctreeVolumeMapper::IsCudaAvailable())
-      {
-        vtkOutputWindowDisplayText("Octree Volume: no usable CUDA device on this server; "
-                                   "vtkOctreeVolumeMapper uses its CPU backend.\n");
-      }
-    }
-    // Every rank keeps the mapper on the volume (vtkPVLODVolume has no
-    // other LOD to fall back on); a rank with nothing to draw gives it the
-    // empty piece, draws nothing, and adds only background (far depth) to
-    // the composite.
-    if (this->Cache && IsDrawable(piece) && piece->GetNumberOfPoints() > 0)
-    {
-      this->Mapper->SetInputConnection(producerPort);
-    }
-    else
-    {
-      this->Mapper->SetInputConnection(this->EmptyPiece->GetOutputPort());
-    }
-    this->UpdateMapperParameters();
-    this->Actor->SetMapper(this->Mapper);
+    this->AttachPiece(inInfo);
   }
   return 1;
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::DeliverPiece(vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  // This rank's points, or an empty vtkPolyData where it has none (an
+  // empty piece, an input the mapper cannot draw, or no input at all).
+  vtkDataObject* piece =
+    this->Cache ? static_cast<vtkDataObject*>(this->Cache) : this->EmptyPiece->GetOutputDataObject(0);
+  vtkPVRenderView::SetPiece(inInfo, this, piece, this->DataSize);
+
+  // Every process traces its own points; the picture is composited, never
+  // the data gathered on the client.
+  vtkPVRenderView::SetRequiresDistributedRendering(inInfo, this, true);
+
+  vtkNew<vtkMatrix4x4> matrix;
+  this->Actor->GetMatrix(matrix);
+  vtkPVRenderView::SetGeometryBounds(inInfo, this, this->DataBounds, matrix);
+
+  if (!this->IsTranslucentBlendMode())
+  {
+    return;
+  }
+  const bool redistributed = this->Cache && this->Cache->IsA("vtkPointSet");
+  if (redistributed)
+  {
+    // Blended modes: the view cuts the points into spatially disjoint
+    // pieces (k-d tree over the ranks) that IceT blends in order.
+    outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 1);
+    vtkPVRenderView::SetOrderedCompositingConfiguration(inInfo, this,
+      vtkPVRenderView::DATA_IS_REDISTRIBUTABLE | vtkPVRenderView::USE_DATA_FOR_LOAD_BALANCING);
+    vtkPVRenderView::SetRedistributionModeToUniquelyAssignBoundaryCells(inInfo, this);
+  }
+  // Nothing is blended where nothing is drawn (no input, or one the mapper
+  // cannot draw, which ReportUndrawable names).
+  const int ranks = RankCount();
+  if (this->Cache && ranks > 1 && !this->OrderWarningIssued)
+  {
+    this->OrderWarningIssued = true;
+    this->WarnAboutBlendOrder(ranks, redistributed);
+  }
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::WarnAboutBlendOrder(int ranks, bool redistributed)
+{
+  if (!redistributed)
+  {
+    // Image data is not redistributed by the view: the pieces the reader
+    // made are blended as they are.
+    vtkWarningOnFirstRankMacro("Octree Volume: translucent blend modes on image data over "
+      << ranks << " ranks blend each rank's picture without ordering; use the surface modes "
+      << "or one rank for an exact picture.");
+    return;
+  }
+  vtkWarningOnFirstRankMacro("Octree Volume: with a translucent blend mode over "
+    << ranks
+    << " ranks the points are redistributed into disjoint pieces and blended in order; "
+       "each piece has its own octree, so voxels along the cuts may differ from a "
+       "one-rank picture. The surface modes composite exactly.");
+  const std::string compat = octoray::MissingExpatCompat();
+  if (!compat.empty())
+  {
+    vtkWarningOnFirstRankMacro("Octree Volume: this libexpat defers reparsing (Debian 12's "
+      "libexpat1 2.5.0-1+deb12u2 and later), and ParaView 5.11's ranks then cannot exchange "
+      "data: the redistribution fails and ranks draw nothing. Start ParaView with LD_PRELOAD="
+      << compat << " (see the README's ParaView section).");
+  }
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::AttachPiece(vtkInformation* inInfo)
+{
+  vtkAlgorithmOutput* producerPort = vtkPVRenderView::GetPieceProducer(inInfo, this);
+  vtkDataSet* piece =
+    producerPort ? vtkDataSet::SafeDownCast(producerPort->GetProducer()->GetOutputDataObject(0)) : nullptr;
+  if (!this->BackendReported)
+  {
+    // Once per representation and process: say which backend draws, so a
+    // server without a GPU tells the user it uses the CPU.
+    this->BackendReported = true;
+    if (!vtkOctreeVolumeMapper::IsCudaAvailable())
+    {
+      vtkOutputWindowDisplayText("Octree Volume: no usable CUDA device on this server; "
+                                 "vtkOctreeVolumeMapper uses its CPU backend.\n");
+    }
+  }
+  // Every rank keeps the mapper on the volume (vtkPVLODVolume has no
+  // other LOD to fall back on); a rank with nothing to draw gives it the
+  // empty piece, draws nothing, and adds only background (far depth) to
+  // the composite.
+  if (this->Cache && IsDrawable(piece) && piece->GetNumberOfPoints() > 0)
+  {
+    this->Mapper->SetInputConnection(producerPort);
+  }
+  else
+  {
+    this->Mapper->SetInputConnection(this->EmptyPiece->GetOutputPort());
+  }
+  this->UpdateMapperParameters();
+  this->Actor->SetMapper(this->Mapper);
 }
 
 //----------------------------------------------------------------------------

@@ -142,6 +142,32 @@ protected:
   bool RemoveFromView(vtkView* view) override;
 
   /**
+   * RequestData's part for a drawable input: keeps this rank's piece
+   * (Cache), its bounds and size; reports an input the mapper cannot draw.
+   */
+  void CacheInput(vtkDataObject* data, int ranks);
+
+  /**
+   * REQUEST_UPDATE: hands the view this rank's piece and, for the
+   * translucent blend modes, asks for ordered compositing where the view
+   * can redistribute the points.
+   */
+  void DeliverPiece(vtkInformation* inInfo, vtkInformation* outInfo);
+
+  /**
+   * Why a translucent picture over several ranks may differ from a
+   * one-rank one: pieces redistributed (points) or blended as they are
+   * (images). Said once, on the first rank.
+   */
+  void WarnAboutBlendOrder(int ranks, bool redistributed);
+
+  /**
+   * REQUEST_RENDER: gives the mapper the view's piece, or the empty one
+   * where this rank has nothing to draw.
+   */
+  void AttachPiece(vtkInformation* inInfo);
+
+  /**
    * Colour array, scalar mode and component handling, as
    * vtkUnstructuredGridVolumeRepresentation::UpdateMapperParameters.
    */

@@ -15,7 +15,9 @@ vtkOctreeVolumeRepresentation:
   the representation directly, rendered three times: the warning naming
   vtkTable, with the Table To Points hint, exactly once;
 - in both, what the representation can draw (vtkPointSet, vtkImageData);
-- on several ranks, still one of each (the first rank speaks for all);
+- on several ranks, still one of each (the first rank speaks for all), and
+  no warning about blending the ranks' pictures in order for data that is
+  not drawn (the multiblock's composite blend mode);
 - no pipeline error about the representation's input ("Can not execute
   simple algorithm ... without output ports", which ParaView printed for
   composite data before), and the script ran to its end.
@@ -95,6 +97,9 @@ def main():
     check("warnings naming vtkMultiBlockDataSet", out.count(MULTIBLOCK), 1)
     check("warnings naming vtkTable", out.count(TABLE), 1)
     check("'Octree Volume cannot draw' in all", out.count("Octree Volume cannot draw"), 2)
+    check("blend-order warnings for data not drawn",
+          out.count("blend each rank's picture without ordering") +
+          out.count("ranks the points are redistributed into disjoint pieces"), 0)
     check("pipeline errors about the representation's input",
           out.count("Can not execute simple algorithm vtkOctreeVolumeRepresentation") +
           out.count("vtkOctreeVolumeRepresentation) is of type"), 0)
