@@ -201,6 +201,37 @@ size_t DropPointsWithoutPosition(const Arrays& a, const Real* p, size_t n)
   return bad;
 }
 
+// Sizes every output array for n points; false, with the message, where
+// the memory cannot be had.
+bool AllocateArrays(const Arrays& a, size_t n, const std::string& file, std::string& error)
+{
+  for (const Sink& s : a.Sinks)
+  {
+    s.Array->SetNumberOfComponents(s.Components);
+    s.Array->SetNumberOfTuples(static_cast<vtkIdType>(n));
+    if (static_cast<size_t>(s.Array->GetNumberOfTuples()) != n)
+    {
+      error = file + ": cannot allocate memory for " + Plural(n, "point", "points") + " (array " +
+        s.Array->GetName() + " of " + std::to_string(s.Components) + " component(s))";
+      return false;
+    }
+  }
+  return true;
+}
+
+// What the reader says of the `bad` points of n it left out
+// (DropPointsWithoutPosition).
+std::string SkippedPointsWarning(const std::string& file, const Header& h, size_t n, size_t bad)
+{
+  const std::string organised = h.Height > 1
+    ? " (empty cells of the organised " + std::to_string(h.Width) + " x " + std::to_string(h.Height) +
+      " cloud)"
+    : std::string();
+  return file + ": skipped " + std::to_string(bad) + " of " + Plural(n, "point", "points") +
+    " whose x, y or z is NaN or infinite" + organised + "; kept " + std::to_string(n - bad) +
+    " (field data SkippedPointCount)";
+}
+
 void AddPointData(vtkPolyData* output, const Arrays& a)
 {
   auto points = vtkSmartPointer<vtkPoints>::New();
@@ -305,17 +336,10 @@ bool vtkPCDReader::ReadPoints(const char* data, size_t size, vtkPolyData* output
   const size_t n = static_cast<size_t>(h.Points);
   const bool real64 = this->OutputPointsPrecision == DOUBLE_PRECISION;
   Arrays arrays = MakeArrays(h, real64);
-  for (Sink& s : arrays.Sinks)
+  if (!AllocateArrays(arrays, n, file, error))
   {
-    s.Array->SetNumberOfComponents(s.Components);
-    s.Array->SetNumberOfTuples(static_cast<vtkIdType>(n));
-    if (static_cast<size_t>(s.Array->GetNumberOfTuples()) != n)
-    {
-      this->Fail(file + ": cannot allocate memory for " + Plural(n, "point", "points") +
-        " (array " + s.Array->GetName() + " of " + std::to_string(s.Components) +
-        " component(s))");
-      return false;
-    }
+    this->Fail(error);
+    return false;
   }
   for (size_t i0 = 0; i0 < n; i0 += ChunkPoints)
   {
@@ -338,12 +362,7 @@ bool vtkPCDReader::ReadPoints(const char* data, size_t size, vtkPolyData* output
   if (bad)
   {
     this->NumberOfSkippedPoints = static_cast<vtkIdType>(bad);
-    warnings.push_back(file + ": skipped " + std::to_string(bad) + " of " +
-      Plural(n, "point", "points") + " whose x, y or z is NaN or infinite" +
-      (h.Height > 1 ? " (empty cells of the organised " + std::to_string(h.Width) + " x " +
-            std::to_string(h.Height) + " cloud)"
-                    : std::string()) +
-      "; kept " + std::to_string(n - bad) + " (field data SkippedPointCount)");
+    warnings.push_back(SkippedPointsWarning(file, h, n, bad));
   }
   AddPointData(output, arrays);
   AddFieldData(output, h, this->NumberOfSkippedPoints);
