@@ -42,8 +42,8 @@ test: build data
 # UndefinedBehaviorSanitizer (any report fails: -fno-sanitize-recover=all,
 # LeakSanitizer on at exit) for the project's own code (CPU engine without
 # CUDA, readers, and the mappers where they exist); ParaView's libraries are
-# not instrumented. It runs the C++ tests of the engine, the readers and the
-# reliability tests, and each libFuzzer target for FUZZ_SECONDS; and the
+# not instrumented. It runs the C++ tests of the engine, the command-line
+# tool's test, the readers' and the reliability tests, and each libFuzzer target for FUZZ_SECONDS; and the
 # Python reader suites (python.particle_reader, .pcd_reader,
 # .slice_stack_reader, .depth_and_normals) with the instrumented `octoray`
 # modules: python3 and ParaView's libraries are not instrumented, so the ASan
@@ -57,7 +57,7 @@ ASAN_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fr
 # Coverage for libFuzzer in the project's code (the readers the fuzz targets
 # call), not only in the targets themselves.
 ASAN_CXX_FLAGS = $(ASAN_FLAGS) -fsanitize=fuzzer-no-link
-ASAN_TARGETS = octoray_engine_tests octorayIOParticlesCxxTests octorayIOImageStackCxxTests \
+ASAN_TARGETS = octoray_engine_tests octoray octorayIOParticlesCxxTests octorayIOImageStackCxxTests \
   octorayFiltersPCLCxxTests TestReaderRobustness TestSceneLeaks octoray_fuzz_ParticleHeader \
   octoray_fuzz_ParticleText octoray_fuzz_PCD octoray_fuzz_SliceStackMetadata \
   octorayIOParticlesPython octorayIOImageStackPython octorayFiltersPCLPython \
@@ -74,7 +74,7 @@ test-asan: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Reliability/lsan.supp:print_suppressions=0 \
 	  ctest --output-on-failure -j $(JOBS) \
-	  -R '^(deps\.|engine\.cpu|octoray::(IOParticles|IOImageStack|FiltersPCL)Cxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
+	  -R '^(deps\.|engine\.(cpu|tool)|octoray::(IOParticles|IOImageStack|FiltersPCL)Cxx-|reliability\.|fuzz\.|python\.(particle_reader|pcd_reader|slice_stack_reader|depth_and_normals)$$)'
 
 # The demo (Wrapping/Python/octoray/demo.py): the head CT (DICOM, bone and
 # skin presets, and side by side with vtkSmartVolumeMapper), the PCL laser

@@ -7,6 +7,7 @@
 //                       [--depth 0] [--backend cpu|cuda|all] [--threads N]
 //                       [--repeats 5] [--json PATH]
 #include "BenchUtil.h"
+#include "CommandLine.h"
 
 #include <octoray/Engine.h>
 #include <octoray/Octree.h>
@@ -141,16 +142,21 @@ int main(int argc, char** argv)
   std::string json;
   CommandLine options;
   options
-    .Option("--points",
+    .Option("--points", "a list of counts such as 1000000,1e7",
       [&](const std::string& v) {
         counts.clear();
         for (const std::string& c : SplitList(v))
         {
-          counts.push_back(static_cast<std::size_t>(std::strtod(c.c_str(), nullptr))); // 1e7 works too
+          std::size_t n = 0;
+          if (!CommandLine::ParseCount(c, n) || n == 0)
+          {
+            return false;
+          }
+          counts.push_back(n);
         }
-        return true;
+        return !counts.empty();
       })
-    .Option("--sets",
+    .Option("--sets", "a list of uniform, clustered and narrow",
       [&](const std::string& v) {
         sets = SplitList(v);
         return std::all_of(sets.begin(), sets.end(),

@@ -48,6 +48,7 @@
 // Testing/Python/test_bench_quality_metrics.py checks with scikit-image.
 #include "BenchScenes.h"
 #include "BenchUtil.h"
+#include "CommandLine.h"
 #include "ImageMetrics.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
@@ -498,8 +499,8 @@ int main(int argc, char** argv)
     .Text("--lidar", lidar)
     .Text("--only", only)
     .Size("--size", width, height)
-    .Integer("--repeats", repeats)
-    .Integer("--threads", threads)
+    .Integer("--repeats", repeats, 0) // 0: by backend
+    .Integer("--threads", threads, 0)
     .Count("--sphere-points", spherePoints)
     .Text("--json", json)
     .Text("--dump", dump);

@@ -20,6 +20,7 @@
 //                              [--repeats 3] [--json PATH]
 #include "BenchScenes.h"
 #include "BenchUtil.h"
+#include "CommandLine.h"
 #include "PointFile.h"
 #include <octoray/Quantisation.h>
 
@@ -59,7 +60,7 @@ int main(int argc, char** argv)
   std::size_t spherePoints = 200000;
   CommandLine options;
   options.Choice("--backend", backend, { "cpu", "cuda" })
-    .Option("--depths",
+    .Option("--depths", "a range FIRST-LAST within 1-" + std::to_string(kMaxLevel),
       [&](const std::string& v) {
         return std::sscanf(v.c_str(), "%d-%d", &first, &last) == 2 && first >= 1 && last <= kMaxLevel &&
           first <= last;

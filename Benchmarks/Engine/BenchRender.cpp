@@ -20,6 +20,7 @@
 // time is the median of the repeats after one warm-up frame.
 #include "BenchScenes.h"
 #include "BenchUtil.h"
+#include "CommandLine.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
 
@@ -211,8 +212,8 @@ int main(int argc, char** argv)
   std::string backend = "cpu", lidar = OCTORAY_LIDAR_FILE, json, parts = "modes,off";
   CommandLine options;
   options.Size("--size", w, h)
-    .Integer("--repeats", repeats)
-    .Integer("--threads", threads)
+    .Integer("--repeats", repeats, 1)
+    .Integer("--threads", threads, 0)
     .Choice("--backend", backend, { "cpu", "cuda", "all" })
     .Text("--lidar", lidar)
     .Count("--sphere-points", spherePoints)

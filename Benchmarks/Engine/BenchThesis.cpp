@@ -14,6 +14,7 @@
 //                        [--sphere-points 1000000] [--json PATH]
 #include "BenchScenes.h"
 #include "BenchUtil.h"
+#include "CommandLine.h"
 
 #include <octoray/Engine.h>
 

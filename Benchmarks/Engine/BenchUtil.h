@@ -12,7 +12,6 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
-#include <initializer_list>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -502,6 +501,7 @@ inline void MergeRecords(const std::string& path, const std::vector<Record>& rec
   }
 }
 // ---------------------------------------------------------------- command line
+// (CommandLine.h, beside the octoray tool, parses the options.)
 
 // A comma-separated list, empty items dropped.
 inline std::vector<std::string> SplitList(const std::string& list)
@@ -518,79 +518,6 @@ inline std::vector<std::string> SplitList(const std::string& list)
   }
   return items;
 }
-
-// The benchmarks' command lines, all `--name value` pairs: each option
-// writes its variable; Parse() is false for an unknown option, one without
-// its value or a value that does not parse, and the program prints its
-// usage.
-class CommandLine
-{
-public:
-  using Parser = std::function<bool(const std::string&)>;
-
-  CommandLine& Option(const char* name, Parser parse)
-  {
-    Options.emplace_back(name, std::move(parse));
-    return *this;
-  }
-  CommandLine& Text(const char* name, std::string& into)
-  {
-    return Option(name, [&into](const std::string& v) { into = v; return true; });
-  }
-  // One of `allowed`, e.g. the backend.
-  CommandLine& Choice(const char* name, std::string& into, std::initializer_list<const char*> allowed)
-  {
-    std::vector<std::string> values(allowed.begin(), allowed.end());
-    return Option(name, [&into, values](const std::string& v) {
-      into = v;
-      return std::find(values.begin(), values.end(), v) != values.end();
-    });
-  }
-  // An integer, raised to `atLeast` when below it.
-  CommandLine& Integer(const char* name, int& into, int atLeast = std::numeric_limits<int>::min())
-  {
-    return Option(name, [&into, atLeast](const std::string& v) {
-      into = std::max(atLeast, std::atoi(v.c_str()));
-      return true;
-    });
-  }
-  CommandLine& Real(const char* name, double& into)
-  {
-    return Option(name, [&into](const std::string& v) { into = std::strtod(v.c_str(), nullptr); return true; });
-  }
-  // A point count: "1000000" or "1e6".
-  CommandLine& Count(const char* name, std::size_t& into)
-  {
-    return Option(name, [&into](const std::string& v) {
-      into = static_cast<std::size_t>(std::strtod(v.c_str(), nullptr));
-      return true;
-    });
-  }
-  // A picture size, "WxH".
-  CommandLine& Size(const char* name, int& width, int& height)
-  {
-    return Option(name, [&width, &height](const std::string& v) {
-      return std::sscanf(v.c_str(), "%dx%d", &width, &height) == 2;
-    });
-  }
-
-  bool Parse(int argc, char** argv) const
-  {
-    for (int a = 1; a < argc; a += 2)
-    {
-      const auto option = std::find_if(
-        Options.begin(), Options.end(), [&](const auto& o) { return o.first == argv[a]; });
-      if (option == Options.end() || a + 1 >= argc || !option->second(argv[a + 1]))
-      {
-        return false;
-      }
-    }
-    return true;
-  }
-
-private:
-  std::vector<std::pair<std::string, Parser>> Options;
-};
 
 // Merges `records` into the JSON file `path` (nothing when it is empty) and
 // says so.

@@ -30,6 +30,7 @@
 //                      12, without keeping the points: a real scan at a
 //                      billion points)
 #include "BenchUtil.h"
+#include "CommandLine.h"
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
@@ -806,7 +807,7 @@ void RunSize(const Scene& scene, int w, int h, const Options& o, std::vector<Rec
 int main(int argc, char* argv[])
 {
   Options o;
-  CommandLine cli;
+  octoray::CommandLine cli;
   cli.Text("--points", o.Points).Text("--sizes", o.Sizes).Text("--methods", o.Methods).Text("--file", o.File);
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
   cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);

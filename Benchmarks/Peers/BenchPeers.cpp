@@ -16,6 +16,7 @@
 // --octree-locator-max: leave vtkOctreePointLocator out of cases with more
 // than N points (about a minute per build at 10 M on 2 cores).
 #include "BenchUtil.h"
+#include "CommandLine.h"
 
 #include <octoray/Engine.h>
 
@@ -96,7 +97,7 @@ int main(int argc, char** argv)
   std::string json;
   CommandLine options;
   options
-    .Option("--cases",
+    .Option("--cases", "a list SET:N of uniform or clustered and a count",
       [&](const std::string& v) {
         cases.clear();
         for (const std::string& item : SplitList(v))
@@ -106,8 +107,9 @@ int main(int argc, char** argv)
           {
             return false;
           }
-          Case c{ item.substr(0, colon), static_cast<std::size_t>(std::strtod(item.c_str() + colon + 1, nullptr)) };
-          if ((c.set != "uniform" && c.set != "clustered") || c.n == 0)
+          Case c{ item.substr(0, colon), 0 };
+          if ((c.set != "uniform" && c.set != "clustered") || !CommandLine::ParseCount(item.substr(colon + 1), c.n) ||
+            c.n == 0)
           {
             return false;
           }

@@ -3,6 +3,7 @@
 // builds the octree of a particle file and prints its statistics and costs;
 //   octoray render FILE -o OUT.png [options]
 // ray-traces it from a camera orbiting the data and writes the picture.
+#include "CommandLine.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
 
@@ -14,10 +15,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
+#include <string>
+#include <vector>
 
 #if OCTORAY_HAVE_OIIO
 #include <OpenImageIO/imageio.h>
@@ -39,98 +42,124 @@ int Usage()
   return 2;
 }
 
+double Seconds(std::chrono::steady_clock::time_point since)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// The options both commands take.
+struct EngineOptions
+{
+  std::string backend = "auto";
+  int threads = 0;
+  octoray::BuildOptions build;
+
+  void AddTo(octoray::CommandLine& options)
+  {
+    options.Choice("--backend", backend, { "auto", "cpu", "cuda" })
+      .Integer("--threads", threads, 0)
+      .Integer("--depth", build.depth); // its range is the engine's to check
+  }
+};
+
+// A particle file loaded, and the engine its options ask for with its
+// octree built.
+struct Built
+{
+  std::string path;
+  octoray::PointFile file;
+  double loadSeconds = 0;
+  std::unique_ptr<octoray::Engine> engine;
+  std::string cudaNotUsed; // why "auto" took the CPU
+  octoray::BuildStats stats;
+};
+
+Built LoadAndBuild(const std::string& path, const EngineOptions& o)
+{
+  Built b;
+  b.path = path;
+  const auto start = std::chrono::steady_clock::now();
+  b.file = octoray::PointFile::Load(path);
+  b.loadSeconds = Seconds(start);
+  std::string why;
+  const bool useCuda = o.backend == "cuda" || (o.backend == "auto" && octoray::CudaAvailable(&why));
+  b.cudaNotUsed = (!useCuda && o.backend == "auto") ? why : "";
+  b.engine = octoray::CreateEngine(useCuda ? octoray::Backend::CUDA : octoray::Backend::CPU);
+  if (o.threads > 0)
+  {
+    b.engine->SetThreadCount(o.threads);
+  }
+  b.stats = b.engine->Build(b.file.View(), o.build);
+  return b;
+}
+
+// The lines both commands print first: the file and the backend.
+void PrintSource(const Built& b)
+{
+  std::printf("file            %s (%zu points, read in %.3f s)\n", b.path.c_str(), b.stats.points, b.loadSeconds);
+  std::printf("backend         %s%s%s\n", b.engine->Description().c_str(),
+    b.cudaNotUsed.empty() ? "" : ", CUDA not used: ", b.cudaNotUsed.c_str());
+}
+
+int Stats(int argc, char** argv)
+{
+  EngineOptions o;
+  octoray::CommandLine options;
+  o.AddTo(options);
+  if (!options.Parse(argc, argv, 3))
+  {
+    return Usage();
+  }
+  const Built b = LoadAndBuild(argv[2], o);
+  const octoray::BuildStats& stats = b.stats;
+  const octoray::MemoryReport memory = b.engine->Memory();
+  PrintSource(b);
+  std::printf("depth           %d%s\n", stats.depth, o.build.depth ? "" : " (automatic)");
+  std::printf("nodes           %zu\n", stats.nodes);
+  std::printf("nodes per level");
+  for (std::size_t l = 0; l < stats.nodesPerLevel.size(); ++l)
+  {
+    std::printf(" %u", stats.nodesPerLevel[l]);
+  }
+  std::printf("\n");
+  std::printf("build           %.3f ms (keys %.3f, sort %.3f, levels %.3f)\n", stats.seconds * 1e3,
+    stats.keySeconds * 1e3, stats.sortSeconds * 1e3, stats.levelSeconds * 1e3);
+  std::printf("memory          %zu bytes, %.1f bytes per point\n", memory.Total(),
+    static_cast<double>(memory.Total()) / static_cast<double>(stats.points));
+  for (const auto& array : memory.arrays)
+  {
+    std::printf("  %-24s %zu\n", array.first.c_str(), array.second);
+  }
+  return 0;
+}
+
 int Render(int argc, char** argv);
 }
 
 int main(int argc, char** argv)
 {
-  if (argc >= 3 && std::strcmp(argv[1], "render") == 0)
-  {
-    return Render(argc, argv);
-  }
-  if (argc < 3 || std::strcmp(argv[1], "stats") != 0)
+  if (argc < 3)
   {
     return Usage();
   }
-  const std::string path = argv[2];
-  octoray::BuildOptions options;
-  std::string backend = "auto";
-  int threads = 0;
-  for (int a = 3; a < argc; ++a)
+  const std::string command = argv[1];
+  if (command != "stats" && command != "render")
   {
-    const std::string arg = argv[a];
-    if (a + 1 >= argc)
-    {
-      return Usage();
-    }
-    if (arg == "--depth")
-    {
-      options.depth = std::atoi(argv[++a]);
-    }
-    else if (arg == "--backend")
-    {
-      backend = argv[++a];
-    }
-    else if (arg == "--threads")
-    {
-      threads = std::atoi(argv[++a]);
-    }
-    else
-    {
-      return Usage();
-    }
+    return Usage();
   }
   try
   {
-    const auto t0 = std::chrono::steady_clock::now();
-    const octoray::PointFile file = octoray::PointFile::Load(path);
-    const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-    std::string why;
-    const bool useCuda = backend == "cuda" || (backend == "auto" && octoray::CudaAvailable(&why));
-    auto engine = octoray::CreateEngine(useCuda ? octoray::Backend::CUDA : octoray::Backend::CPU);
-    if (threads > 0)
-    {
-      engine->SetThreadCount(threads);
-    }
-    const octoray::BuildStats stats = engine->Build(file.View(), options);
-    const octoray::MemoryReport memory = engine->Memory();
-
-    std::printf("file            %s (%zu points, read in %.3f s)\n", path.c_str(), stats.points, loadSeconds);
-    std::printf("backend         %s%s%s\n", engine->Description().c_str(),
-      (!useCuda && backend == "auto") ? ", CUDA not used: " : "", (!useCuda && backend == "auto") ? why.c_str() : "");
-    std::printf("depth           %d%s\n", stats.depth, options.depth ? "" : " (automatic)");
-    std::printf("nodes           %zu\n", stats.nodes);
-    std::printf("nodes per level");
-    for (std::size_t l = 0; l < stats.nodesPerLevel.size(); ++l)
-    {
-      std::printf(" %u", stats.nodesPerLevel[l]);
-    }
-    std::printf("\n");
-    std::printf("build           %.3f ms (keys %.3f, sort %.3f, levels %.3f)\n", stats.seconds * 1e3,
-      stats.keySeconds * 1e3, stats.sortSeconds * 1e3, stats.levelSeconds * 1e3);
-    std::printf("memory          %zu bytes, %.1f bytes per point\n", memory.Total(),
-      static_cast<double>(memory.Total()) / static_cast<double>(stats.points));
-    for (const auto& array : memory.arrays)
-    {
-      std::printf("  %-24s %zu\n", array.first.c_str(), array.second);
-    }
+    return command == "stats" ? Stats(argc, argv) : Render(argc, argv);
   }
   catch (const std::exception& e)
   {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;
   }
-  return 0;
 }
 
 namespace
 {
-double Seconds(std::chrono::steady_clock::time_point since)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
 // 8-bit RGB, top row first, the premultiplied picture composited over a
 // dark background (what a viewer shows; the engine's rows start at the bottom).
 std::vector<unsigned char> Composite(const octoray::Image& image, float gain)
@@ -190,161 +219,159 @@ std::string WriteImage(const std::string& path, int w, int h, const std::vector<
 #endif
 }
 
-int Render(int argc, char** argv)
+// What each --mode selects: a surface shading, or a blend mode.
+struct ToolMode
 {
-  const std::string path = argv[2];
-  std::string output, mode = "surface", backend = "auto";
-  int width = 1280, height = 720, bounces = 2, threads = 0;
-  double azimuth = -60, elevation = 30, zoom = 1;
-  float lod = 0;
+  const char* name;
+  octoray::ShadeMode shade;
+  octoray::BlendMode blend;
+};
+constexpr ToolMode kToolModes[] = {
+  { "surface", octoray::ShadeMode::Flat, octoray::BlendMode::Surface },
+  { "depthcue", octoray::ShadeMode::DepthCue, octoray::BlendMode::Surface },
+  { "phong", octoray::ShadeMode::Phong, octoray::BlendMode::Surface },
+  { "composite", octoray::ShadeMode::Flat, octoray::BlendMode::Composite },
+  { "mip", octoray::ShadeMode::Flat, octoray::BlendMode::Maximum },
+  { "minip", octoray::ShadeMode::Flat, octoray::BlendMode::Minimum },
+  { "average", octoray::ShadeMode::Flat, octoray::BlendMode::Average },
+  { "additive", octoray::ShadeMode::Flat, octoray::BlendMode::Additive },
+};
+
+// The render command's options.
+struct RenderOptions
+{
+  EngineOptions engine;
+  std::string output;
+  const ToolMode* mode = &kToolModes[0];
+  int width = 1280, height = 720, bounces = 2;
+  double azimuth = -60, elevation = 30, zoom = 1, lod = 0;
   bool shadows = false;
-  octoray::BuildOptions options;
-  for (int a = 3; a < argc; ++a)
+
+  // Parses argv from argv[3]; false, having said why, where it does not.
+  bool Parse(int argc, char** argv)
   {
-    const std::string arg = argv[a];
-    if (arg == "--shadows")
+    std::string modes = "one of";
+    for (const ToolMode& m : kToolModes)
     {
-      shadows = true;
-      continue;
+      modes += (&m == kToolModes ? " " : ", ") + std::string(m.name);
     }
-    if (a + 1 >= argc)
+    octoray::CommandLine options;
+    engine.AddTo(options);
+    options.Text("-o", output)
+      .Size("--size", width, height)
+      .Option("--mode", modes,
+        [this](const std::string& v) {
+          const auto found = std::find_if(
+            std::begin(kToolModes), std::end(kToolModes), [&](const ToolMode& m) { return v == m.name; });
+          mode = found != std::end(kToolModes) ? found : nullptr;
+          return mode != nullptr;
+        })
+      .Real("--lod", lod)
+      .Integer("--bounces", bounces, 0)
+      .Flag("--shadows", shadows)
+      .Real("--azimuth", azimuth)
+      .Real("--elevation", elevation)
+      .Real("--zoom", zoom, true);
+    if (!options.Parse(argc, argv, 3))
     {
-      return Usage();
+      return false;
     }
-    const char* value = argv[++a];
-    if (arg == "-o")
-      output = value;
-    else if (arg == "--size")
+    if (output.empty())
     {
-      if (std::sscanf(value, "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0)
-        return Usage();
+      std::fprintf(stderr, "octoray: render needs -o OUT.png, the picture to write\n");
+      return false;
     }
-    else if (arg == "--mode")
-      mode = value;
-    else if (arg == "--depth")
-      options.depth = std::atoi(value);
-    else if (arg == "--lod")
-      lod = static_cast<float>(std::atof(value));
-    else if (arg == "--bounces")
-      bounces = std::atoi(value);
-    else if (arg == "--backend")
-      backend = value;
-    else if (arg == "--threads")
-      threads = std::atoi(value);
-    else if (arg == "--azimuth")
-      azimuth = std::atof(value);
-    else if (arg == "--elevation")
-      elevation = std::atof(value);
-    else if (arg == "--zoom")
-      zoom = std::atof(value);
-    else
-      return Usage();
+    return true;
   }
-  if (output.empty() || !(zoom > 0))
-  {
-    return Usage();
-  }
+};
+
+// The render settings for a picture of the points `points` (an octree of
+// depth `depth`): the camera orbiting their bounding box's centre, whose
+// bounding sphere fills the vertical field of view at zoom 1, a sun for
+// the shadows, and an opacity for composite.
+octoray::RenderSettings SceneSettings(const RenderOptions& o, const octoray::PointCloudView& points, int depth)
+{
   octoray::RenderSettings s;
-  s.width = width;
-  s.height = height;
-  s.maxBounces = bounces;
-  s.lodPixels = lod;
-  s.shadows = shadows;
-  if (mode == "surface")
-    s.shade = octoray::ShadeMode::Flat;
-  else if (mode == "depthcue")
-    s.shade = octoray::ShadeMode::DepthCue;
-  else if (mode == "phong")
-    s.shade = octoray::ShadeMode::Phong;
-  else if (mode == "composite")
-    s.blend = octoray::BlendMode::Composite;
-  else if (mode == "mip")
-    s.blend = octoray::BlendMode::Maximum;
-  else if (mode == "minip")
-    s.blend = octoray::BlendMode::Minimum;
-  else if (mode == "average")
-    s.blend = octoray::BlendMode::Average;
-  else if (mode == "additive")
-    s.blend = octoray::BlendMode::Additive;
-  else
-    return Usage();
-
-  try
+  s.width = o.width;
+  s.height = o.height;
+  s.maxBounces = o.bounces;
+  s.lodPixels = static_cast<float>(o.lod);
+  s.shadows = o.shadows;
+  s.shade = o.mode->shade;
+  s.blend = o.mode->blend;
+  double lo[3], hi[3];
+  octoray::Bounds(points, lo, hi);
+  octoray::OrbitCamera camera;
+  camera.azimuth = o.azimuth;
+  camera.elevation = o.elevation;
+  camera.zoom = o.zoom;
+  if (!camera.Apply(lo, hi, s))
   {
-    auto start = std::chrono::steady_clock::now();
-    const octoray::PointFile file = octoray::PointFile::Load(path);
-    const double loadSeconds = Seconds(start);
-    std::string why;
-    const bool useCuda = backend == "cuda" || (backend == "auto" && octoray::CudaAvailable(&why));
-    auto engine = octoray::CreateEngine(useCuda ? octoray::Backend::CUDA : octoray::Backend::CPU);
-    if (threads > 0)
-      engine->SetThreadCount(threads);
-    const octoray::PointCloudView points = file.View();
-    const octoray::BuildStats build = engine->Build(points, options);
-
-    // Orbit the centre of the data's bounding box; its bounding sphere
-    // fits the vertical field of view at zoom 1.
-    double lo[3], hi[3];
-    octoray::Bounds(points, lo, hi);
-    octoray::OrbitCamera camera;
-    camera.azimuth = azimuth;
-    camera.elevation = elevation;
-    camera.zoom = zoom;
-    if (!camera.Apply(lo, hi, s))
-    {
-      throw octoray::Error("octoray: the camera matrix is singular");
-    }
+    throw octoray::Error("octoray: the camera matrix is singular");
+  }
+  if (o.shadows)
+  {
+    // Shadows need a light other than the headlight: a sun above and to
+    // the left of the camera, so shadows fall visibly down and right.
+    octoray::Light sun;
+    octoray::OrbitCamera::Direction(o.azimuth + 40, std::min(80.0, o.elevation + 35), sun.position);
+    sun.position[3] = 0;
+    s.lights.push_back(sun);
+  }
+  if (s.blend == octoray::BlendMode::Composite)
+  {
+    // Node colours with an opacity per unit length, so composite is not
+    // merely the first hit: a ramp over the node colours' luminance would
+    // need scalars; the points' colours at 20% opacity per voxel do.
     const double radius = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
       (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    if (shadows)
-    {
-      // Shadows need a light other than the headlight: a sun above and to
-      // the left of the camera, so shadows fall visibly down and right.
-      octoray::Light sun;
-      octoray::OrbitCamera::Direction(azimuth + 40, std::min(80.0, elevation + 35), sun.position);
-      sun.position[3] = 0;
-      s.lights.push_back(sun);
-    }
-    if (s.blend == octoray::BlendMode::Composite)
-    {
-      // Node colours with an opacity per unit length, so composite is not
-      // merely the first hit: a ramp over the node colours' luminance would
-      // need scalars; the points' colours at 20% opacity per voxel do.
-      s.opacityUnitDistance = static_cast<float>(5.0 * std::ldexp(radius * 2, -build.depth));
-    }
-
-    octoray::Image image;
-    engine->Render(s, image); // first frame: buffers, caches
-    const octoray::RenderStats stats = engine->Render(s, image);
-    float gain = 1.0f;
-    if (s.blend == octoray::BlendMode::Additive || s.blend == octoray::BlendMode::Average)
-    {
-      // Integrals have no natural scale: normalise the brightest pixel to 1.
-      float most = 0;
-      for (std::size_t i = 0; i < image.depth.size(); ++i)
-        most = std::max(most, std::max(image.rgba[4 * i], std::max(image.rgba[4 * i + 1], image.rgba[4 * i + 2])));
-      gain = most > 0 ? 1.0f / most : 1.0f;
-    }
-    start = std::chrono::steady_clock::now();
-    const std::string written = WriteImage(output, width, height, Composite(image, gain));
-    const double writeSeconds = Seconds(start);
-
-    const double rays = static_cast<double>(stats.primaryRays + stats.secondaryRays);
-    std::printf("file            %s (%zu points, read in %.3f s)\n", path.c_str(), build.points, loadSeconds);
-    std::printf("backend         %s%s%s\n", engine->Description().c_str(),
-      (!useCuda && backend == "auto") ? ", CUDA not used: " : "", (!useCuda && backend == "auto") ? why.c_str() : "");
-    std::printf("build           %.3f ms (depth %d, %zu nodes)\n", build.seconds * 1e3, build.depth, build.nodes);
-    std::printf("render          %.3f ms, %dx%d, mode %s%s, %zu primary + %zu secondary rays\n", stats.seconds * 1e3,
-      width, height, mode.c_str(), shadows ? " + shadows" : "", stats.primaryRays, stats.secondaryRays);
-    std::printf("throughput      %.2f Mrays/s (%.2f Mrays/s primary)\n", rays / stats.seconds * 1e-6,
-      static_cast<double>(stats.primaryRays) / stats.seconds * 1e-6);
-    std::printf("wrote           %s (%.3f s)\n", written.c_str(), writeSeconds);
+    s.opacityUnitDistance = static_cast<float>(5.0 * std::ldexp(radius * 2, -depth));
   }
-  catch (const std::exception& e)
+  return s;
+}
+
+// The scale of the picture's colours: 1, but for the integrals (additive,
+// average), which have no natural scale and are normalised to their
+// brightest pixel.
+float Gain(const octoray::Image& image, octoray::BlendMode blend)
+{
+  if (blend != octoray::BlendMode::Additive && blend != octoray::BlendMode::Average)
   {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
+    return 1.0f;
   }
+  float most = 0;
+  for (std::size_t i = 0; i < image.depth.size(); ++i)
+  {
+    most = std::max(most, std::max(image.rgba[4 * i], std::max(image.rgba[4 * i + 1], image.rgba[4 * i + 2])));
+  }
+  return most > 0 ? 1.0f / most : 1.0f;
+}
+
+int Render(int argc, char** argv)
+{
+  RenderOptions o;
+  if (!o.Parse(argc, argv))
+  {
+    return Usage();
+  }
+  const Built b = LoadAndBuild(argv[2], o.engine);
+  const octoray::RenderSettings s = SceneSettings(o, b.file.View(), b.stats.depth);
+  octoray::Image image;
+  b.engine->Render(s, image); // first frame: buffers, caches
+  const octoray::RenderStats stats = b.engine->Render(s, image);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string written = WriteImage(o.output, o.width, o.height, Composite(image, Gain(image, s.blend)));
+  const double writeSeconds = Seconds(start);
+
+  const double rays = static_cast<double>(stats.primaryRays + stats.secondaryRays);
+  PrintSource(b);
+  std::printf("build           %.3f ms (depth %d, %zu nodes)\n", b.stats.seconds * 1e3, b.stats.depth,
+    b.stats.nodes);
+  std::printf("render          %.3f ms, %dx%d, mode %s%s, %zu primary + %zu secondary rays\n", stats.seconds * 1e3,
+    o.width, o.height, o.mode->name, o.shadows ? " + shadows" : "", stats.primaryRays, stats.secondaryRays);
+  std::printf("throughput      %.2f Mrays/s (%.2f Mrays/s primary)\n", rays / stats.seconds * 1e-6,
+    static_cast<double>(stats.primaryRays) / stats.seconds * 1e-6);
+  std::printf("wrote           %s (%.3f s)\n", written.c_str(), writeSeconds);
   return 0;
 }
 }
