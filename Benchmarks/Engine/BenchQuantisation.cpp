@@ -62,7 +62,8 @@ int main(int argc, char** argv)
   options.Choice("--backend", backend, { "cpu", "cuda" })
     .Option("--depths", "a range FIRST-LAST within 1-" + std::to_string(kMaxLevel),
       [&](const std::string& v) {
-        return std::sscanf(v.c_str(), "%d-%d", &first, &last) == 2 && first >= 1 && last <= kMaxLevel &&
+        char rest = 0;
+        return std::sscanf(v.c_str(), "%d-%d%c", &first, &last, &rest) == 2 && first >= 1 && last <= kMaxLevel &&
           first <= last;
       })
     .Text("--ct", ct)
