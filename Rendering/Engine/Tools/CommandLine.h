@@ -35,7 +35,11 @@ public:
   // An option without a value: sets `into`.
   CommandLine& Flag(const char* name, bool& into)
   {
-    Options.push_back(Entry{ name, "", [&into](const std::string&) { return into = true; }, true });
+    Parser set = [&into](const std::string&) {
+      into = true;
+      return true;
+    };
+    Options.push_back(Entry{ name, "", std::move(set), true });
     return *this;
   }
   CommandLine& Text(const char* name, std::string& into)
@@ -55,8 +59,12 @@ public:
       expects += (&v == &values.front() ? " " : ", ") + v;
     }
     return Option(name, expects, [&into, values](const std::string& v) {
+      if (std::find(values.begin(), values.end(), v) == values.end())
+      {
+        return false;
+      }
       into = v;
-      return std::find(values.begin(), values.end(), v) != values.end();
+      return true;
     });
   }
   // A whole number from `least` to `most`.
