@@ -2,8 +2,9 @@
 
 usage: test_octoray_tool.py OCTORAY DATA_DIR WORK_DIR
 
-- bad arguments: exit status 2, and a message naming the option, what it
-  expects and what it got (or the missing value, or the missing -o);
+- bad arguments: exit status 2, a message naming the option, what it
+  expects and what it got (or the missing value, or the missing -o), and
+  no picture written;
 - a depth the engine refuses, and a file that does not exist: exit status 1
   and the engine's or the loader's message;
 - `stats`: the points counted as the file holds them, one root node, and
@@ -20,6 +21,8 @@ import unittest
 
 TOOL, DATA, WORK = sys.argv[1:4]
 LIDAR = os.path.join(DATA, "Particles", "lidar_simple.particles")
+# Where a bad-argument case would write, were its argument taken.
+STRAY = os.path.join(WORK, "stray.ppm")
 # The tool composites over this background (octoray.cpp's Composite).
 BACKGROUND = (round(255 * 0.08), round(255 * 0.08), round(255 * 0.1))
 
@@ -41,14 +44,14 @@ def read_ppm(path):
 
 class BadArguments(unittest.TestCase):
     CASES = [
-        (["render", LIDAR, "-o", "x.ppm", "--depth", "x"], "--depth expects a whole number, not 'x'"),
-        (["render", LIDAR, "-o", "x.ppm", "--mode", "fancy"],
+        (["render", LIDAR, "-o", STRAY, "--depth", "x"], "--depth expects a whole number, not 'x'"),
+        (["render", LIDAR, "-o", STRAY, "--mode", "fancy"],
          "--mode expects one of surface, depthcue, phong, composite, mip, minip, average, additive, not 'fancy'"),
-        (["render", LIDAR, "-o", "x.ppm", "--size", "0x10"], "--size expects a size WxH such as 1920x1080, not '0x10'"),
-        (["render", LIDAR, "-o", "x.ppm", "--zoom", "0"], "--zoom expects a number above 0, not '0'"),
-        (["render", LIDAR, "-o", "x.ppm", "--lod", "2px"], "--lod expects a number, not '2px'"),
-        (["render", LIDAR, "-o", "x.ppm", "--bounces", "-1"], "--bounces expects a whole number of at least 0, not '-1'"),
-        (["render", LIDAR, "-o", "x.ppm", "--bogus", "1"], "unknown option '--bogus'"),
+        (["render", LIDAR, "-o", STRAY, "--size", "0x10"], "--size expects a size WxH such as 1920x1080, not '0x10'"),
+        (["render", LIDAR, "-o", STRAY, "--zoom", "0"], "--zoom expects a number above 0, not '0'"),
+        (["render", LIDAR, "-o", STRAY, "--lod", "2px"], "--lod expects a number, not '2px'"),
+        (["render", LIDAR, "-o", STRAY, "--bounces", "-1"], "--bounces expects a whole number of at least 0, not '-1'"),
+        (["render", LIDAR, "-o", STRAY, "--bogus", "1"], "unknown option '--bogus'"),
         (["render", LIDAR, "-o"], "-o expects a value, and no value follows it"),
         (["render", LIDAR, "--mode", "phong"], "render needs -o OUT.png, the picture to write"),
         (["stats", LIDAR, "--backend", "gpu"], "--backend expects one of auto, cpu, cuda, not 'gpu'"),
@@ -56,12 +59,15 @@ class BadArguments(unittest.TestCase):
     ]
 
     def test_each_is_named(self):
+        if os.path.exists(STRAY):
+            os.remove(STRAY)
         for args, message in self.CASES:
             with self.subTest(args=args):
                 status, _, err = run(*args)
                 self.assertEqual(status, 2)
                 self.assertIn("octoray: " + message + "\n", err)
                 self.assertIn("usage: octoray", err)
+                self.assertFalse(os.path.exists(STRAY), "a picture was written")
 
     def test_unknown_command(self):
         status, _, err = run("draw", LIDAR)
