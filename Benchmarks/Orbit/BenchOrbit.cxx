@@ -650,7 +650,8 @@ std::vector<Scene> LoadScenes(const Options& o)
   std::vector<Scene> scenes;
   for (const std::string& count : SplitList(o.Points))
   {
-    const auto n = static_cast<std::size_t>(std::strtod(count.c_str(), nullptr));
+    std::size_t n = 0;
+    octoray::CommandLine::ParseCount(count, n); // checked by the parse
     if (n == 0)
     {
       continue; // --points 0: the file's scene alone
@@ -808,7 +809,23 @@ int main(int argc, char* argv[])
 {
   Options o;
   octoray::CommandLine cli;
-  cli.Text("--points", o.Points).Text("--sizes", o.Sizes).Text("--methods", o.Methods).Text("--file", o.File);
+  cli.Text("--methods", o.Methods).Text("--file", o.File);
+  cli.Option("--points", "a list of counts such as 1e6,1e7 (0: the file's scene alone)", [&o](const std::string& v) {
+    o.Points = v;
+    const std::vector<std::string> counts = SplitList(v);
+    std::size_t n = 0;
+    return !counts.empty() && std::all_of(counts.begin(), counts.end(), [&](const std::string& count) {
+      return octoray::CommandLine::ParseCount(count, n);
+    });
+  });
+  cli.Option("--sizes", "a list of sizes WxH such as 1920x1080,3840x2160", [&o](const std::string& v) {
+    o.Sizes = v;
+    const std::vector<std::string> sizes = SplitList(v);
+    int w = 0, h = 0;
+    return !sizes.empty() && std::all_of(sizes.begin(), sizes.end(), [&](const std::string& size) {
+      return octoray::CommandLine::ParseSize(size, w, h);
+    });
+  });
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
   cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);
   if (!cli.Parse(argc, argv))
@@ -833,7 +850,7 @@ int main(int argc, char* argv[])
     for (const std::string& size : SplitList(o.Sizes))
     {
       int w = 0, h = 0;
-      std::sscanf(size.c_str(), "%dx%d", &w, &h);
+      octoray::CommandLine::ParseSize(size, w, h); // checked by the parse
       RunSize(scene, w, h, o, records);
     }
   }

@@ -105,15 +105,7 @@ public:
   CommandLine& Size(const char* name, int& width, int& height)
   {
     return Option(name, "a size WxH such as 1920x1080", [&width, &height](const std::string& v) {
-      int w = 0, h = 0;
-      char rest = 0;
-      if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w <= 0 || h <= 0)
-      {
-        return false;
-      }
-      width = w;
-      height = h;
-      return true;
+      return ParseSize(v, width, height);
     });
   }
 
@@ -169,6 +161,20 @@ public:
       return false;
     }
     into = static_cast<std::size_t>(d);
+    return true;
+  }
+
+  // A picture size "WxH", both above 0, that is the whole of `text`.
+  static bool ParseSize(const std::string& text, int& width, int& height)
+  {
+    int w = 0, h = 0;
+    char rest = 0;
+    if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w <= 0 || h <= 0)
+    {
+      return false;
+    }
+    width = w;
+    height = h;
     return true;
   }
 
