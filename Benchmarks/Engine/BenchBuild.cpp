@@ -142,20 +142,7 @@ int main(int argc, char** argv)
   std::string json;
   CommandLine options;
   options
-    .Option("--points", "a list of counts such as 1000000,1e7",
-      [&](const std::string& v) {
-        counts.clear();
-        for (const std::string& c : SplitList(v))
-        {
-          std::size_t n = 0;
-          if (!CommandLine::ParseCount(c, n) || n == 0)
-          {
-            return false;
-          }
-          counts.push_back(n);
-        }
-        return !counts.empty();
-      })
+    .Counts("--points", counts, 1)
     .Option("--sets", "a list of uniform, clustered and narrow",
       [&](const std::string& v) {
         sets = SplitList(v);

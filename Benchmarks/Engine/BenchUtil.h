@@ -500,25 +500,6 @@ inline void MergeRecords(const std::string& path, const std::vector<Record>& rec
     throw std::runtime_error(path + ": could not be replaced by " + temporary);
   }
 }
-// ---------------------------------------------------------------- command line
-// (CommandLine.h, beside the octoray tool, parses the options.)
-
-// A comma-separated list, empty items dropped.
-inline std::vector<std::string> SplitList(const std::string& list)
-{
-  std::vector<std::string> items;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ','))
-  {
-    if (!item.empty())
-    {
-      items.push_back(item);
-    }
-  }
-  return items;
-}
-
 // Merges `records` into the JSON file `path` (nothing when it is empty) and
 // says so.
 inline void SaveRecords(const std::string& path, const std::vector<Record>& records)

@@ -66,6 +66,7 @@
 #include <cuda_runtime_api.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -597,8 +598,9 @@ Scene MakeScene(const std::string& name, vtkSmartPointer<vtkPolyData> cloud, dou
 
 struct Options
 {
-  std::string Points = "1e6,1e7,1e8", Sizes = "1920x1080,3840x2160",
-              Methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", File, Json, Images;
+  std::vector<std::size_t> Points = { 1000000, 10000000, 100000000 }; // 0: the file's scene alone
+  std::vector<std::array<int, 2>> Sizes = { { 1920, 1080 }, { 3840, 2160 } };
+  std::string Methods = "octoray,octoray-host,pointgauss,points,smart-256,smart-512", File, Json, Images;
   double Tile = 0.0; // points: the file's cloud tiled to that many (a static scene, points not kept)
   int TileDepth = 12;
   int Frames = 60;
@@ -648,10 +650,8 @@ void ColourIfUncoloured(vtkPolyData* cloud)
 std::vector<Scene> LoadScenes(const Options& o)
 {
   std::vector<Scene> scenes;
-  for (const std::string& count : SplitList(o.Points))
+  for (const std::size_t n : o.Points)
   {
-    std::size_t n = 0;
-    octoray::CommandLine::ParseCount(count, n); // checked by the parse
     if (n == 0)
     {
       continue; // --points 0: the file's scene alone
@@ -781,7 +781,7 @@ void RunSize(const Scene& scene, int w, int h, const Options& o, std::vector<Rec
 {
   std::map<std::string, Result> results;
   double secondsPerVoxel = 0.0; // the last resampling's
-  for (const std::string& method : SplitList(o.Methods))
+  for (const std::string& method : octoray::SplitList(o.Methods))
   {
     double estimate = 0.0;
     if (ResamplingTooSlow(method, secondsPerVoxel, o, estimate))
@@ -810,21 +810,19 @@ int main(int argc, char* argv[])
   Options o;
   octoray::CommandLine cli;
   cli.Text("--methods", o.Methods).Text("--file", o.File);
-  cli.Option("--points", "a list of counts such as 1e6,1e7 (0: the file's scene alone)", [&o](const std::string& v) {
-    o.Points = v;
-    const std::vector<std::string> counts = SplitList(v);
-    std::size_t n = 0;
-    return !counts.empty() && std::all_of(counts.begin(), counts.end(), [&](const std::string& count) {
-      return octoray::CommandLine::ParseCount(count, n);
-    });
-  });
+  cli.Counts("--points", o.Points);
   cli.Option("--sizes", "a list of sizes WxH such as 1920x1080,3840x2160", [&o](const std::string& v) {
-    o.Sizes = v;
-    const std::vector<std::string> sizes = SplitList(v);
-    int w = 0, h = 0;
-    return !sizes.empty() && std::all_of(sizes.begin(), sizes.end(), [&](const std::string& size) {
-      return octoray::CommandLine::ParseSize(size, w, h);
-    });
+    o.Sizes.clear();
+    for (const std::string& size : octoray::SplitList(v))
+    {
+      std::array<int, 2> wh{};
+      if (!octoray::CommandLine::ParseSize(size, wh[0], wh[1]))
+      {
+        return false;
+      }
+      o.Sizes.push_back(wh);
+    }
+    return !o.Sizes.empty();
   });
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
   cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);
@@ -847,11 +845,9 @@ int main(int argc, char* argv[])
   {
     std::printf("\n%s, %lld points: generated or read in %.2f s\n", scene.Name.c_str(),
       static_cast<long long>(scene.Cloud->GetNumberOfPoints()), scene.PrepareSeconds);
-    for (const std::string& size : SplitList(o.Sizes))
+    for (const std::array<int, 2>& size : o.Sizes)
     {
-      int w = 0, h = 0;
-      octoray::CommandLine::ParseSize(size, w, h); // checked by the parse
-      RunSize(scene, w, h, o, records);
+      RunSize(scene, size[0], size[1], o, records);
     }
   }
   SaveRecords(o.Json, records);

@@ -1096,7 +1096,7 @@ def _cuda(ctx):
             "Call / copy moves with the host's copy speed from run to run: at 10 M points and depth 10 it was %s in "
             "this run, and in rounds of %s's engine on other H200 machines: %s. At 100 M points, %s here and %s "
             "there." % (listed(here[10000000]), ROUNDS_ENGINE, sessions, listed(here[100000000]),
-                        "; ".join(listed(r[3]) for r in rounds[100000000])),
+                        "; ".join(listed(ratios) for _, _, _, ratios in rounds[100000000])),
             "",
         ]
     if staging:

@@ -12,14 +12,30 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <initializer_list>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace octoray
 {
+// A comma-separated list, empty items dropped.
+inline std::vector<std::string> SplitList(const std::string& list)
+{
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ','))
+  {
+    if (!item.empty())
+    {
+      items.push_back(item);
+    }
+  }
+  return items;
+}
+
 class CommandLine
 {
 public:
@@ -50,9 +66,8 @@ public:
     });
   }
   // One of `allowed`, e.g. the backend.
-  CommandLine& Choice(const char* name, std::string& into, std::initializer_list<const char*> allowed)
+  CommandLine& Choice(const char* name, std::string& into, std::vector<std::string> values)
   {
-    std::vector<std::string> values(allowed.begin(), allowed.end());
     std::string expects = "one of";
     for (const std::string& v : values)
     {
@@ -99,6 +114,26 @@ public:
   {
     return Option(name, "a count such as 1000000 or 1e6", [&into](const std::string& v) {
       return ParseCount(v, into);
+    });
+  }
+  // A comma-separated list of point counts, each at least `least`.
+  CommandLine& Counts(const char* name, std::vector<std::size_t>& into, std::size_t least = 0)
+  {
+    const std::string expects =
+      "a list of counts such as 1e6,1e7" + (least ? ", each at least " + std::to_string(least) : std::string());
+    return Option(name, expects, [&into, least](const std::string& v) {
+      std::vector<std::size_t> counts;
+      for (const std::string& item : SplitList(v))
+      {
+        std::size_t n = 0;
+        if (!ParseCount(item, n) || n < least)
+        {
+          return false;
+        }
+        counts.push_back(n);
+      }
+      into = counts;
+      return !counts.empty();
     });
   }
   // A picture size, "WxH", both above 0.

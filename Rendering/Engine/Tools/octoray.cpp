@@ -17,7 +17,6 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
@@ -243,7 +242,7 @@ struct RenderOptions
 {
   EngineOptions engine;
   std::string output;
-  const ToolMode* mode = &kToolModes[0];
+  const ToolMode* mode = nullptr;
   int width = 1280, height = 720, bounces = 2;
   double azimuth = -60, elevation = 30, zoom = 1, lod = 0;
   bool shadows = false;
@@ -251,22 +250,17 @@ struct RenderOptions
   // Parses argv from argv[3]; false, having said why, where it does not.
   bool Parse(int argc, char** argv)
   {
-    std::string modes = "one of";
+    std::vector<std::string> modes;
     for (const ToolMode& m : kToolModes)
     {
-      modes += (&m == kToolModes ? " " : ", ") + std::string(m.name);
+      modes.push_back(m.name);
     }
+    std::string modeName = modes.front();
     octoray::CommandLine options;
     engine.AddTo(options);
     options.Text("-o", output)
       .Size("--size", width, height)
-      .Option("--mode", modes,
-        [this](const std::string& v) {
-          const auto found = std::find_if(
-            std::begin(kToolModes), std::end(kToolModes), [&](const ToolMode& m) { return v == m.name; });
-          mode = found != std::end(kToolModes) ? found : nullptr;
-          return mode != nullptr;
-        })
+      .Choice("--mode", modeName, modes)
       .Real("--lod", lod)
       .Integer("--bounces", bounces, 0)
       .Flag("--shadows", shadows)
@@ -277,6 +271,7 @@ struct RenderOptions
     {
       return false;
     }
+    mode = &kToolModes[std::find(modes.begin(), modes.end(), modeName) - modes.begin()];
     if (output.empty())
     {
       std::fprintf(stderr, "octoray: render needs -o OUT.png, the picture to write\n");
