@@ -1,7 +1,5 @@
 """The engine's command-line tool, `octoray`, as a user runs it.
 
-usage: test_octoray_tool.py OCTORAY DATA_DIR WORK_DIR
-
 - bad arguments: exit status 2, a message naming the option, what it
   expects and what it got (or the missing value, or the missing -o), and
   no picture written;
@@ -10,8 +8,14 @@ usage: test_octoray_tool.py OCTORAY DATA_DIR WORK_DIR
 - `stats`: the points counted as the file holds them, one root node, and
   the nodes per level adding up to the node count;
 - `render` to a PPM file: the picture has the requested size, every pixel a
-  primary ray, and the points drawn (pixels off the background).
+  primary ray, and the points drawn (pixels off the background);
+- `--help`: the usage on stdout, exit status 0;
+- OnCuda (run alone as engine.tool.cuda, skipped where CUDA is not
+  available): `stats` gives the CPU's octree level for level, and `render`
+  the CPU's pictures within the engine's tolerance between backends.
 Plain python3 (no VTK, no pytest): the tool builds without VTK.
+
+usage: test_octoray_tool.py OCTORAY DATA_DIR WORK_DIR [unittest arguments]
 """
 import os
 import re
@@ -72,7 +76,23 @@ class BadArguments(unittest.TestCase):
     def test_unknown_command(self):
         status, _, err = run("draw", LIDAR)
         self.assertEqual(status, 2)
+        self.assertIn("octoray: unknown command 'draw'\n", err)
         self.assertIn("usage: octoray", err)
+
+    def test_missing_file_argument(self):
+        status, _, err = run("render")
+        self.assertEqual(status, 2)
+        self.assertIn("octoray: render needs a FILE, the particle file to read\n", err)
+
+
+class Help(unittest.TestCase):
+    def test_usage_on_stdout(self):
+        for args in (["--help"], ["-h"], ["help"], ["render", LIDAR, "--help"]):
+            with self.subTest(args=args):
+                status, out, err = run(*args)
+                self.assertEqual((status, err), (0, ""))
+                self.assertTrue(out.startswith("usage: octoray stats FILE"), out)
+                self.assertIn("MODE: surface", out)
 
 
 class Failures(unittest.TestCase):
@@ -116,6 +136,72 @@ class Commands(unittest.TestCase):
         self.assertLess(drawn, len(pixels))
 
 
+def stats_lines(out):
+    """The lines of `stats` that describe the octree (not the backend, the
+    times or the memory, which differ between backends)."""
+    return [line for line in out.splitlines() if line.startswith(("file ", "depth ", "nodes "))]
+
+
+def without_times(out):
+    return re.sub(r" \(\d+\.\d+ s\)| read in \d+\.\d+ s", "", out)
+
+
+class OnCuda(unittest.TestCase):
+    # CUDA pictures against the CPU's: at least 99.9 % of the pixels equal,
+    # none off by more than 2 in any 8-bit channel (the engine tests' bound).
+    SAME_FRACTION = 0.999
+    MOST_OFF = 2
+    RENDERS = [
+        ["--mode", "phong", "--shadows", "--bounces", "1"],
+        ["--mode", "depthcue", "--depth", "5", "--lod", "2"],
+        ["--mode", "composite", "--azimuth", "120", "--elevation", "60"],
+        ["--mode", "mip", "--zoom", "2"],
+    ]
+
+    @classmethod
+    def setUpClass(cls):
+        status, _, err = run("stats", LIDAR, "--backend", "cuda")
+        if status != 0 and "the CUDA backend is not available" in err:
+            raise unittest.SkipTest(err.strip())
+
+    def test_stats_same_octree(self):
+        for depth in ("0", "6", "12"):
+            with self.subTest(depth=depth):
+                outs = []
+                for backend in ("cpu", "cuda"):
+                    status, out, err = run("stats", LIDAR, "--backend", backend, "--depth", depth)
+                    self.assertEqual(status, 0, err)
+                    outs.append(without_times(out))
+                self.assertIn("CUDA", re.search(r"^backend .*$", outs[1], re.M).group(0))
+                self.assertEqual(len(stats_lines(outs[0])), 4, outs[0])
+                self.assertEqual(stats_lines(outs[1]), stats_lines(outs[0]))
+
+    def test_render_same_pictures(self):
+        for options in self.RENDERS:
+            with self.subTest(options=options):
+                pictures = []
+                for backend in ("cpu", "cuda"):
+                    picture = os.path.join(WORK, "lidar-%s.ppm" % backend)
+                    if os.path.exists(picture):
+                        os.remove(picture)
+                    status, _, err = run("render", LIDAR, "-o", picture, "--backend", backend, "--size", "320x180",
+                                         *options)
+                    self.assertEqual(status, 0, err)
+                    pictures.append(read_ppm(picture))
+                (w, h, cpu), cuda = pictures[0], pictures[1]
+                self.assertEqual(cuda[:2], (w, h))
+                drawn = sum(1 for p in cpu if p != BACKGROUND)
+                self.assertGreater(drawn, 0.02 * len(cpu), "too little drawn to compare")
+                off = [max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(cpu, cuda[2])]
+                self.assertLessEqual(max(off), self.MOST_OFF)
+                self.assertGreaterEqual(off.count(0), self.SAME_FRACTION * len(off))
+
+
+def load_tests(loader, tests, pattern):
+    """Every class but OnCuda, which engine.tool.cuda names."""
+    return unittest.TestSuite(suite for suite in tests if not any(isinstance(t, OnCuda) for t in suite))
+
+
 if __name__ == "__main__":
     os.makedirs(WORK, exist_ok=True)
-    unittest.main(argv=sys.argv[:1], verbosity=2)
+    unittest.main(argv=sys.argv[:1] + sys.argv[4:], verbosity=2)

@@ -14,8 +14,8 @@
 # A VTK found in /tmp/vtk-egl (an earlier call on the same machine) is reused.
 #
 #   scripts/gpu/gpu-check.sh OUTDIR [PARTS]
-# PARTS, comma-separated (default all): tests (engine and mapper tests, both
-# backends), sanitize (compute-sanitizer memcheck, initcheck and synccheck on
+# PARTS, comma-separated (default all): tests (engine, mapper and tool tests,
+# both backends), sanitize (compute-sanitizer memcheck, initcheck and synccheck on
 # the engine's CUDA tests, memcheck on the mapper's), racecheck (on the
 # engine's CUDA tests: the slowest, about 3 minutes), bench (engine
 # benchmarks; BILLION points, default 1e9, generated on the device, 0: none),
@@ -80,6 +80,8 @@ mapper_tests='RenderingVolumeCxx'
 if want tests; then
   step engine-tests $build/bin/octoray_engine_tests --gtest_output=xml:"$out/engine-tests.xml"
   step mapper-tests bash -c "cd $build && ctest -R '$mapper_tests' --no-tests=error --output-on-failure --output-junit '$out/mapper-tests.xml'"
+  # The command-line tool, its CUDA half among them (engine.tool.cuda).
+  step tool-tests bash -c "cd $build && ctest -R '^engine\.tool' --no-tests=error --output-on-failure -V"
 fi
 
 # The engine's tests of launches the CUDA runtime refuses on purpose.
@@ -185,6 +187,7 @@ echo
 echo "== octoray GPU check, $(date -u +%Y-%m-%d): $(cat "$out/gpu.txt") =="
 [ -f "$out/engine-tests.log" ] && grep -E "tests? (ran|from)|PASSED|FAILED" "$out/engine-tests.log" | tail -3
 [ -f "$out/mapper-tests.log" ] && grep -E "tests passed|tests failed|\(Failed\)|\(Skipped\)" "$out/mapper-tests.log" | tail -8
+[ -f "$out/tool-tests.log" ] && grep -E "Test +#[0-9]+: engine\.tool" "$out/tool-tests.log"
 for f in memcheck memcheck-refused racecheck initcheck synccheck memcheck-mapper; do
   [ -f "$out/$f.log" ] && echo "$f: $(grep -E "ERROR SUMMARY|RACECHECK SUMMARY" "$out/$f.log" | sort | uniq -c | tr -s ' ' | paste -sd';')"
 done

@@ -2,7 +2,9 @@
 //   octoray stats FILE [--depth N] [--backend cpu|cuda|auto] [--threads N]
 // builds the octree of a particle file and prints its statistics and costs;
 //   octoray render FILE -o OUT.png [options]
-// ray-traces it from a camera orbiting the data and writes the picture.
+// ray-traces it from a camera orbiting the data and writes the picture;
+//   octoray --help
+// prints the options.
 #include "CommandLine.h"
 #include "OrbitCamera.h"
 #include "PointFile.h"
@@ -28,9 +30,10 @@
 
 namespace
 {
-int Usage()
+// The usage, on `to`; the exit status of a command line that is wrong.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  std::fprintf(to,
     "usage: octoray stats FILE [--depth N] [--backend cpu|cuda|auto] [--threads N]\n"
     "  builds the octree of a particle file (3, 4, 6 or 8 columns) and prints its statistics\n"
     "       octoray render FILE -o OUT.png [--size WxH] [--mode MODE] [--depth N] [--lod K]\n"
@@ -40,6 +43,13 @@ int Usage()
     "  the camera orbits the data's centre (azimuth about +z, elevation above the xy plane);\n"
     "  PNG through OpenImageIO where it was found at build time, else binary PPM\n");
   return 2;
+}
+
+// `--help` or `-h` anywhere, or `help` as the command.
+bool AsksForHelp(int argc, char** argv)
+{
+  const auto isHelp = [](const std::string& a) { return a == "--help" || a == "-h"; };
+  return (argc > 1 && std::string(argv[1]) == "help") || std::any_of(argv + 1, argv + argc, isHelp);
 }
 
 double Seconds(std::chrono::steady_clock::time_point since)
@@ -138,13 +148,23 @@ int Render(int argc, char** argv);
 
 int main(int argc, char** argv)
 {
-  if (argc < 3)
+  if (AsksForHelp(argc, argv))
   {
-    return Usage();
+    Usage(stdout);
+    return 0;
   }
-  const std::string command = argv[1];
+  const std::string command = argc > 1 ? argv[1] : "";
   if (command != "stats" && command != "render")
   {
+    if (!command.empty())
+    {
+      std::fprintf(stderr, "octoray: unknown command '%s'\n", command.c_str());
+    }
+    return Usage();
+  }
+  if (argc < 3)
+  {
+    std::fprintf(stderr, "octoray: %s needs a FILE, the particle file to read\n", command.c_str());
     return Usage();
   }
   try
