@@ -143,6 +143,7 @@ def stats_lines(out):
 
 
 def without_times(out):
+    """The output with its times taken out: they differ from run to run."""
     return re.sub(r" \(\d+\.\d+ s\)| read in \d+\.\d+ s", "", out)
 
 
