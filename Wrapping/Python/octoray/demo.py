@@ -252,8 +252,9 @@ def laser_scan(args, timings, pictures):
     points_picture(args, timings, pictures, "2/3", "laser scan",
                    os.path.join(args.data, "External", "PCL", "table_scene_lms400.pcd"), "scan.png",
                    "vtkPCDReader", (1200, 900), view=(18.0, 12.0), depth_from_auto=-1,
-                   # Key and fill balanced: the key light's shadows on a
-                   # noisy, voxel-terraced scan speckle (see the README).
+                   # Key and fill balanced: on a noisy scan the key
+                   # light's shadows add dots where single voxels stand
+                   # above their neighbours (README, "Shadows on voxels").
                    lights=(0.55, 0.6), zoom=1.5,
                    prop_settings={"Ambient": 0.12, "Diffuse": 0.88, "Specular": 0.1, "SpecularPower": 20})
 
