@@ -81,11 +81,12 @@ protected:
   void TearDown() override { InjectCudaLaunchFailure(""); }
 };
 
-// A build of `second` at the automatic depth whose launch of `kernel` the
-// runtime refuses: the error names the kernel, the octree of `first` and its
-// picture stay as they were, and the same build then succeeds.
+// A build of `second` with `refused` (the automatic depth, say) whose
+// launch of `kernel` the runtime refuses: the error names the kernel, the
+// octree of `first` and its picture stay as they were, and a build of
+// `second` at the fixed depth then succeeds.
 void ExpectRefusedBuildKeepsTheOctree(const Cloud& first, const Cloud& second, const char* kernel,
-  const BuildOptions& fixedDepth, const BuildOptions& automaticDepth)
+  const BuildOptions& fixedDepth, const BuildOptions& refused)
 {
   auto engine = CreateEngine(Backend::CUDA);
   engine->Build(first.View(), fixedDepth);
@@ -94,7 +95,7 @@ void ExpectRefusedBuildKeepsTheOctree(const Cloud& first, const Cloud& second, c
   const std::vector<float> picture = Picture(*engine);
 
   InjectCudaLaunchFailure(kernel);
-  EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Build(second.View(), automaticDepth); }), kernel));
+  EXPECT_TRUE(IsRefusal(ErrorOf([&] { engine->Build(second.View(), refused); }), kernel));
 
   HostOctree after;
   engine->CopyToHost(after);
@@ -142,6 +143,23 @@ TEST_F(CudaFaultsLaunch, BuildKeepsThePreviousOctree)
       SCOPED_TRACE(name + (second == &staged ? ", staged" : ""));
       ExpectRefusedBuildKeepsTheOctree(first, *second, kernel, fixedDepth, automaticDepth);
     }
+  }
+}
+
+// A fixed cube that leaves points out: the loop that finds the first of
+// them is refused, for a cloud the engine copies itself and for one it
+// stages; the error names that loop, not a point.
+TEST_F(CudaFaultsLaunch, CubeCheckKeepsThePreviousOctree)
+{
+  const Cloud first = UniformCloud(1500, 61);
+  BuildOptions fixedDepth;
+  fixedDepth.depth = 6;
+  BuildOptions tooSmall = fixedDepth;
+  tooSmall.fixedCube = true; // the unit cube from the origin: the clouds span [-1, 1]
+  for (const Cloud& second : { UniformCloud(1500, 65), UniformCloud(60000, 66) })
+  {
+    SCOPED_TRACE(second.Size());
+    ExpectRefusedBuildKeepsTheOctree(first, second, "OutsideCubeKernel", fixedDepth, tooSmall);
   }
 }
 
