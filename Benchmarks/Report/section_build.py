@@ -1317,7 +1317,8 @@ def _goal_rows(builds, records, phases, upload):
                      " / ".join(seconds(r["seconds"]) for r in calls),
                      "pinned copy of the same bytes %s; issue 16's goal ≤ %g×" %
                      (" / ".join(seconds(r["pinned_upload_seconds"]) for r in calls), GOAL_CALL_OVER_COPY),
-                     " / ".join("%.2f×" % call_over_copy(r) for r in calls)))
+                     " / ".join("%.2f×" % call_over_copy(r) for r in calls) +
+                     (" (median of the pairs)" if all("call_over_pinned_copy" in r for r in calls) else "")))
     r = named_record(records, "gpu bytes per point, every attribute")
     if r:
         rows.append(("GPU memory, %s points, depth %d, every attribute (GPU run)" % (count(r["n"]), r["depth"]),
