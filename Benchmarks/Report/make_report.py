@@ -119,9 +119,12 @@ class Context:
 
     def relative(self, path):
         """Paths inside the repository written relative to it, so commands in
-        RESULTS.md read the same on every machine."""
+        RESULTS.md read the same on every machine: an argument that is such
+        a path, or one that ends with it (--gtest_output=xml:PATH)."""
         if isinstance(path, str) and os.path.isabs(path) and path.startswith(self.root + os.sep):
             return os.path.relpath(path, self.root)
+        if isinstance(path, str) and (self.root + os.sep) in path:
+            return path.replace(self.root + os.sep, "")
         return path
 
     # ------------------------------------------------------------ files

@@ -38,6 +38,12 @@ def python_env(ctx):
     return {"PYTHONPATH": python_dir(ctx.build), "VTK_LOGGING_LEVEL": "ERROR"}
 
 
+def with_python_path(command):
+    """A command run in python_env as RESULTS.md shows it, from the
+    repository's root (make's build folder)."""
+    return "PYTHONPATH=build/lib/python3/dist-packages " + command
+
+
 def ct_particles(ctx):
     """build/report/scenes/ct5n.particles: the CT series as points (x y z
     HU), air removed. Written by this file run as a program, through

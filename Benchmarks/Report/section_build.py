@@ -942,7 +942,8 @@ def _cuda(ctx):
         "their ratio to the sort, 1.97–2.00 against 1.94–1.99, moved with the sort's own time, 0.56–0.58 ms "
         "(Benchmarks/gpu/variants-count-fields.txt). The level phase also waited for the host, which reserved the node arrays before "
         "it queued the phase's first kernel: 0.2–0.3 ms at 10 M points while the engine's memory pool grew, over "
-        "the first four builds of a size. Since 2330cb0 the leaves' select runs on the device meanwhile. Since "
+        "the first four builds of a size. From 2330cb0 the leaves' select ran on the device meanwhile (the nested "
+        "lists replaced the selects since). Since "
         "7ad2508 the benchmark times its builds once the pool has settled. In three rounds of it, the level phase "
         "at 10 M points took 0.62 ms, where its kernels alone take 0.60, and 0.64–0.67 ms for the engine before "
         "(Benchmarks/gpu/variants-levels-order.txt). An inner node's children add up in float since bdad029 (at "
@@ -965,7 +966,7 @@ def _cuda(ctx):
         "them; at depth 16 the phase took 2.63–2.65 ms so against 3.05–3.08, the host queueing its 16 levels in "
         "0.7–1.2 ms (Benchmarks/gpu/variants-levels-spin-2.txt). "
         "The levels' selects "
-        "are CUB's DeviceSelect::If, its predicate reading two keys; on the same sorted keys DeviceSelect::"
+        "were then CUB's DeviceSelect::If, its predicate reading two keys; on the same sorted keys DeviceSelect::"
         "UniqueByKey took 1.45–1.76 times as long, and a select of tiles with a decoupled look-back written for "
         "them 1.06–2.89 times (Benchmarks/gpu/variants-run-starts-select.txt). The thirteenth session's first try of every level's run starts from one pass over the sorted points (a "
         "count pass, a scan and a placing pass after the histogram and the host's reservations; "
@@ -1105,7 +1106,8 @@ def _cuda(ctx):
         text += [
             "Where the whole call goes, and what the engine holds. The engine copies a caller's pageable arrays of "
             + ("1 MB and more through page-locked buffers on up to 16 host threads, started once and kept, in "
-               "pieces of 0.5 to 4 MB (small at the run's start and end), which the threads take in turn as each "
+               "pieces that grow from 0.5 to 4 MB over the run's start (half that of the reflectivity's 16-bit "
+               "codes), which the threads take in turn as each "
                "becomes free "
                if host_copy else "16 MB and more through page-locked buffers on up to 8 host threads ")
             + "(Rendering/Engine/octoray/"
@@ -1128,8 +1130,9 @@ def _cuda(ctx):
                  "No upload through page-locked buffers takes less than the longer of the host copy and a pinned "
                  "copy of what it lands (before c9c93d4, the pinned copy here)" if host_copy else "")
                 + ("; nor less than the two at once (*host copy and pinned copy at once*: both read the host's "
-                   "memory); *staged copy alone* is the engine's staging of the same arrays with nothing queued on "
-                   "its pieces (a build reduces the positions' bounds on them)" if one_pass else "")),
+                   "memory); *staged copy alone* is the engine's staging of the same arrays with nothing queued "
+                   "after it (a build reduces the positions' bounds in one loop once they have landed)"
+                   if one_pass else "")),
             "",
             ctx.table(["points", "depth", "upload", "plain cudaMemcpy", "cudaHostRegister + copy", "pinned copy"]
                       + (["host copy"] if host_copy else [])
@@ -1218,7 +1221,7 @@ def _cuda(ctx):
         primary = named_record(records, "device points primary 1920x1080")
         full = named_record(records, "device points shadows+bounce 1920x1080")
         text += [
-            "**%s points on one GPU** (`octoray_bench_cuda --billion`): Gaussian clusters like the ones above, "
+            "**%s points on one GPU** (`octoray_bench_cuda --billion 1e9`): Gaussian clusters like the ones above, "
             "generated on the device from a fixed seed (xyz float and 8-bit RGB), built from device memory at "
             "depth 10 without the points (the engine copies them on the device, then keeps the node arrays "
             "alone), traced at 1920×1080. One build, the first, its allocations included: %s (sort %s, levels %s), "
@@ -1520,8 +1523,8 @@ Command:
     {peers_cmd}
 
 Every build starts from nothing (fresh engine, fresh PCL octree, fresh locator); freeing a tree is not timed.
-octoray: median of {peer_repeats} after 1 warm-up. PCL and vtkOctreePointLocator: median of 3, no warm-up (1 build at
-5 M points and more). vtkStaticPointLocator: median of {peer_repeats} after 1 warm-up. vtkOctreePointLocator gets MaximumPointsPerRegion =
+octoray: median of {peer_repeats} after 1 warm-up. PCL and vtkOctreePointLocator: median of 3, no warm-up
+(vtkOctreePointLocator: 1 build at 5 M points and more). vtkStaticPointLocator: median of {peer_repeats} after 1 warm-up. vtkOctreePointLocator gets MaximumPointsPerRegion =
 octoray's mean points per leaf rounded up; vtkStaticPointLocator the same NumberOfPointsPerBucket. Ratio = peer time
 / octoray time with the same thread count; for PCL it is the median over its builds of PCL's time / the time of a
 single-threaded octoray build run right after it (with glibc's free lists consolidated in between, untimed), so that
@@ -1562,7 +1565,7 @@ Reading these figures:
   shared machine swing from run to run; read the 1-thread column for ratios.
 - B/point is dominated by what the engine keeps besides nodes (float xyz 12 B, the sort's keys and their second
   buffer, the records in sorted order; the points' keys are not kept: a rebuild computes them again from the
-  positions); the node arrays alone are ~20 B/point. The dense skeleton is smaller than
+  positions); the node arrays alone are the smaller part (*node arrays B/point*). The dense skeleton is smaller than
   octoray only at shallow depth on uniform data; from depth 9 on it is larger and grows 8× per level.
 - vtkSMPTools in Debian's ParaView defaults to the Sequential backend; the benchmark switches it to STDThread so
   vtkStaticPointLocator's threaded build is measured.
@@ -1575,14 +1578,14 @@ Reading these figures:
 
 Command:
 
-    PYTHONPATH=build/lib/python3/dist-packages {scene_cmd}
+    {scene_cmd}
     {quant_cmd}
 
 Drawing a point as its leaf voxel moves it to the voxel's centre; the octree's depth trades that error for nodes and
 memory. For every leaf depth 1–21 the engine builds the octree (fresh engine per depth; build time median of 3 after
 a warm-up; engine MB = `Engine::Memory().Total()`), the tree is copied to the host (`Engine::CopyToHost`), and each
 point is walked from the root through the stored child masks to its leaf, whose centre comes from the leaf's stored
-Morton key and the engine's double-precision root cube (Benchmarks/Engine/Quantisation.h). Distances are in the
+Morton key and the engine's double-precision root cube (Rendering/Engine/octoray/Quantisation.h). Distances are in the
 scene's data units. Why the figure is trustworthy: the walk fails if the tree lacks a point's leaf, no distance may
 exceed the analytic bound (half the leaf diagonal, √3/2 · side / 2^depth; max / bound below), and the engine test
 `Quantisation.*` (Testing/Engine/TestQuantisation.cpp, in `make test`) checks the same measurement against a
@@ -1592,6 +1595,6 @@ voxel corners give exactly the bound and points at centres exactly 0.
 {quantisation}
 """.format(machine=machine_text(ctx, "build"), peers_cmd=ctx.command("build-peers"), octl=count(octl_max),
            peers=peers, peer_repeats=PEER_REPEATS, engine_cmd=ctx.command("build-engine"), repeats=BUILD_REPEATS, engine=engine, memory=memory,
-           cuda=cuda, scene_cmd=ctx.command("scene-ct5n"), quant_cmd=ctx.command("build-quantisation"),
+           cuda=cuda, scene_cmd=scenes.with_python_path(ctx.command("scene-ct5n")), quant_cmd=ctx.command("build-quantisation"),
            quantisation=quantisation)
     return Section(text, summary + cuda_summary)

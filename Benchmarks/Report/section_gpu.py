@@ -65,8 +65,8 @@ def _device_checks(ctx):
                  if "RACECHECK SUMMARY" in line), None)
     tools.append("racecheck %s" % (race.group(1) if race else "not run"))
     return [
-        "The CUDA device's primitives under the build driver (ForEach, Reduce, Histogram, Select, the nested "
-        "lists, every sort, the run starts and the first failing step) are held to the CPU device's checks "
+        "The CUDA device's primitives under the build driver (ForEach, Reduce, Select, the nested "
+        "lists with their side histogram, every sort, the run starts and the first failing step) are held to the CPU device's checks "
         "(Testing/Engine/DeviceChecks.h, suite `CudaDeviceCUDA`). On an NVIDIA H200 (the twenty-seventh "
         "session's calls, [gpu/%s](gpu/%s)): %d of %d passed; compute-sanitizer over them: %s; built against "
         "a CudaDevice.h that drops an item or a key bit in each primitive, %d of %d failed."

@@ -12,6 +12,8 @@ import os
 import re
 import shutil
 
+from scenes import with_python_path
+
 TITLE = "Pictures: the mapper against vtkPointInterpolator, vtkGaussianSplatter and vtkPointGaussianMapper"
 
 PYTHON = "/usr/bin/python3"  # Debian's python3: ParaView 5.11's VTK
@@ -186,11 +188,11 @@ def render(ctx):
     data = ctx.load_json(path)
     images = ctx.work_path("pictures")
     w, h = data["size"]
-    cmd = ctx.command("pictures")
+    cmd = with_python_path(ctx.command("pictures"))
     md = []
     md.append(
         "Command (under an X display; `xvfb-run -a` without one):\n\n"
-        "    PYTHONPATH=build/lib/python3/dist-packages %s\n\n"
+        "    %s\n\n"
         "The same points, in one run, drawn by four methods into an offscreen %d×%d window from one "
         "camera (VTK's ResetCamera of the points' bounds, raised by an elevation per scene), which then "
         "orbits the data in %d steps:\n\n"
@@ -306,7 +308,7 @@ def _render_modes(data):
 
 
 def _mapper_section(ctx, scenes):
-    cmd = ctx.command("pictures-mapper")
+    cmd = with_python_path(ctx.command("pictures-mapper"))
     if not scenes:
         return "### Mapper in a VTK render window, CPU\n\nNot produced yet."
     s0 = scenes[0]
@@ -325,7 +327,7 @@ def _mapper_section(ctx, scenes):
         "What the mapper itself adds to a frame beside the engine's trace. Command (`make bench` runs "
         "the same as bench.mapper at 1920×1080 with 10 frames and 1 M points; here smaller, to fit the "
         "report's time):\n\n"
-        "    PYTHONPATH=build/lib/python3/dist-packages %s\n\n"
+        "    %s\n\n"
         "Offscreen %d×%d window under Xvfb (Mesa's software OpenGL), an opaque sphere actor plus the "
         "cloud (so the depth read-back has something to read), camera orbiting; median of %d frames; "
         "backend: %s.\n\n%s\n\n"

@@ -191,7 +191,7 @@ def render(ctx):
         f"the reference picture of the same scene, rendered by the same backend. Pictures are "
         f"{first['width']}×{first['height']} (W×H), Phong-shaded with one directional light.\n")
     md.append(f"CPU rows: `{ctx.command('quality-cpu')}` (CT scene written first by "
-              f"`{ctx.command('scene-ct5n')}`), on {first['device']}.")
+              f"`{scenes.with_python_path(ctx.command('scene-ct5n'))}`), on {first['device']}.")
     if gpu:
         md.append(f"CUDA rows: `build-gpu/bin/octoray_bench_quality --backend cuda --scenes DIR --json "
                   f"quality-cuda.json` (scripts/gpu/gpu-check.sh; DIR holds the ct5n.particles written here), "

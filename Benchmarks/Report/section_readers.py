@@ -86,15 +86,15 @@ def render(ctx):
 Command (the report's sizes; `make bench` runs the same script as ctest `bench.readers` on a 1 GiB particle file, a
 64 MB prefix for VTK and 200 slices of 512²):
 
-    PYTHONPATH=build/lib/python3/dist-packages {cmd}
+    {cmd}
 
 **Particle text.** A generated file in the thesis format (`x y z r g b reflectivity refraction`, {mb} MB, blocks of
 distinct random lines in random order), in the page cache before every reader. octoray's vtkParticleReader
 (multi-threaded parser, all cores and one), pandas `read_csv` (C engine; the pyarrow engine where pyarrow is
 importable) and vtkDelimitedTextReader + vtkTableToPolyData, what a VTK user has for such a file. VTK's reader runs
 at a few MB/s, so it reads the first {vtk_mb} MB of the same file (header line dropped: VTK 9.2's reader has no
-comment character) and throughputs are compared. Time: median of {repeats} runs for octoray, 1 run for the others
-(seconds each). Speed-up = octoray (all threads) MB/s / the reader's MB/s.
+comment character) and throughputs are compared. Time: median of {repeats} runs for octoray on all threads, 1 run for
+the others, octoray's one-thread run among them (seconds each). Speed-up = octoray (all threads) MB/s / the reader's MB/s.
 
 {text_table}
 
@@ -107,7 +107,7 @@ time / octoray's.
 {slice_table}
 
 [CSV]({csv}) · ![reader throughput]({link})
-""".format(machine=machine_text(ctx, "readers"), cmd=ctx.command("readers"), mb=PARTICLE_MB, vtk_mb=VTK_MB,
+""".format(machine=machine_text(ctx, "readers"), cmd=scenes.with_python_path(ctx.command("readers")), mb=PARTICLE_MB, vtk_mb=VTK_MB,
            repeats=REPEATS, slices=SLICES, size=SLICE_SIZE, csv=csv, link=link,
            text_table=ctx.table(["reader", "MB read", "points", "time", "runs", "MB/s", "octoray speed-up"],
                                 text_rows, "lrrrrrr") if text_rows else "No particle-text records.",

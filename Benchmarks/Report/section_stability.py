@@ -48,10 +48,8 @@ def produce(ctx):
     if os.path.exists(xml):
         os.remove(xml)
     try:
-        # The XML path relative to the build folder the command runs in, so
-        # that the command shown reads the same on every machine.
         ctx.run("stability-cpu", [os.path.join(ctx.bin, "octoray_engine_tests"), "--gtest_filter=*Stability*",
-                                  "--gtest_output=xml:" + os.path.relpath(xml, ctx.build)])
+                                  "--gtest_output=xml:" + xml])
     except RuntimeError as e:
         # A failing case is a row of the table (its failure message), not a
         # report that stops; the XML is written either way.
@@ -176,7 +174,7 @@ made independently of the engine, with the tolerance given in the second column:
 - *analytic*: geometry worked out in double for the scene (a box's outline, the cell under a hit point,
   Snell's law and the critical angle, the Phong formula, the ambient term alone under an enclosed light).
 
-CPU column: `{ctx.command("stability-cpu")}` (run in the build folder) on this machine. CUDA column: {gpu_source}. Each outcome is the
+CPU column: `{ctx.command("stability-cpu")}` on this machine. CUDA column: {gpu_source}. Each outcome is the
 test's own measurement (its `outcome` property in the XML); a failing case shows its failure message.
 Table as CSV: [{csv_link}]({csv_link}).
 
