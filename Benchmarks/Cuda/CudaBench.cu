@@ -29,6 +29,7 @@
 #include <octoray/OctreeKernels.h>
 
 #include "BenchScenes.h"
+#include "CommandLine.h"
 
 #include <cub/device/device_radix_sort.cuh>
 
@@ -718,27 +719,33 @@ int main(int argc, char** argv)
   }
 }
 
+int Usage()
+{
+  std::fprintf(stderr, "usage: octoray_bench_cuda [--json out.json] [--small] [--only all|build|render] [--billion N] "
+                       "[--profile-build N]\n");
+  return 2;
+}
+
 int Run(int argc, char** argv)
 {
   std::string json;
-  std::string only; // "build" or "render": that section alone
+  std::string only = "all"; // "build" or "render": that section alone
+  bool small = false;       // 1 M and 10 M points, not 100 M
   std::size_t billion = 0;
   std::size_t profileBuild = 0; // points: two builds at depth 10 alone, for a profiler's kernel list
-  std::vector<std::size_t> sizes = { 1000000, 10000000, 100000000 };
-  for (int a = 1; a < argc; ++a)
+  CommandLine options;
+  options.Text("--json", json)
+    .Flag("--small", small)
+    .Choice("--only", only, { "all", "build", "render" })
+    .Count("--billion", billion)
+    .Count("--profile-build", profileBuild);
+  if (!options.Parse(argc, argv))
   {
-    if (!std::strcmp(argv[a], "--json") && a + 1 < argc)
-      json = argv[++a];
-    else if (!std::strcmp(argv[a], "--small"))
-      sizes = { 1000000, 10000000 };
-    else if (!std::strcmp(argv[a], "--only") && a + 1 < argc)
-      only = argv[++a];
-    else if (!std::strcmp(argv[a], "--billion") && a + 1 < argc)
-      billion = static_cast<std::size_t>(std::stod(argv[++a]));
-    else if (!std::strcmp(argv[a], "--profile-build") && a + 1 < argc)
-      profileBuild = static_cast<std::size_t>(std::stod(argv[++a]));
+    return Usage();
   }
-  auto section = [&](const char* name) { return only.empty() || only == name; };
+  const std::vector<std::size_t> sizes =
+    small ? std::vector<std::size_t>{ 1000000, 10000000 } : std::vector<std::size_t>{ 1000000, 10000000, 100000000 };
+  auto section = [&](const char* name) { return only == "all" || only == name; };
   std::string why;
   if (!CudaAvailable(&why))
   {
