@@ -158,12 +158,13 @@ TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 # rounds of "wholebounds" (calls 2 and 3, 42ed685 with the patch that
 # a74e097 keeps, on one machine), the forty-first's of "main" (calls 3
 # and 4, at 68179e4, beside a variant not kept) and the forty-second's
-# (call 1, at fd87b4a, the benchmark alone) (COMMAND.md).
+# (calls 1, 3 and 4, at fd87b4a and 42b586b, the benchmark alone)
+# (COMMAND.md).
 ROUNDS_ENGINE = "a74e097"
 ROUNDS = (
     ("fortieth", "variants-whole-bounds.txt", ("wholebounds-2", "wholebounds-3")),
     ("forty-first", "variants-hugepages.txt", ("main-3", "main-4")),
-    ("forty-second", "bench-build-rounds.txt", ("main",)),
+    ("forty-second", "bench-build-rounds.txt", ("main", "main-3")),
 )
 
 
