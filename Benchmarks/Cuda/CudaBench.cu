@@ -729,7 +729,7 @@ int Usage()
 int Run(int argc, char** argv)
 {
   std::string json;
-  std::string only = "all"; // "build" or "render": that section alone
+  std::string only = "all"; // or "build" or "render": that section alone
   bool small = false;       // 1 M and 10 M points, not 100 M
   std::size_t billion = 0;
   std::size_t profileBuild = 0; // points: two builds at depth 10 alone, for a profiler's kernel list
