@@ -3,8 +3,9 @@
 - bad arguments: exit status 2, a message naming the option, what it
   expects and what it got (or the missing value, or the missing -o), and
   no picture written;
-- a depth the engine refuses, and a file that does not exist: exit status 1
-  and the engine's or the loader's message;
+- a depth the engine refuses, a file that does not exist, a PCD file and a
+  gzip-compressed one: exit status 1 and the engine's or the loader's
+  message;
 - `stats`: the points counted as the file holds them, one root node, and
   the nodes per level adding up to the node count;
 - `render` to a PPM file: the picture has the requested size, every pixel a
@@ -17,6 +18,7 @@ Plain python3 (no VTK, no pytest): the tool builds without VTK.
 
 usage: test_octoray_tool.py OCTORAY DATA_DIR WORK_DIR [unittest arguments]
 """
+import gzip
 import os
 import re
 import subprocess
@@ -106,6 +108,22 @@ class Failures(unittest.TestCase):
         status, _, err = run("stats", missing, "--backend", "cpu")
         self.assertEqual(status, 1)
         self.assertIn(missing + ": cannot open the file", err)
+
+    def test_formats_it_does_not_read(self):
+        """A PCD file and a gzip-compressed particle file are named for what
+        they are, not as a column that is not a number."""
+        pcd = os.path.join(WORK, "cloud.pcd")
+        with open(pcd, "w") as f:
+            f.write("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\n")
+        packed = os.path.join(WORK, "lidar.particles.gz")
+        with open(LIDAR, "rb") as source, gzip.open(packed, "wb") as f:
+            f.write(source.read())
+        for path, message in ((pcd, pcd + ":2: a PCD file's header; the octoray tool reads particle text files"),
+                              (packed, packed + ": gzip-compressed; the octoray tool reads plain text")):
+            with self.subTest(path=path):
+                status, _, err = run("stats", path, "--backend", "cpu")
+                self.assertEqual(status, 1)
+                self.assertIn(message, err)
 
 
 class Commands(unittest.TestCase):
