@@ -74,6 +74,22 @@ check("DICOM series: same points as the folder", s.GetDataInformation(0).GetNumb
       dicom_points)
 check("DICOM .dcm: File > Open offers the series reader",
       "OctoraySliceStackReader" in readers_for(files[0]), True)
+# Both slice readers take their options from one definition
+# (OctoraySliceReaderBase): the same list, each documented, and each reader
+# offered only for what it reads.
+options = ["Spacing", "Origin", "UseMetadata", "BackgroundRange", "RegionOfInterest", "Stride",
+           "FillBetweenSlices", "GenerateVertices"]
+for name, proxy in (("folder", d), ("series", s)):
+    check(f"{name} reader: its options", [o for o in options if proxy.GetProperty(o)], options)
+    check(f"{name} reader: each documented",
+          [o for o in options if not proxy.GetProperty(o).GetDocumentation().GetDescription()], [])
+    check(f"{name} reader: two outputs", proxy.GetNumberOfOutputPorts(), 2)
+check("DICOM .dcm: not offered the folder reader", "OctoraySliceFolderReader" in readers_for(files[0]), False)
+check("DICOM folder: not offered the series reader", "OctoraySliceStackReader" in readers_for(folder), False)
+strided = OctoraySliceStackReader(FileNames=files, Stride=[2, 2, 1])
+strided.UpdatePipeline()
+check("DICOM series: a stride of 2 thins the particles",
+      0 < strided.GetDataInformation(0).GetNumberOfPoints() < dicom_points, True)
 
 if failures:
     print("FAILED:", ", ".join(failures))
