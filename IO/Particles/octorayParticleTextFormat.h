@@ -1,8 +1,10 @@
 // The particle text format without VTK: tokens, numbers, the column layout
-// from a header line or a column count, and the prologue (comments, header,
-// first data line) of a file. vtkParticleTextReader parses with these, and
-// the fuzz targets in Testing/Fuzz call them directly (no VTK needed).
-// Private to the module; not wrapped.
+// from a header line or a column count, the prologue (comments, header,
+// first data line) of a file, and the fields of a data line with the
+// message for a bad one. vtkParticleTextReader parses with these; the fuzz
+// targets in Testing/Fuzz and the engine's command-line tool
+// (Rendering/Engine/Tools/PointFile.h, which builds without VTK) call them
+// directly. Not wrapped.
 #ifndef octorayParticleTextFormat_h
 #define octorayParticleTextFormat_h
 
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -372,6 +375,103 @@ inline Prologue ParsePrologue(const char* data, size_t size, const std::string& 
   }
   r.Ok = true;
   return r;
+}
+
+// What is wrong with a data line: where, and what.
+struct Problem
+{
+  const char* At = nullptr;
+  std::string What;
+};
+
+// What a value of a column of that sink must be, when v is not it: the
+// "expected ..." of the message; null when v is fine.
+template <typename Real>
+inline const char* Expected(Sink target, Real v)
+{
+  if (!std::isfinite(v))
+  {
+    return "a finite number";
+  }
+  switch (target)
+  {
+    case Sink::R:
+    case Sink::G:
+    case Sink::B:
+      return v < 0 || v > 255 ? "a colour value 0-255" : nullptr;
+    case Sink::Reflectivity:
+      return v < 0 || v > 1 ? "a reflectivity 0-1" : nullptr;
+    case Sink::Refraction:
+      return v < 0 ? "a refraction index >= 0 (0 = none)" : nullptr;
+    default:
+      return nullptr;
+  }
+}
+
+// The fields of the data line that starts at lineStart, from its first
+// non-blank byte q to e: numbers separated by blanks or one comma, into
+// values (one a column of the prologue's layout). False, with the problem,
+// at the first that is wrong.
+template <typename Real>
+inline bool ParseFields(
+  const Prologue& pro, const char* lineStart, const char* q, const char* e, Real* values, Problem& problem)
+{
+  const int ncols = static_cast<int>(pro.Columns.size());
+  int field = 0;
+  while (true)
+  {
+    const char* tok = q;
+    if (field < ncols)
+    {
+      Real v;
+      const char* after = ParseNumber(q, e, v);
+      const Column& col = pro.Columns[field];
+      if (const char* expected = after ? Expected(col.Target, v) : "a number")
+      {
+        problem = { tok, "expected " + std::string(expected) + " for column " + std::to_string(field + 1) +
+            " (" + col.Name + "), found '" + TokenAt(tok, e) + "'" };
+        return false;
+      }
+      values[field] = v;
+      q = after;
+    }
+    else
+    {
+      while (q < e && !EndsToken(*q))
+      {
+        ++q;
+      }
+    }
+    ++field;
+    q = SkipBlanks(q, e);
+    if (q < e && *q == ',')
+    {
+      q = SkipBlanks(q + 1, e);
+      if (q == e || *q == ',' || *q == '#')
+      {
+        problem = { q, "expected a number for column " + std::to_string(field + 1) +
+            " after the comma, found an empty field" };
+        return false;
+      }
+    }
+    else if (q == e || *q == '#')
+    {
+      break;
+    }
+  }
+  if (field != ncols)
+  {
+    problem = { field < ncols ? q : lineStart, "expected " + std::to_string(ncols) + " columns (" + pro.Layout +
+        "), found " + std::to_string(field) };
+    return false;
+  }
+  return true;
+}
+
+// A problem's message: file:line:column: what.
+inline std::string LineMessage(const std::string& file, long long line, const char* lineStart, const Problem& problem)
+{
+  return file + ":" + std::to_string(line) + ":" + std::to_string(problem.At - lineStart + 1) + ": " + problem.What;
 }
 
 // Whether the start of a file is particle text, for CanReadFile (a reader

@@ -133,12 +133,6 @@ private:
   };
 
   // A bad line: where in it (for the column number) and what is wrong.
-  struct Problem
-  {
-    const char* At = nullptr;
-    std::string What;
-  };
-
   // ---- Serial prologue: comments, the optional header, and the first data
   // line, whose column count gives the layout when there is no header.
   bool ReadPrologue()
@@ -332,7 +326,7 @@ private:
         this->ChangedBetweenPasses = true;
         return;
       }
-      if (this->ParseFields(lineStart, q, e, values.data(), problem))
+      if (ParseFields(this->Pro, lineStart, q, e, values.data(), problem))
       {
         this->Arrays.Store(values.data(), pt);
       }
@@ -356,88 +350,6 @@ private:
     }
   }
 
-  // What a value of a column of that sink must be, when v is not it: the
-  // "expected ..." of the message; null when v is fine.
-  static const char* Expected(Sink target, Real v)
-  {
-    if (!std::isfinite(v))
-    {
-      return "a finite number";
-    }
-    switch (target)
-    {
-      case Sink::R:
-      case Sink::G:
-      case Sink::B:
-        return v < 0 || v > 255 ? "a colour value 0-255" : nullptr;
-      case Sink::Reflectivity:
-        return v < 0 || v > 1 ? "a reflectivity 0-1" : nullptr;
-      case Sink::Refraction:
-        return v < 0 ? "a refraction index >= 0 (0 = none)" : nullptr;
-      default:
-        return nullptr;
-    }
-  }
-
-  // The fields of the data line that starts at lineStart, from its first
-  // non-blank byte q to e: numbers separated by blanks or one comma, into
-  // values. False, with the problem, at the first that is wrong.
-  bool ParseFields(const char* lineStart, const char* q, const char* e, Real* values,
-    Problem& problem) const
-  {
-    const int ncols = this->NumberOfColumns;
-    int field = 0;
-    while (true)
-    {
-      const char* tok = q;
-      if (field < ncols)
-      {
-        Real v;
-        const char* after = ParseNumber(q, e, v);
-        const Column& col = this->Pro.Columns[field];
-        if (const char* expected = after ? Expected(col.Target, v) : "a number")
-        {
-          problem = { tok, "expected " + std::string(expected) + " for column " +
-              std::to_string(field + 1) + " (" + col.Name + "), found '" + TokenAt(tok, e) +
-              "'" };
-          return false;
-        }
-        values[field] = v;
-        q = after;
-      }
-      else
-      {
-        while (q < e && !EndsToken(*q))
-        {
-          ++q;
-        }
-      }
-      ++field;
-      q = SkipBlanks(q, e);
-      if (q < e && *q == ',')
-      {
-        q = SkipBlanks(q + 1, e);
-        if (q == e || *q == ',' || *q == '#')
-        {
-          problem = { q, "expected a number for column " + std::to_string(field + 1) +
-              " after the comma, found an empty field" };
-          return false;
-        }
-      }
-      else if (q == e || *q == '#')
-      {
-        break;
-      }
-    }
-    if (field != ncols)
-    {
-      problem = { field < ncols ? q : lineStart, "expected " + std::to_string(ncols) +
-          " columns (" + this->Pro.Layout + "), found " + std::to_string(field) };
-      return false;
-    }
-    return true;
-  }
-
   void RecordBad(ChunkResult& r, vtkIdType ln, vtkIdType pt, const char* lineStart,
     const Problem& problem)
   {
@@ -448,8 +360,7 @@ private:
     }
     if (r.FirstMessage.empty())
     {
-      r.FirstMessage = this->Settings.File + ":" + std::to_string(ln) + ":" +
-        std::to_string(problem.At - lineStart + 1) + ": " + problem.What;
+      r.FirstMessage = LineMessage(this->Settings.File, ln, lineStart, problem);
     }
     if (this->Settings.Lenient)
     {

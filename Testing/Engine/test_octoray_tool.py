@@ -7,7 +7,8 @@
   gzip-compressed one: exit status 1 and the engine's or the loader's
   message;
 - `stats`: the points counted as the file holds them, one root node, and
-  the nodes per level adding up to the node count;
+  the nodes per level adding up to the node count; a header line naming
+  the columns, and a bad value named as vtkParticleTextReader names it;
 - `render` to a PPM file: the picture has the requested size, every pixel a
   primary ray, and the points drawn (pixels off the background);
 - `--help`: the usage on stdout, exit status 0;
@@ -109,6 +110,16 @@ class Failures(unittest.TestCase):
         self.assertEqual(status, 1)
         self.assertIn(missing + ": cannot open the file", err)
 
+    def test_bad_line_as_the_reader_says(self):
+        """A bad value is named by line, column and layout in
+        vtkParticleTextReader's words (the same format core reads both)."""
+        bad = os.path.join(WORK, "bad-colour.txt")
+        with open(bad, "w") as f:
+            f.write("0 0 0 10 20 30\n1 1 1 10 272 30\n")
+        status, _, err = run("stats", bad, "--backend", "cpu")
+        self.assertEqual(status, 1)
+        self.assertIn(bad + ":2:10: expected a colour value 0-255 for column 5 (g), found '272'", err)
+
     def test_formats_it_does_not_read(self):
         """A PCD file and a gzip-compressed particle file are named for what
         they are, not as a column that is not a number."""
@@ -137,6 +148,16 @@ class Commands(unittest.TestCase):
         self.assertEqual(len(per_level), 7)
         self.assertEqual(per_level[0], 1)
         self.assertEqual(sum(per_level), int(re.search(r"^nodes +(\d+)$", out, re.M).group(1)))
+
+    def test_header_names_the_columns(self):
+        """A header line names the columns, other columns read and left
+        out, as vtkParticleTextReader reads the file."""
+        named = os.path.join(WORK, "named.csv")
+        with open(named, "w") as f:
+            f.write("intensity,z,y,x,return\n0.5,3,2,1,1\n0.7,6,5,4,2\n0.9,9,8,7,1\n")
+        status, out, err = run("stats", named, "--backend", "cpu")
+        self.assertEqual(status, 0, err)
+        self.assertIn("(3 points,", out)
 
     def test_render(self):
         picture = os.path.join(WORK, "lidar.ppm")

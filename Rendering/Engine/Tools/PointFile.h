@@ -1,13 +1,21 @@
-// A minimal loader of whitespace- or comma-separated particle files for the
-// engine's command-line tool (which must build without VTK). Columns: xyz,
-// xyz + scalar, xyz + rgb, or the thesis's xyz rgb reflectivity refraction.
-// The VTK reader (vtkParticleReader) is the full-featured one.
+// Particle text files for the engine's command-line tool and benchmarks,
+// which build without VTK: read with the format's VTK-free core from
+// IO/Particles (octorayParticleTextFormat.h), so that comments, a header
+// line naming the columns, the layouts of 3, 4, 6 or 8 columns, the numbers
+// and the messages for bad lines are vtkParticleTextReader's. Colours,
+// scalars, reflectivity and refraction become the engine's arrays; other
+// named columns are read and left out. Gzip-compressed files and PCD files
+// are named and refused (the VTK readers read them).
 #pragma once
+
+#include "octorayParticleTextFormat.h"
 
 #include <octoray/PointCloud.h>
 
-#include <cstdlib>
+#include <algorithm>
+#include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -38,129 +46,109 @@ struct PointFile
   // Throws octoray::Error naming the file and line of the first bad line.
   static PointFile Load(const std::string& path)
   {
-    std::ifstream in(path);
+    std::ifstream in(path, std::ios::binary);
     if (!in)
     {
       throw Error(path + ": cannot open the file");
     }
-    RefuseGzip(path, in);
-    PointFile f;
-    std::string line;
-    std::size_t lineNumber = 0;
-    std::size_t columns = 0; // the first line's, which every line must have
-    std::vector<double> values;
-    while (std::getline(in, line))
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    RefuseOtherFormats(path, text);
+    const ptext::Prologue prologue = ptext::ParsePrologue(text.data(), text.size(), path);
+    if (!prologue.Ok)
     {
-      const std::string where = path + ":" + std::to_string(++lineNumber);
-      const std::size_t bad = ParseLine(line, values);
-      if (bad)
-      {
-        throw Error(where + (IsPcdHeader(line) ? kPcdHeader : ": column " + std::to_string(bad) + " is not a number"));
-      }
-      if (values.empty())
+      throw Error(prologue.Error);
+    }
+    PointFile f;
+    std::vector<double> values(prologue.Columns.size());
+    ptext::Problem problem;
+    long long line = prologue.FirstDataLine;
+    const char* const end = text.data() + text.size();
+    for (const char* s = text.data() + prologue.FirstData; s < end; ++line)
+    {
+      const char* lineStart = s;
+      const char* e = std::find(s, end, '\n');
+      s = e < end ? e + 1 : end;
+      const char* q = SkipBlanks(lineStart, e);
+      if (q == e || *q == '#')
       {
         continue;
       }
-      if (!columns)
+      if (!ptext::ParseFields(prologue, lineStart, q, e, values.data(), problem))
       {
-        columns = values.size();
-        if (columns != 3 && columns != 4 && columns != 6 && columns != 8)
-        {
-          throw Error(where + ": expected 3, 4, 6 or 8 columns, got " + std::to_string(columns));
-        }
+        throw Error(ptext::LineMessage(path, line, lineStart, problem));
       }
-      else if (values.size() != columns)
-      {
-        throw Error(where + ": expected " + std::to_string(columns) + " columns like the first line, got " +
-          std::to_string(values.size()));
-      }
-      f.Add(values);
-    }
-    if (f.xyz.empty())
-    {
-      throw Error(path + ": no points in the file");
+      f.Add(prologue.Columns, values);
     }
     return f;
   }
 
 private:
-  static constexpr const char* kPcdHeader =
-    ": a PCD file's header; the octoray tool reads particle text files (vtkPCDReader reads PCD, in Python and "
-    "ParaView)";
-
-  // A gzip file would fail on its first line as "not a number".
-  static void RefuseGzip(const std::string& path, std::ifstream& in)
+  // A gzip file and PCL's PCD would fail on their first line as a bad
+  // layout or a binary file: name them for what they are.
+  static void RefuseOtherFormats(const std::string& path, const std::string& text)
   {
-    const int first = in.get(), second = in.get();
-    if (first == 0x1f && second == 0x8b)
+    if (text.size() >= 2 && static_cast<unsigned char>(text[0]) == 0x1f && static_cast<unsigned char>(text[1]) == 0x8b)
     {
       throw Error(path + ": gzip-compressed; the octoray tool reads plain text (gunzip it first; vtkParticleReader "
                          "reads it as it is)");
     }
-    in.clear();
-    in.seekg(0);
-  }
-
-  // The header lines PCL's PCD files begin with (after comments).
-  static bool IsPcdHeader(const std::string& line)
-  {
-    return line.rfind("VERSION", 0) == 0 || line.rfind("FIELDS", 0) == 0;
-  }
-
-  // The numbers of one line into `values` (commas, tabs and spaces apart;
-  // '#' starts a comment); 0, or the column of the first that is not one.
-  static std::size_t ParseLine(const std::string& text, std::vector<double>& values)
-  {
-    std::string line = text.substr(0, text.find('#'));
-    for (char& c : line)
+    std::size_t line = 1;
+    for (std::size_t at = 0; at < text.size() && line <= kPcdHeaderLines; ++line)
     {
-      if (c == ',' || c == '\t' || c == '\r')
+      const std::size_t next = std::min(text.find('\n', at), text.size());
+      const std::string start = text.substr(at, 8);
+      if (start.rfind("VERSION", 0) == 0 || start.rfind("FIELDS", 0) == 0)
       {
-        c = ' ';
+        throw Error(path + ":" + std::to_string(line) + ": a PCD file's header; the octoray tool reads particle "
+                    "text files (vtkPCDReader reads PCD, in Python and ParaView)");
       }
-    }
-    values.clear();
-    for (const char* s = line.c_str();;)
-    {
-      while (*s == ' ')
-      {
-        ++s;
-      }
-      if (!*s)
-      {
-        return 0;
-      }
-      char* end = nullptr;
-      const double v = std::strtod(s, &end);
-      if (end == s || (*end && *end != ' '))
-      {
-        return values.size() + 1;
-      }
-      values.push_back(v);
-      s = end;
+      at = next + 1;
     }
   }
+  // PCD's VERSION or FIELDS line comes after its comments, within the first few.
+  static constexpr std::size_t kPcdHeaderLines = 4;
 
-  // One point of 3, 4, 6 or 8 columns.
-  void Add(const std::vector<double>& values)
+  // One point from its columns' values, each where its column goes.
+  void Add(const std::vector<ptext::Column>& columns, const std::vector<double>& values)
   {
-    xyz.insert(xyz.end(), values.begin(), values.begin() + 3);
-    if (values.size() == 4)
+    double position[3] = {}, colour[3] = {};
+    bool hasColour = false;
+    for (std::size_t c = 0; c < columns.size(); ++c)
     {
-      scalar.push_back(static_cast<float>(values[3]));
-    }
-    if (values.size() >= 6)
-    {
-      for (int c = 3; c < 6; ++c)
+      const double v = values[c];
+      switch (const ptext::Sink target = columns[c].Target)
       {
-        const double v = values[c] < 0 ? 0 : (values[c] > 255 ? 255 : values[c]);
-        rgb.push_back(static_cast<std::uint8_t>(v + 0.5));
+        case ptext::Sink::X:
+        case ptext::Sink::Y:
+        case ptext::Sink::Z:
+          position[static_cast<int>(target) - static_cast<int>(ptext::Sink::X)] = v;
+          break;
+        case ptext::Sink::R:
+        case ptext::Sink::G:
+        case ptext::Sink::B:
+          colour[static_cast<int>(target) - static_cast<int>(ptext::Sink::R)] = v;
+          hasColour = true;
+          break;
+        case ptext::Sink::Scalar:
+          scalar.push_back(static_cast<float>(v));
+          break;
+        case ptext::Sink::Reflectivity:
+          reflectivity.push_back(static_cast<float>(v));
+          break;
+        case ptext::Sink::Refraction:
+          refraction.push_back(static_cast<float>(v));
+          break;
+        case ptext::Sink::Extra:
+          break;
       }
     }
-    if (values.size() == 8)
+    xyz.insert(xyz.end(), position, position + 3);
+    if (hasColour)
     {
-      reflectivity.push_back(static_cast<float>(values[6]));
-      refraction.push_back(static_cast<float>(values[7]));
+      for (double v : colour)
+      {
+        rgb.push_back(static_cast<std::uint8_t>(v + 0.5)); // 0-255: ParseFields checks the range
+      }
     }
   }
 };

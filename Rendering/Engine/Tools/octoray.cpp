@@ -35,7 +35,8 @@ int Usage(std::FILE* to = stderr)
 {
   std::fprintf(to,
     "usage: octoray stats FILE [--depth N] [--backend cpu|cuda|auto] [--threads N]\n"
-    "  builds the octree of a particle file (3, 4, 6 or 8 columns) and prints its statistics\n"
+    "  builds the octree of a particle text file (a header line naming x y z ..., or 3, 4, 6 or 8\n"
+    "  columns) and prints its statistics\n"
     "       octoray render FILE -o OUT.png [--size WxH] [--mode MODE] [--depth N] [--lod K]\n"
     "                      [--shadows] [--bounces N] [--backend auto|cpu|cuda] [--threads N]\n"
     "                      [--azimuth DEG] [--elevation DEG] [--zoom F]\n"
