@@ -5,6 +5,7 @@
 #ifndef octorayTextScan_h
 #define octorayTextScan_h
 
+#include <cstddef>
 #include <cstdio>
 #include <string>
 
@@ -14,6 +15,13 @@ namespace octoray
 inline bool IsBlank(char c)
 {
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+// Whether `n` bytes from p start with gzip's magic number.
+inline bool StartsGzip(const void* p, std::size_t n)
+{
+  const unsigned char* b = static_cast<const unsigned char*>(p);
+  return n >= 2 && b[0] == 0x1f && b[1] == 0x8b;
 }
 
 // The first byte of [p, e) that is no blank, or e.

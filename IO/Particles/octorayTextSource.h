@@ -11,6 +11,7 @@
 #define octorayTextSource_h
 
 #include "octorayMappedFileGuard.h"
+#include "octorayTextScan.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -89,8 +90,7 @@ public:
     }
     this->Fd = fd;
     this->Opened = st;
-    if (this->MapSize >= 2 && static_cast<unsigned char>(this->Map[0]) == 0x1f &&
-      static_cast<unsigned char>(this->Map[1]) == 0x8b)
+    if (StartsGzip(this->Map, this->MapSize))
     {
       this->Compressed = true;
       bool ok = this->Inflate(name, error);
@@ -201,7 +201,7 @@ private:
       if (ret == Z_STREAM_END)
       {
         // Concatenated members (gzip -c a b > c) form one text.
-        if (inLeft >= 2 && in[0] == 0x1f && in[1] == 0x8b)
+        if (StartsGzip(in, inLeft))
         {
           inflateReset(&zs);
           continue;

@@ -125,11 +125,13 @@ class Failures(unittest.TestCase):
         they are, not as a column that is not a number."""
         pcd = os.path.join(WORK, "cloud.pcd")
         with open(pcd, "w") as f:
-            f.write("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\n")
+            f.write("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z intensity\n"
+                    "SIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+                    "POINTS 3\nDATA ascii\n0 0 0 1\n1 0 0 2\n0 1 0 3\n")
         packed = os.path.join(WORK, "lidar.particles.gz")
         with open(LIDAR, "rb") as source, gzip.open(packed, "wb") as f:
             f.write(source.read())
-        for path, message in ((pcd, pcd + ":2: a PCD file's header; the octoray tool reads particle text files"),
+        for path, message in ((pcd, pcd + ": a PCD file; the octoray tool reads particle text files (vtkPCDReader reads PCD"),
                               (packed, packed + ": gzip-compressed; the octoray tool reads plain text")):
             with self.subTest(path=path):
                 status, _, err = run("stats", path, "--backend", "cpu")

@@ -8,6 +8,7 @@
 // are named and refused (the VTK readers read them).
 #pragma once
 
+#include "octorayPCDHeader.h"
 #include "octorayParticleTextFormat.h"
 
 #include <octoray/PointCloud.h>
@@ -83,30 +84,24 @@ struct PointFile
   }
 
 private:
-  // A gzip file and PCL's PCD would fail on their first line as a bad
-  // layout or a binary file: name them for what they are.
+  // A gzip file and PCL's PCD would fail as a bad layout or a binary
+  // file: name them for what they are, as the VTK readers know them (a PCD
+  // file is one whose header vtkPCDReader's parser reads).
   static void RefuseOtherFormats(const std::string& path, const std::string& text)
   {
-    if (text.size() >= 2 && static_cast<unsigned char>(text[0]) == 0x1f && static_cast<unsigned char>(text[1]) == 0x8b)
+    if (StartsGzip(text.data(), text.size()))
     {
       throw Error(path + ": gzip-compressed; the octoray tool reads plain text (gunzip it first; vtkParticleReader "
                          "reads it as it is)");
     }
-    std::size_t line = 1;
-    for (std::size_t at = 0; at < text.size() && line <= kPcdHeaderLines; ++line)
+    pcd::Header header;
+    std::string notPcd;
+    if (pcd::ParseHeader(text.data(), text.size(), path, header, notPcd))
     {
-      const std::size_t next = std::min(text.find('\n', at), text.size());
-      const std::string start = text.substr(at, 8);
-      if (start.rfind("VERSION", 0) == 0 || start.rfind("FIELDS", 0) == 0)
-      {
-        throw Error(path + ":" + std::to_string(line) + ": a PCD file's header; the octoray tool reads particle "
-                    "text files (vtkPCDReader reads PCD, in Python and ParaView)");
-      }
-      at = next + 1;
+      throw Error(path + ": a PCD file; the octoray tool reads particle text files (vtkPCDReader reads PCD, in "
+                         "Python and ParaView)");
     }
   }
-  // PCD's VERSION or FIELDS line comes after its comments, within the first few.
-  static constexpr std::size_t kPcdHeaderLines = 4;
 
   // One point from its columns' values, each where its column goes.
   void Add(const std::vector<ptext::Column>& columns, const std::vector<double>& values)
