@@ -468,6 +468,28 @@ inline bool ParseFields(
   return true;
 }
 
+// Calls visit(lineStart, q, e) for each data line of [s, end): each line
+// whose first non-blank byte q is neither its end e nor a comment's '#'.
+// `line` holds the number of the line at s and counts on with every line,
+// blank and comment lines too, so that visit reads its line's number there;
+// the walk stops at end, or at a line for which visit returns false.
+template <typename LineNumber, typename Visit>
+inline void ForEachDataLine(const char* s, const char* const end, LineNumber& line, Visit&& visit)
+{
+  for (; s < end; ++line)
+  {
+    const char* const lineStart = s;
+    const char* const nl = static_cast<const char*>(std::memchr(s, '\n', static_cast<size_t>(end - s)));
+    const char* const e = nl ? nl : end;
+    s = nl ? nl + 1 : end;
+    const char* const q = SkipBlanks(lineStart, e);
+    if (q != e && *q != '#' && !visit(lineStart, q, e))
+    {
+      return;
+    }
+  }
+}
+
 // A problem's message: file:line:column: what.
 inline std::string LineMessage(const std::string& file, long long line, const char* lineStart, const Problem& problem)
 {

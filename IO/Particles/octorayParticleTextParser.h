@@ -296,7 +296,7 @@ private:
     const char* s = this->Starts[c];
     const char* const ce = this->Starts[c + 1];
     const bool lenient = this->Settings.Lenient;
-    vtkIdType ln = r.FirstLine - 1;
+    vtkIdType ln = r.FirstLine; // the number of the line at s
     vtkIdType pt = r.FirstPoint;
     // Pass 1 counted this chunk's data lines; a file written to between
     // the passes can hold more or fewer now, and the chunk must not write
@@ -304,27 +304,17 @@ private:
     const vtkIdType ptEnd = r.FirstPoint + r.DataLines;
     std::vector<Real> values(this->NumberOfColumns);
     Problem problem;
-    while (s < ce)
-    {
+    bool walked = true; // every line of the chunk, not stopped
+    ForEachDataLine(s, ce, ln, [&](const char* lineStart, const char* q, const char* e) {
       if (!lenient &&
         (this->FirstFailedChunk.load(std::memory_order_relaxed) < c || this->Aborted))
       {
-        return;
-      }
-      const char* nl = static_cast<const char*>(std::memchr(s, '\n', ce - s));
-      const char* e = nl ? nl : ce;
-      const char* lineStart = s;
-      ++ln;
-      s = nl ? nl + 1 : ce;
-      const char* q = SkipBlanks(lineStart, e);
-      if (q == e || *q == '#')
-      {
-        continue;
+        return walked = false;
       }
       if (pt >= ptEnd)
       {
         this->ChangedBetweenPasses = true;
-        return;
+        return walked = false;
       }
       if (ParseFields(this->Pro, lineStart, q, e, values.data(), problem))
       {
@@ -339,12 +329,13 @@ private:
           while (c < expected && !this->FirstFailedChunk.compare_exchange_weak(expected, c))
           {
           }
-          return;
+          return walked = false;
         }
       }
       ++pt;
-    }
-    if (pt != ptEnd)
+      return true;
+    });
+    if (walked && pt != ptEnd)
     {
       this->ChangedBetweenPasses = true;
     }

@@ -112,13 +112,14 @@ class Failures(unittest.TestCase):
 
     def test_bad_line_as_the_reader_says(self):
         """A bad value is named by line, column and layout in
-        vtkParticleTextReader's words (the same format core reads both)."""
+        vtkParticleTextReader's words (the same format core reads both);
+        blank and comment lines count in the line number."""
         bad = os.path.join(WORK, "bad-colour.txt")
         with open(bad, "w") as f:
-            f.write("0 0 0 10 20 30\n1 1 1 10 272 30\n")
+            f.write("0 0 0 10 20 30\n\n# between\n1 1 1 10 272 30\n")
         status, _, err = run("stats", bad, "--backend", "cpu")
         self.assertEqual(status, 1)
-        self.assertIn(bad + ":2:10: expected a colour value 0-255 for column 5 (g), found '272'", err)
+        self.assertIn(bad + ":4:10: expected a colour value 0-255 for column 5 (g), found '272'", err)
 
     def test_formats_it_does_not_read(self):
         """A PCD file and a gzip-compressed particle file are named for what

@@ -63,23 +63,15 @@ struct PointFile
     std::vector<double> values(prologue.Columns.size());
     ptext::Problem problem;
     long long line = prologue.FirstDataLine;
-    const char* const end = text.data() + text.size();
-    for (const char* s = text.data() + prologue.FirstData; s < end; ++line)
-    {
-      const char* lineStart = s;
-      const char* e = std::find(s, end, '\n');
-      s = e < end ? e + 1 : end;
-      const char* q = SkipBlanks(lineStart, e);
-      if (q == e || *q == '#')
-      {
-        continue;
-      }
-      if (!ptext::ParseFields(prologue, lineStart, q, e, values.data(), problem))
-      {
-        throw Error(ptext::LineMessage(path, line, lineStart, problem));
-      }
-      f.Add(prologue.Columns, values);
-    }
+    ptext::ForEachDataLine(text.data() + prologue.FirstData, text.data() + text.size(), line,
+      [&](const char* lineStart, const char* q, const char* e) {
+        if (!ptext::ParseFields(prologue, lineStart, q, e, values.data(), problem))
+        {
+          throw Error(ptext::LineMessage(path, line, lineStart, problem));
+        }
+        f.Add(prologue.Columns, values);
+        return true;
+      });
     return f;
   }
 

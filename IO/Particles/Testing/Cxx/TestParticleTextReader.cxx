@@ -69,26 +69,27 @@ void TestHeaderOrder()
   CHECK(std::string(r->GetErrorMessage()).empty());
 }
 
-// Strict: the error names file, line, column and what was expected.
+// Strict: the error names file, line, column and what was expected; blank
+// and comment lines between the data lines count in the line numbers.
 // Lenient: both bad lines skipped, counted and listed.
 void TestStrictAndLenient()
 {
   vtkNew<vtkParticleTextReader> r;
   Quiet(r);
-  const std::string path = Write("bad.txt", "1 2 3\n4 5 6\n7 8 zz\n1 2\n");
+  const std::string path = Write("bad.txt", "1 2 3\n\n  # between\n4 5 6\n7 8 zz\n1 2\n");
   r->SetFileName(path.c_str());
   r->Update();
   CHECK(r->GetOutput()->GetNumberOfPoints() == 0);
   CHECK(std::string(r->GetErrorMessage()) ==
-    path + ":3:5: expected a number for column 3 (z), found 'zz'");
+    path + ":5:5: expected a number for column 3 (z), found 'zz'");
   r->LenientOn();
   r->Update();
   CHECK(r->GetOutput()->GetNumberOfPoints() == 2);
   CHECK(r->GetNumberOfSkippedLines() == 2);
   auto* lines =
     vtkIdTypeArray::SafeDownCast(r->GetOutput()->GetFieldData()->GetArray("SkippedLineNumbers"));
-  CHECK(lines && lines->GetNumberOfTuples() == 2 && lines->GetValue(0) == 3 &&
-    lines->GetValue(1) == 4);
+  CHECK(lines && lines->GetNumberOfTuples() == 2 && lines->GetValue(0) == 5 &&
+    lines->GetValue(1) == 6);
 }
 
 // Parallel and serial parsing give the same points, in file order; the
