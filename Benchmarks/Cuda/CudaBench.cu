@@ -719,11 +719,12 @@ int main(int argc, char** argv)
   }
 }
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr, "usage: octoray_bench_cuda [--json out.json] [--small] [--only all|build|render] [--billion N] "
-                       "[--profile-build N]\n");
-  return 2;
+  return CommandLine::PrintUsage(to,
+    "usage: octoray_bench_cuda [--json out.json] [--small] [--only all|build|render] [--billion N] "
+    "[--profile-build N]\n");
 }
 
 int Run(int argc, char** argv)
@@ -739,6 +740,10 @@ int Run(int argc, char** argv)
     .Choice("--only", only, { "all", "build", "render" })
     .Count("--billion", billion)
     .Count("--profile-build", profileBuild);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
   {
     return Usage();

@@ -26,12 +26,12 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_build [--points N[,N...]] [--sets uniform,clustered,narrow] [--depth L (0: automatic)]\n"
     "                           [--backend cpu|cuda|all] [--threads N] [--repeats R] [--json PATH]\n");
-  return 2;
 }
 
 
@@ -154,6 +154,10 @@ int main(int argc, char** argv)
     .Integer("--threads", threads, 1)
     .Integer("--repeats", repeats, 1)
     .Text("--json", json);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
   {
     return Usage();

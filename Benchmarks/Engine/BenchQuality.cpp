@@ -71,13 +71,13 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_quality [--backend cpu|cuda|all] [--scenes DIR] [--lidar PATH]\n"
     "                             [--only ct5n,lidar,spheres] [--size WxH] [--repeats R]\n"
     "                             [--threads N] [--sphere-points N] [--json FILE] [--dump DIR]\n");
-  return 2;
 }
 
 struct Scene
@@ -504,6 +504,10 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Text("--json", json)
     .Text("--dump", dump);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
   {
     return Usage();

@@ -38,12 +38,12 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_quantisation [--backend cpu|cuda] [--depths FIRST-LAST] [--ct PATH] [--lidar PATH]\n"
     "                                  [--sphere-points N] [--repeats R] [--json PATH]\n");
-  return 2;
 }
 
 struct Scene
@@ -71,6 +71,10 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Integer("--repeats", repeats, 1)
     .Text("--json", json);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
     return Usage();
 

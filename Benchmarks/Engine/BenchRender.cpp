@@ -43,12 +43,12 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
     "                            [--lidar PATH] [--sphere-points N] [--parts modes,off] [--json PATH]\n");
-  return 2;
 }
 
 using Mode = NamedRenderMode;
@@ -219,6 +219,10 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Text("--parts", parts)
     .Text("--json", json);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
     return Usage();
   parts = "," + parts + ",";

@@ -28,11 +28,11 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_thesis [--backend cpu|cuda] [--repeats R] [--sphere-points N] [--json PATH]\n");
-  return 2;
 }
 
 // A build's record: its median, fastest time, memory and nodes (depth 7, the
@@ -88,6 +88,10 @@ int main(int argc, char** argv)
     .Integer("--repeats", repeats, 1)
     .Count("--sphere-points", spherePoints)
     .Text("--json", json);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
     return Usage();
 

@@ -826,14 +826,19 @@ int main(int argc, char* argv[])
   });
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
   cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);
+  const auto usage = [](std::FILE* to) {
+    return octoray::CommandLine::PrintUsage(to,
+      "usage: octoray_bench_orbit [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points]\n"
+      "                           [--file particles.txt|cloud.pcd] [--frames 60] [--seconds 6] [--max-prepare 90]\n"
+      "                           [--json out.json] [--images DIR] [--tile N [--tile-depth 12]]\n");
+  };
+  if (octoray::CommandLine::AsksForHelp(argc, argv))
+  {
+    return usage(stdout);
+  }
   if (!cli.Parse(argc, argv))
   {
-    std::fprintf(stderr,
-      "usage: %s [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points] [--file particles.txt|cloud.pcd]\n"
-      "          [--frames 60] [--seconds 6] [--max-prepare 90] [--json out.json] [--images DIR]\n"
-      "          [--tile N [--tile-depth 12]]\n",
-      argv[0]);
-    return 2;
+    return usage(stderr);
   }
   if (!vtkOctreeVolumeMapper::IsCudaAvailable())
   {

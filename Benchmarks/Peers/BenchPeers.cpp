@@ -48,13 +48,13 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-int Usage()
+// The usage, on `to`; the exit status.
+int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(stderr,
+  return CommandLine::PrintUsage(to,
     "usage: octoray_bench_peers [--cases SET:N[,SET:N...]] [--depth L (0: automatic)] [--threads N]\n"
     "                           [--repeats R] [--peer-repeats R] [--octree-locator-max N] [--json PATH]\n"
     "  SET is uniform or clustered; N may be written 1e7\n");
-  return 2;
 }
 
 struct Case
@@ -123,6 +123,10 @@ int main(int argc, char** argv)
     .Integer("--peer-repeats", peerRepeats, 1)
     .Real("--octree-locator-max", octreeLocatorMax)
     .Text("--json", json);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
   if (!options.Parse(argc, argv))
   {
     return Usage();

@@ -2,7 +2,8 @@
 // value` options and `--name` flags, after the positional arguments. Each
 // option writes its variable as it is parsed; a value that does not parse,
 // an unknown option or a missing value stops the parse with a message that
-// names the option, what it expects and what it got.
+// names the option, what it expects and what it got. `--help` or `-h`
+// asks for the usage, which goes to stdout with exit status 0.
 #pragma once
 
 #include <algorithm>
@@ -184,6 +185,22 @@ public:
       }
     }
     return "";
+  }
+
+  // Whether argv[first..argc) asks for the usage: `--help` or `-h` anywhere.
+  static bool AsksForHelp(int argc, char** argv, int first = 1)
+  {
+    return std::any_of(argv + std::min(first, argc), argv + argc, [](const char* a) {
+      return std::string(a) == "--help" || std::string(a) == "-h";
+    });
+  }
+
+  // Prints a program's usage on `to` and returns its exit status: 0 where
+  // it was asked for (on stdout), 2 after a wrong command line (on stderr).
+  static int PrintUsage(std::FILE* to, const char* usage)
+  {
+    std::fputs(usage, to);
+    return to == stdout ? 0 : 2;
   }
 
   // A whole count, written as digits or in floating-point notation (1e6);

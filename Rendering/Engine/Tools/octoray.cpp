@@ -30,10 +30,10 @@
 
 namespace
 {
-// The usage, on `to`; the exit status of a command line that is wrong.
+// The usage, on `to`; the exit status.
 int Usage(std::FILE* to = stderr)
 {
-  std::fprintf(to,
+  return octoray::CommandLine::PrintUsage(to,
     "usage: octoray stats FILE [--depth N] [--backend cpu|cuda|auto] [--threads N]\n"
     "  builds the octree of a particle text file (a header line naming x y z ..., or 3, 4, 6 or 8\n"
     "  columns) and prints its statistics\n"
@@ -43,14 +43,12 @@ int Usage(std::FILE* to = stderr)
     "  MODE: surface (flat colours, default), depthcue, phong, composite, mip, minip, average, additive\n"
     "  the camera orbits the data's centre (azimuth about +z, elevation above the xy plane);\n"
     "  PNG through OpenImageIO where it was found at build time, else binary PPM\n");
-  return 2;
 }
 
 // `--help` or `-h` anywhere, or `help` as the command.
 bool AsksForHelp(int argc, char** argv)
 {
-  const auto isHelp = [](const std::string& a) { return a == "--help" || a == "-h"; };
-  return (argc > 1 && std::string(argv[1]) == "help") || std::any_of(argv + 1, argv + argc, isHelp);
+  return (argc > 1 && std::string(argv[1]) == "help") || octoray::CommandLine::AsksForHelp(argc, argv);
 }
 
 double Seconds(std::chrono::steady_clock::time_point since)
@@ -151,8 +149,7 @@ int main(int argc, char** argv)
 {
   if (AsksForHelp(argc, argv))
   {
-    Usage(stdout);
-    return 0;
+    return Usage(stdout);
   }
   const std::string command = argc > 1 ? argv[1] : "";
   if (command != "stats" && command != "render")
