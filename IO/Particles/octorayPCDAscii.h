@@ -227,9 +227,7 @@ inline std::string AsciiValueNames(const Header& h)
 inline bool ParseAsciiLine(const char* ls, const char* le, size_t line, const Header& h,
   const std::string& file, const std::string& names, unsigned char* dst, std::string& error)
 {
-  auto where = [&](const char* at) {
-    return file + ":" + std::to_string(line) + ":" + std::to_string(at - ls + 1) + ": ";
-  };
+  auto where = [&](const char* at) { return Where(file, static_cast<long long>(line), at - ls + 1); };
   auto wrongCount = [&](const char* at, size_t found) {
     error = where(at) + "expected " + std::to_string(h.ValuesPerPoint) + " values (" +
       Printable(names) + "), found " + std::to_string(found);

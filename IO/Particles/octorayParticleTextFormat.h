@@ -278,87 +278,103 @@ struct Prologue
 // needs, and it keeps the serial prologue from walking a huge binary file.
 constexpr size_t MaxPrologueLine = size_t(1) << 20;
 
+// The column names of a header line: a line's tokens (a comment's after
+// its '#') where none is a number and they name x, y and z; else none.
+inline std::vector<std::string> HeaderNames(const std::vector<std::pair<std::string, int>>& tokens)
+{
+  std::vector<std::string> names;
+  for (const auto& t : tokens)
+  {
+    if (IsNumber(t.first))
+    {
+      return {};
+    }
+    names.push_back(t.first);
+  }
+  const auto named = [&names](const char* axis) {
+    return std::any_of(names.begin(), names.end(), [axis](const std::string& n) { return Lower(n) == axis; });
+  };
+  return named("x") && named("y") && named("z") ? names : std::vector<std::string>();
+}
+
+// Why the prologue's line `lineNo`, [p, e) of the file at data, is not
+// text: longer than MaxPrologueLine (`cut`: no newline within it) or
+// holding a NUL byte, which no particle text file holds; "" where it is.
+inline std::string NotText(
+  const char* data, const char* p, const char* e, bool cut, const std::string& file, long long lineNo)
+{
+  if (cut)
+  {
+    return Where(file, lineNo, 1) + "line " + std::to_string(lineNo) + " is longer than " +
+      std::to_string(MaxPrologueLine) + " bytes before any particle was read; not a particle text file";
+  }
+  if (const void* z = std::memchr(p, '\0', static_cast<size_t>(e - p)))
+  {
+    const char* at = static_cast<const char*>(z);
+    return Where(file, lineNo, at - p + 1) + "a NUL byte (at byte offset " + std::to_string(at - data) +
+      "): this is a binary file, not particle text";
+  }
+  return "";
+}
+
+// Line `lineNo` of the prologue, [p, e) of the file at data, from its first
+// non-blank byte q: the header line (the first that names x, y and z), a
+// comment, or the first data line, which ends the prologue and, without a
+// header, gives the layout by its column count. False, with r.Error, where
+// the line is wrong.
+inline bool ReadPrologueLine(Prologue& r, const char* data, const char* p, const char* q, const char* e,
+  const std::string& file, long long lineNo)
+{
+  const std::string where = Where(file, lineNo, 1);
+  const bool comment = *q == '#';
+  const auto tokens = SplitTokens(comment ? q + 1 : q, e);
+  const std::vector<std::string> names = r.HaveHeader ? std::vector<std::string>() : HeaderNames(tokens);
+  if (!names.empty())
+  {
+    std::string why;
+    r.HaveHeader = LayoutFromNames(names, r.Columns, r.Extras, why);
+    r.Error = r.HaveHeader ? "" : where + "bad header line: " + why;
+    return r.HaveHeader;
+  }
+  if (comment)
+  {
+    return true;
+  }
+  r.FirstData = static_cast<size_t>(p - data);
+  r.FirstDataLine = lineNo;
+  if (!r.HaveHeader && !LayoutFromCount(tokens.size(), r.Columns))
+  {
+    r.Error = where +
+      "expected 3 (x y z), 4 (x y z scalar), 6 (x y z r g b) or 8 (x y z r g b reflectivity refraction) "
+      "columns, found " +
+      std::to_string(tokens.size()) + "; a header line such as '# x y z intensity' names other layouts";
+    return false;
+  }
+  return true;
+}
+
+// Reads the prologue; its Error names the file, line and column of what is
+// wrong, or says that no data line follows it.
 inline Prologue ParsePrologue(const char* data, size_t size, const std::string& file)
 {
   Prologue r;
   const char* const end = data + size;
   long long lineNo = 0;
-  const char* p = data;
-  bool found = false;
-  auto where = [&](long long line, long long col) {
-    return file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": ";
-  };
-  while (p < end)
+  for (const char* p = data; p < end && r.FirstDataLine == 0;)
   {
+    ++lineNo;
     const size_t look = std::min<size_t>(static_cast<size_t>(end - p), MaxPrologueLine + 1);
     const char* nl = static_cast<const char*>(std::memchr(p, '\n', look));
-    ++lineNo;
-    if (!nl && look > MaxPrologueLine)
-    {
-      r.Error = where(lineNo, 1) + "line " + std::to_string(lineNo) +
-        " is longer than " + std::to_string(MaxPrologueLine) +
-        " bytes before any particle was read; not a particle text file";
-      return r;
-    }
     const char* e = nl ? nl : end;
-    // A particle text file holds no NUL bytes: say so rather than report a
-    // bad number in what is a binary file.
-    if (const void* z = std::memchr(p, '\0', static_cast<size_t>(e - p)))
+    r.Error = NotText(data, p, e, !nl && look > MaxPrologueLine, file, lineNo);
+    if (!r.Error.empty())
     {
-      r.Error = where(lineNo, static_cast<const char*>(z) - p + 1) +
-        "a NUL byte (at byte offset " + std::to_string(static_cast<const char*>(z) - data) +
-        "): this is a binary file, not particle text";
       return r;
     }
-    const char* q = p;
-    while (q < e && IsBlank(*q))
+    const char* q = SkipBlanks(p, e);
+    if (q < e && !ReadPrologueLine(r, data, p, q, e, file, lineNo))
     {
-      ++q;
-    }
-    if (q < e)
-    {
-      const bool comment = *q == '#';
-      auto tokens = comment ? SplitTokens(q + 1, e) : SplitTokens(q, e);
-      const bool allNames = !tokens.empty() &&
-        std::none_of(tokens.begin(), tokens.end(), [](auto& t) { return IsNumber(t.first); });
-      std::vector<std::string> names;
-      for (auto& t : tokens)
-      {
-        names.push_back(t.first);
-      }
-      auto named = [&](const char* want) {
-        return std::any_of(
-          names.begin(), names.end(), [&](const std::string& n) { return Lower(n) == want; });
-      };
-      const bool namesXYZ = allNames && named("x") && named("y") && named("z");
-      if (!r.HaveHeader && namesXYZ)
-      {
-        std::string why;
-        if (!LayoutFromNames(names, r.Columns, r.Extras, why))
-        {
-          r.Error = where(lineNo, 1) + "bad header line: " + why;
-          return r;
-        }
-        r.HaveHeader = true;
-      }
-      else if (!comment)
-      {
-        r.FirstData = static_cast<size_t>(p - data);
-        r.FirstDataLine = lineNo;
-        found = true;
-        if (!r.HaveHeader)
-        {
-          if (!LayoutFromCount(tokens.size(), r.Columns))
-          {
-            r.Error = where(lineNo, 1) + "expected 3 (x y z), 4 (x y z "
-                "scalar), 6 (x y z r g b) or 8 (x y z r g b reflectivity refraction) columns, "
-                "found " + std::to_string(tokens.size()) +
-              "; a header line such as '# x y z intensity' names other layouts";
-            return r;
-          }
-        }
-        break;
-      }
+      return r;
     }
     p = nl ? nl + 1 : end;
   }
@@ -366,9 +382,9 @@ inline Prologue ParsePrologue(const char* data, size_t size, const std::string& 
   {
     r.Layout += (r.Layout.empty() ? "" : " ") + c.Name;
   }
-  if (!found)
+  if (r.FirstDataLine == 0)
   {
-    r.Error = where(lineNo, 1) + "no particle lines in the file (only " +
+    r.Error = Where(file, lineNo, 1) + "no particle lines in the file (only " +
       (r.HaveHeader ? "a header, " : "") + "comments or blank lines); expected lines of " +
       (r.HaveHeader ? r.Layout : std::string("x y z ..."));
     return r;
@@ -493,7 +509,7 @@ inline void ForEachDataLine(const char* s, const char* const end, LineNumber& li
 // A problem's message: file:line:column: what.
 inline std::string LineMessage(const std::string& file, long long line, const char* lineStart, const Problem& problem)
 {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(problem.At - lineStart + 1) + ": " + problem.What;
+  return Where(file, line, problem.At - lineStart + 1) + problem.What;
 }
 
 // Whether the start of a file is particle text, for CanReadFile (a reader

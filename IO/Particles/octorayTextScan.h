@@ -1,5 +1,5 @@
 // What the module's two text formats, particle text and PCD, share: which
-// bytes are blanks, and how a token is shown in an error message. VTK-free,
+// bytes are blanks, and how a message names a place and shows a token. VTK-free,
 // like the format headers that include it (the fuzz targets call them
 // without VTK). Private to the module; not wrapped.
 #ifndef octorayTextScan_h
@@ -32,6 +32,12 @@ inline const char* SkipBlanks(const char* p, const char* e)
     ++p;
   }
   return p;
+}
+
+// "file:line:column: ", the start of a message about a byte of a file.
+inline std::string Where(const std::string& file, long long line, long long column)
+{
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": ";
 }
 
 // [b, e) for a message: at most 40 characters (longer ones end in "..."),

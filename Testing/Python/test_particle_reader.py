@@ -157,7 +157,13 @@ def test_double_precision_and_no_vertices(tmp_path):
     ("1 2\n", "p.txt:1:1: expected 3 (x y z), 4 (x y z scalar), 6 (x y z r g b) or 8"),
     ("# x y q\n1 2 3\n", None),  # not a header (no z): a comment, then 3 columns
     ("# x y z x\n1 2 3 4\n", "p.txt:1:1: bad header line: column 'x' is named twice"),
-    ("# only a comment\n\n", "no particle lines in the file"),
+    ("# only a comment\n\n", "p.txt:2:1: no particle lines in the file (only comments or blank lines); "
+     "expected lines of x y z ..."),
+    ("# a comment\n\nX Y Z r g b\n# another\n",
+     "p.txt:4:1: no particle lines in the file (only a header, comments or blank lines); expected lines of "
+     "X Y Z r g b"),
+    ("# a comment\n# x y z\n# x y z scalar\n1 2 3 4\n",  # the first header line names the columns
+     "p.txt:4:1: expected 3 columns (x y z), found 4"),
 ])
 def test_errors_strict(tmp_path, text, message):
     path = write(tmp_path, "p.txt", text)
