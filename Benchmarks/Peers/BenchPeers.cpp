@@ -63,18 +63,110 @@ struct Case
   std::size_t n = 0;
 };
 
-// Times `build` after `warmups`; `reset` runs untimed after each call, so
-// freeing a tree of millions of nodes is not charged to its build.
-Timing MeasureFresh(
-  const std::function<void()>& build, const std::function<void()>& reset, int warmups, int repeats)
+struct Settings
 {
-  return Measure(build, warmups, repeats, reset);
+  std::vector<Case> cases = { { "uniform", 1000000 }, { "uniform", 10000000 }, { "clustered", 1000000 } };
+  int requestedDepth = 0;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int repeats = 5;
+  int peerRepeats = 3;
+  double octreeLocatorMax = 1e300;
+  std::string json;
+
+  // The thread counts octoray and vtkStaticPointLocator run with: one, and
+  // all of them where there are more.
+  std::vector<int> ThreadCounts() const { return threads > 1 ? std::vector<int>{ 1, threads } : std::vector<int>{ 1 }; }
+};
+
+bool ParseCases(const std::string& list, std::vector<Case>& cases)
+{
+  cases.clear();
+  for (const std::string& item : SplitList(list))
+  {
+    const std::size_t colon = item.find(':');
+    if (colon == std::string::npos)
+    {
+      return false;
+    }
+    Case c{ item.substr(0, colon), 0 };
+    if ((c.set != "uniform" && c.set != "clustered") || !CommandLine::ParseCount(item.substr(colon + 1), c.n) ||
+      c.n == 0)
+    {
+      return false;
+    }
+    cases.push_back(c);
+  }
+  return true;
+}
+
+CommandLine OptionsOf(Settings& s)
+{
+  CommandLine options;
+  options
+    .Option("--cases", "a list SET:N of uniform or clustered and a count",
+      [&s](const std::string& v) { return ParseCases(v, s.cases); })
+    .Integer("--depth", s.requestedDepth)
+    .Integer("--threads", s.threads, 1)
+    .Integer("--repeats", s.repeats, 1)
+    .Integer("--peer-repeats", s.peerRepeats, 1)
+    .Real("--octree-locator-max", s.octreeLocatorMax)
+    .Text("--json", s.json);
+  return options;
 }
 
 std::string CpuBackendName(int threads)
 {
   return "cpu-" + std::to_string(threads) + (threads == 1 ? "thread" : "threads");
 }
+
+// Debian's ParaView defaults to the Sequential SMP backend; ask for a
+// threaded one so that vtkStaticPointLocator's threaded build is measured.
+void ChooseThreadedSmpBackend()
+{
+  const std::string defaultBackend = vtkSMPTools::GetBackend();
+  if (defaultBackend == "Sequential")
+  {
+    vtkSMPTools::SetBackend("STDThread") || vtkSMPTools::SetBackend("TBB") || vtkSMPTools::SetBackend("OpenMP");
+  }
+  std::printf("vtkSMPTools backend %s (default %s); %u hardware threads\n", vtkSMPTools::GetBackend(),
+    defaultBackend.c_str(), std::thread::hardware_concurrency());
+}
+
+// One case's points, and the tree every library is asked for: octoray's
+// cube and depth, with its leaf and branch counts to check PCL's against.
+struct Scene
+{
+  Case c;
+  std::vector<float> xyz;
+  PointCloudView cloud;
+  BuildOptions options; // at the reference's depth: timed builds get it, as PCL gets its resolution
+  RootCube cube;
+  int depth = 0;
+  double leafSize = 0;
+  std::size_t leaves = 0, branches = 0;
+  double meanPerLeaf = 0;
+  int perRegion = 1; // the locators' points a region or bucket: the mean a leaf, rounded up
+
+  Scene(const Case& which, int requestedDepth)
+    : c(which)
+    , xyz(c.set == "uniform" ? UniformCube(c.n) : GaussianClusters(c.n))
+  {
+    cloud.count = c.n;
+    cloud.xyzFloat = xyz.data();
+    options.depth = requestedDepth;
+    HostOctree reference;
+    auto engine = CreateEngine(Backend::CPU);
+    engine->Build(cloud, options);
+    engine->CopyToHost(reference);
+    depth = options.depth = reference.depth;
+    cube = reference.cube;
+    leafSize = cube.size / std::ldexp(1.0, depth);
+    leaves = reference.levelBegin[depth + 1] - reference.levelBegin[depth];
+    branches = reference.NodeCount() - leaves;
+    meanPerLeaf = double(c.n) / double(leaves);
+    perRegion = std::max(1, static_cast<int>(std::ceil(meanPerLeaf)));
+  }
+};
 
 struct Row
 {
@@ -84,295 +176,297 @@ struct Row
   std::string note;
   double leaves = 0; // the peer's leaves or buckets, for the report
 };
+
+// octoray's fresh builds on `threads`; engineBytes gets what the engine
+// holds after one.
+Row MeasureOctoray(const Scene& scene, int threads, int repeats, std::size_t& engineBytes)
+{
+  std::unique_ptr<Engine> engine;
+  const Timing timing = Measure(
+    [&] {
+      engine = CreateEngine(Backend::CPU);
+      engine->SetThreadCount(threads);
+      engine->Build(scene.cloud, scene.options);
+    },
+    1, repeats,
+    [&] {
+      engineBytes = engine->Memory().Total();
+      engine.reset();
+    });
+  return Row{ "octoray", CpuBackendName(threads), timing, "" };
+}
+
+// Seconds of one octoray build on one thread.
+double OneThreadBuildSeconds(const Scene& scene)
+{
+  auto engine = CreateEngine(Backend::CPU);
+  engine->SetThreadCount(1);
+  const auto start = std::chrono::steady_clock::now();
+  engine->Build(scene.cloud, scene.options);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// PCL's octree of the same cube, its resolution the leaf voxel, so that its
+// depth is octoray's.
+struct PclResult
+{
+  Row row;
+  bool sameTree = false;
+  double pairedRatio = 0;
+  std::size_t pairs = 0, leaves = 0, branches = 0;
+};
+
+PclResult MeasurePcl(const Scene& scene, int repeats)
+{
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
+  points->resize(scene.c.n);
+  for (std::size_t i = 0; i < scene.c.n; ++i)
+  {
+    (*points)[i] = pcl::PointXYZ(scene.xyz[3 * i], scene.xyz[3 * i + 1], scene.xyz[3 * i + 2]);
+  }
+  using PclOctree = pcl::octree::OctreePointCloudPointVector<pcl::PointXYZ>;
+  std::unique_ptr<PclOctree> tree;
+  PclResult r;
+  unsigned depth = 0;
+  // Each PCL build is paired with a single-threaded octoray build run
+  // right after it (untimed for PCL): on a shared machine the load drifts
+  // between the octoray and PCL blocks, and the median of the per-pair
+  // ratios is what that drift does not move.
+  std::vector<double> pairedRatios;
+  double pclSeconds = 0.0;
+  const RootCube& cube = scene.cube;
+  const Timing timing = Measure(
+    [&] {
+      const auto start = std::chrono::steady_clock::now();
+      tree = std::make_unique<PclOctree>(scene.leafSize);
+      tree->setInputCloud(points);
+      tree->defineBoundingBox(cube.origin[0], cube.origin[1], cube.origin[2], cube.origin[0] + cube.size,
+        cube.origin[1] + cube.size, cube.origin[2] + cube.size);
+      tree->addPointsFromInputCloud();
+      pclSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    },
+    0, repeats,
+    [&] {
+      r.leaves = tree->getLeafCount();
+      r.branches = tree->getBranchCount();
+      depth = tree->getTreeDepth();
+      tree.reset();
+#if defined(__GLIBC__)
+      // Freeing PCL's tree leaves a million small chunks in glibc's fast
+      // bins; the next large allocation consolidates them (about 0.5 s at
+      // 1 M points here). That is a cost of PCL's teardown, not of whatever
+      // builds next: pay it here, untimed.
+      malloc_trim(0);
+#endif
+      pairedRatios.push_back(pclSeconds / OneThreadBuildSeconds(scene));
+    });
+  r.pairs = pairedRatios.size();
+  r.pairedRatio = Summarise(pairedRatios).median;
+  r.sameTree = r.leaves == scene.leaves && r.branches == scene.branches && depth == unsigned(scene.depth);
+  char note[160];
+  std::snprintf(note, sizeof note, "depth %u, %zu leaves, %zu branches: %s", depth, r.leaves, r.branches,
+    r.sameTree ? "same tree as octoray" : "DIFFERS from octoray");
+  r.row = Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), timing, note, double(r.leaves) };
+  return r;
+}
+
+// vtkOctreePointLocator, serial, with MaximumPointsPerRegion octoray's mean
+// points a leaf rounded up.
+Row MeasureOctreeLocator(const Scene& scene, vtkPolyData* polyData, int repeats)
+{
+  vtkSmartPointer<vtkOctreePointLocator> locator;
+  int leaves = 0;
+  vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
+  const Timing timing = Measure(
+    [&] {
+      locator = vtkSmartPointer<vtkOctreePointLocator>::New();
+      locator->SetDataSet(polyData);
+      locator->SetMaximumPointsPerRegion(scene.perRegion);
+      locator->BuildLocator();
+    },
+    // About a minute per build at 10 M points on this 2-core machine.
+    0, scene.c.n >= 5000000 ? 1 : repeats,
+    [&] {
+      leaves = locator->GetNumberOfLeafNodes();
+      locator = nullptr;
+    });
+  char note[160];
+  std::snprintf(note, sizeof note, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
+    scene.perRegion, scene.meanPerLeaf, leaves);
+  return Row{ "vtkOctreePointLocator", CpuBackendName(1), timing, note, double(leaves) };
+}
+
+// vtkStaticPointLocator through vtkSMPTools on `threads`, with
+// NumberOfPointsPerBucket as MeasureOctreeLocator's regions.
+Row MeasureStaticLocator(const Scene& scene, vtkPolyData* polyData, int threads, int repeats)
+{
+  vtkSMPTools::Initialize(threads);
+  vtkSmartPointer<vtkStaticPointLocator> locator;
+  int divisions[3] = { 0, 0, 0 };
+  const Timing timing = Measure(
+    [&] {
+      locator = vtkSmartPointer<vtkStaticPointLocator>::New();
+      locator->SetDataSet(polyData);
+      locator->SetNumberOfPointsPerBucket(scene.perRegion);
+      locator->BuildLocator();
+    },
+    // Cheap enough to take as many samples as octoray gets.
+    1, repeats,
+    [&] {
+      locator->GetDivisions(divisions);
+      locator = nullptr;
+    });
+  char note[160];
+  std::snprintf(note, sizeof note, "NumberOfPointsPerBucket %d: %dx%dx%d buckets, %d SMP threads", scene.perRegion,
+    divisions[0], divisions[1], divisions[2], vtkSMPTools::GetEstimatedNumberOfThreads());
+  vtkSMPTools::Initialize(0);
+  return Row{ "vtkStaticPointLocator", CpuBackendName(threads), timing, note,
+    double(divisions[0]) * divisions[1] * divisions[2] };
+}
+
+// The case's points as a vtkPolyData for the VTK locators: our array
+// wrapped, no copy.
+vtkSmartPointer<vtkPolyData> WrapPoints(const Scene& scene)
+{
+  vtkNew<vtkFloatArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetArray(
+    const_cast<float*>(scene.xyz.data()), static_cast<vtkIdType>(3 * scene.c.n), 1 /* not ours to free */);
+  vtkNew<vtkPoints> points;
+  points->SetData(coordinates);
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->SetPoints(points);
+  return polyData;
+}
+
+// octoray's timing on the threads of `backend` (CpuBackendName).
+const Timing& OctorayTiming(const std::vector<Row>& rows, const std::string& backend)
+{
+  return std::find_if(rows.begin(), rows.end(), [&](const Row& r) { return r.what == "octoray" && r.backend == backend; })
+    ->timing;
+}
+
+// The table, every peer against octoray with the same thread count, and
+// the peers' records.
+void Report(const Scene& scene, const std::vector<Row>& rows, const PclResult& pcl, std::size_t engineBytes,
+  std::vector<Record>& records)
+{
+  std::printf("%-42s %-13s %10s %10s %5s %9s  %s\n", "build", "threads", "median s", "min s", "runs", "peer/ours",
+    "notes");
+  for (const Row& row : rows)
+  {
+    const bool isOurs = row.what == "octoray";
+    const Timing& mine = OctorayTiming(rows, row.backend);
+    char ratio[32] = "";
+    if (!isOurs)
+    {
+      std::snprintf(ratio, sizeof ratio, "%.2fx", row.timing.median / mine.median);
+    }
+    std::printf("%-42s %-13s %10.4f %10.4f %5d %9s  %s\n", row.what.c_str(), row.backend.c_str(), row.timing.median,
+      row.timing.min, row.timing.repeats, ratio, row.note.c_str());
+    if (isOurs)
+    {
+      continue;
+    }
+    Record r;
+    r.name = "build_vs_" + row.what + "/" + scene.c.set;
+    r.backend = row.backend;
+    r.n = scene.c.n;
+    r.depth = scene.depth;
+    r.seconds = mine.median;
+    r.peer = row.what;
+    r.peerSeconds = row.timing.median;
+    r.With("min_seconds", mine.min)
+      .With("peer_min_seconds", row.timing.min)
+      .With("peer_runs", row.timing.repeats)
+      .With("leaves", double(scene.leaves))
+      .With("branches", double(scene.branches))
+      .With("peer_leaves", row.leaves)
+      .With("engine_bytes", double(engineBytes));
+    if (row.what == pcl.row.what)
+    {
+      r.With("same_tree", pcl.sameTree ? 1.0 : 0.0).With("paired_ratio", pcl.pairedRatio);
+    }
+    records.push_back(r);
+  }
+}
+
+// The case's closing lines: the paired ratio, octoray on all `threads`
+// against PCL, its memory and both trees' counts.
+void PrintSummary(
+  const Scene& scene, const std::vector<Row>& rows, const PclResult& pcl, int threads, std::size_t engineBytes)
+{
+  std::printf("PCL / octoray (1 thread), median of %zu builds each paired with an octoray build: %.2fx\n", pcl.pairs,
+    pcl.pairedRatio);
+  if (threads > 1)
+  {
+    std::printf("octoray %d threads vs PCL (1 thread): %.2fx\n", threads,
+      pcl.row.timing.median / OctorayTiming(rows, CpuBackendName(threads)).median);
+  }
+  std::printf("octoray memory: %.1f B/point (%s; points, keys, sort buffers and nodes); dense pointer skeleton "
+              "of depth %d: %s (8 B x (8^%d-1)/7)\n",
+    double(engineBytes) / scene.c.n, HumanBytes(double(engineBytes)).c_str(), scene.depth,
+    HumanBytes(DenseSkeletonBytes(scene.depth)).c_str(), scene.depth + 1);
+  std::printf("octoray: %zu leaves, %zu branches; PCL: %zu leaves, %zu branches%s\n", scene.leaves, scene.branches,
+    pcl.leaves, pcl.branches, pcl.sameTree ? "" : "  <-- MISMATCH");
+}
+
+// Every peer on one case; appends the peers' records.
+void RunCase(const Case& c, const Settings& s, std::vector<Record>& records)
+{
+  const Scene scene(c, s.requestedDepth);
+  std::printf("\n== %s, %zu points: depth %d, leaf voxel %.6g (cube %.6g), %zu leaves, %.2f points per leaf\n",
+    c.set.c_str(), c.n, scene.depth, scene.leafSize, scene.cube.size, scene.leaves, scene.meanPerLeaf);
+  std::vector<Row> rows;
+  std::size_t engineBytes = 0;
+  for (int threads : s.ThreadCounts())
+  {
+    rows.push_back(MeasureOctoray(scene, threads, s.repeats, engineBytes));
+  }
+  const PclResult pcl = MeasurePcl(scene, s.peerRepeats);
+  rows.push_back(pcl.row);
+  const vtkSmartPointer<vtkPolyData> polyData = WrapPoints(scene);
+  if (double(c.n) <= s.octreeLocatorMax)
+  {
+    rows.push_back(MeasureOctreeLocator(scene, polyData, s.peerRepeats));
+  }
+  else
+  {
+    std::printf("vtkOctreePointLocator left out: %zu points > --octree-locator-max %.0f\n", c.n, s.octreeLocatorMax);
+  }
+  for (int threads : s.ThreadCounts())
+  {
+    rows.push_back(MeasureStaticLocator(scene, polyData, threads, s.repeats));
+  }
+  Report(scene, rows, pcl, engineBytes, records);
+  PrintSummary(scene, rows, pcl, s.threads, engineBytes);
+}
 }
 
 int main(int argc, char** argv)
 {
-  std::vector<Case> cases = { { "uniform", 1000000 }, { "uniform", 10000000 }, { "clustered", 1000000 } };
-  int requestedDepth = 0;
-  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  int repeats = 5;
-  int peerRepeats = 3;
-  double octreeLocatorMax = 1e300;
-  std::string json;
-  CommandLine options;
-  options
-    .Option("--cases", "a list SET:N of uniform or clustered and a count",
-      [&](const std::string& v) {
-        cases.clear();
-        for (const std::string& item : SplitList(v))
-        {
-          const std::size_t colon = item.find(':');
-          if (colon == std::string::npos)
-          {
-            return false;
-          }
-          Case c{ item.substr(0, colon), 0 };
-          if ((c.set != "uniform" && c.set != "clustered") || !CommandLine::ParseCount(item.substr(colon + 1), c.n) ||
-            c.n == 0)
-          {
-            return false;
-          }
-          cases.push_back(c);
-        }
-        return true;
-      })
-    .Integer("--depth", requestedDepth)
-    .Integer("--threads", threads, 1)
-    .Integer("--repeats", repeats, 1)
-    .Integer("--peer-repeats", peerRepeats, 1)
-    .Real("--octree-locator-max", octreeLocatorMax)
-    .Text("--json", json);
+  Settings s;
   if (CommandLine::AsksForHelp(argc, argv))
   {
     return Usage(stdout);
   }
-  if (!options.Parse(argc, argv))
+  if (!OptionsOf(s).Parse(argc, argv))
   {
     return Usage();
   }
-
   std::printf("octoray_bench_peers: octoray median of %d fresh builds after 1 warm-up; PCL and VTK median of %d "
-              "fresh builds, no warm-up (10 M PCL builds take seconds each; vtkOctreePointLocator: 1 build from 5 M points)\n",
-    repeats, peerRepeats);
-  // Debian's ParaView defaults to the Sequential SMP backend; ask for a
-  // threaded one so that vtkStaticPointLocator's threaded build is measured.
-  const std::string defaultBackend = vtkSMPTools::GetBackend();
-  if (defaultBackend == "Sequential")
-  {
-    vtkSMPTools::SetBackend("STDThread") || vtkSMPTools::SetBackend("TBB") || vtkSMPTools::SetBackend("OpenMP");
-  }
-  std::printf("vtkSMPTools backend %s (default %s); %u hardware threads\n", vtkSMPTools::GetBackend(),
-    defaultBackend.c_str(), std::thread::hardware_concurrency());
-
+              "fresh builds, no warm-up (10 M PCL builds take seconds each; vtkOctreePointLocator: 1 build from 5 M "
+              "points)\n",
+    s.repeats, s.peerRepeats);
+  ChooseThreadedSmpBackend();
   std::vector<Record> records;
   try
   {
-    for (const Case& c : cases)
+    for (const Case& c : s.cases)
     {
-      const std::size_t n = c.n;
-      const std::vector<float> xyz = c.set == "uniform" ? UniformCube(n) : GaussianClusters(n);
-      PointCloudView cloud;
-      cloud.count = n;
-      cloud.xyzFloat = xyz.data();
-
-      // The tree every library is asked for: octoray's cube and depth.
-      BuildOptions options;
-      options.depth = requestedDepth;
-      HostOctree reference;
-      {
-        auto engine = CreateEngine(Backend::CPU);
-        engine->Build(cloud, options);
-        engine->CopyToHost(reference);
-      }
-      const int depth = reference.depth;
-      options.depth = depth; // timed builds get the depth, as PCL gets its resolution
-      const RootCube cube = reference.cube;
-      const double leafSize = cube.size / std::ldexp(1.0, depth);
-      const std::size_t leaves = reference.levelBegin[depth + 1] - reference.levelBegin[depth];
-      const std::size_t branches = reference.NodeCount() - leaves;
-      const double meanPerLeaf = double(n) / double(leaves);
-      const int perRegion = std::max(1, static_cast<int>(std::ceil(meanPerLeaf)));
-
-      std::printf("\n== %s, %zu points: depth %d, leaf voxel %.6g (cube %.6g), %zu leaves, %.2f points per leaf\n",
-        c.set.c_str(), n, depth, leafSize, cube.size, leaves, meanPerLeaf);
-
-      std::vector<Row> rows;
-      std::size_t engineBytes = 0;
-
-      // octoray, 1 thread and all threads.
-      Timing ours[2];
-      const int threadCounts[2] = { 1, threads };
-      for (int t = 0; t < (threads > 1 ? 2 : 1); ++t)
-      {
-        std::unique_ptr<Engine> engine;
-        ours[t] = MeasureFresh(
-          [&] {
-            engine = CreateEngine(Backend::CPU);
-            engine->SetThreadCount(threadCounts[t]);
-            engine->Build(cloud, options);
-          },
-          [&] {
-            engineBytes = engine->Memory().Total();
-            engine.reset();
-          },
-          1, repeats);
-        rows.push_back(Row{ "octoray", CpuBackendName(threadCounts[t]), ours[t], "" });
-      }
-
-      // PCL: the same cube; resolution = leaf voxel, so its depth is ours.
-      pcl::PointCloud<pcl::PointXYZ>::Ptr pclCloud(new pcl::PointCloud<pcl::PointXYZ>);
-      pclCloud->resize(n);
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        (*pclCloud)[i] = pcl::PointXYZ(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-      }
-      using PclOctree = pcl::octree::OctreePointCloudPointVector<pcl::PointXYZ>;
-      std::unique_ptr<PclOctree> pclTree;
-      std::size_t pclLeaves = 0, pclBranches = 0;
-      unsigned pclDepth = 0;
-      // Each PCL build is paired with a single-threaded octoray build run
-      // right after it (untimed for PCL): on a shared machine the load
-      // drifts between the octoray and PCL blocks above and below, and the
-      // median of the per-pair ratios is what that drift does not move.
-      std::vector<double> pairedRatios;
-      double pclSeconds = 0.0;
-      const Timing pcl = MeasureFresh(
-        [&] {
-          const auto start = std::chrono::steady_clock::now();
-          pclTree = std::make_unique<PclOctree>(leafSize);
-          pclTree->setInputCloud(pclCloud);
-          pclTree->defineBoundingBox(cube.origin[0], cube.origin[1], cube.origin[2], cube.origin[0] + cube.size,
-            cube.origin[1] + cube.size, cube.origin[2] + cube.size);
-          pclTree->addPointsFromInputCloud();
-          pclSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        },
-        [&] {
-          pclLeaves = pclTree->getLeafCount();
-          pclBranches = pclTree->getBranchCount();
-          pclDepth = pclTree->getTreeDepth();
-          pclTree.reset();
-#if defined(__GLIBC__)
-          // Freeing PCL's tree leaves a million small chunks in glibc's
-          // fast bins; the next large allocation consolidates them (about
-          // 0.5 s at 1 M points here). That is a cost of PCL's teardown, not
-          // of whatever builds next: pay it here, untimed.
-          malloc_trim(0);
-#endif
-          auto engine = CreateEngine(Backend::CPU);
-          engine->SetThreadCount(1);
-          const auto start = std::chrono::steady_clock::now();
-          engine->Build(cloud, options);
-          pairedRatios.push_back(
-            pclSeconds / std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        },
-        0, peerRepeats);
-      std::sort(pairedRatios.begin(), pairedRatios.end());
-      const std::size_t pairs = pairedRatios.size();
-      const double pairedRatio = pairs % 2 ? pairedRatios[pairs / 2]
-                                           : 0.5 * (pairedRatios[pairs / 2 - 1] + pairedRatios[pairs / 2]);
-      const bool same = pclLeaves == leaves && pclBranches == branches && pclDepth == unsigned(depth);
-      char pclNote[160];
-      std::snprintf(pclNote, sizeof pclNote, "depth %u, %zu leaves, %zu branches: %s", pclDepth, pclLeaves,
-        pclBranches, same ? "same tree as octoray" : "DIFFERS from octoray");
-      rows.push_back(Row{ "pcl::octree::OctreePointCloudPointVector", CpuBackendName(1), pcl, pclNote, double(pclLeaves) });
-      pclCloud.reset();
-
-      // VTK locators read a vtkPolyData's points; wrap our array, no copy.
-      vtkNew<vtkFloatArray> coordinates;
-      coordinates->SetNumberOfComponents(3);
-      coordinates->SetArray(const_cast<float*>(xyz.data()), static_cast<vtkIdType>(3 * n), 1 /* not ours to free */);
-      vtkNew<vtkPoints> points;
-      points->SetData(coordinates);
-      vtkNew<vtkPolyData> polyData;
-      polyData->SetPoints(points);
-
-      if (double(n) <= octreeLocatorMax)
-      {
-        vtkSmartPointer<vtkOctreePointLocator> octreeLocator;
-        int vtkLeaves = 0;
-        vtkSMPTools::Initialize(1); // vtkOctreePointLocator is serial; keep SMP out of it anyway
-        const Timing vtkOctree = MeasureFresh(
-          [&] {
-            octreeLocator = vtkSmartPointer<vtkOctreePointLocator>::New();
-            octreeLocator->SetDataSet(polyData);
-            octreeLocator->SetMaximumPointsPerRegion(perRegion);
-            octreeLocator->BuildLocator();
-          },
-          [&] {
-            vtkLeaves = octreeLocator->GetNumberOfLeafNodes();
-            octreeLocator = nullptr;
-          },
-          // About a minute per build at 10 M points on this 2-core machine.
-          0, n >= 5000000 ? 1 : peerRepeats);
-        char octreeNote[160];
-        std::snprintf(octreeNote, sizeof octreeNote, "MaximumPointsPerRegion %d (octoray's mean %.2f rounded up): %d leaves",
-          perRegion, meanPerLeaf, vtkLeaves);
-        rows.push_back(Row{ "vtkOctreePointLocator", CpuBackendName(1), vtkOctree, octreeNote, double(vtkLeaves) });
-      }
-      else
-      {
-        std::printf("vtkOctreePointLocator left out: %zu points > --octree-locator-max %.0f\n", n, octreeLocatorMax);
-      }
-
-      for (int t = 0; t < (threads > 1 ? 2 : 1); ++t)
-      {
-        vtkSMPTools::Initialize(threadCounts[t]);
-        vtkSmartPointer<vtkStaticPointLocator> staticLocator;
-        int divisions[3] = { 0, 0, 0 };
-        const Timing vtkStatic = MeasureFresh(
-          [&] {
-            staticLocator = vtkSmartPointer<vtkStaticPointLocator>::New();
-            staticLocator->SetDataSet(polyData);
-            staticLocator->SetNumberOfPointsPerBucket(perRegion);
-            staticLocator->BuildLocator();
-          },
-          [&] {
-            staticLocator->GetDivisions(divisions);
-            staticLocator = nullptr;
-          },
-          // Cheap enough to take as many samples as octoray gets.
-          1, repeats);
-        char staticNote[160];
-        std::snprintf(staticNote, sizeof staticNote, "NumberOfPointsPerBucket %d: %dx%dx%d buckets, %d SMP threads",
-          perRegion, divisions[0], divisions[1], divisions[2], vtkSMPTools::GetEstimatedNumberOfThreads());
-        rows.push_back(Row{ "vtkStaticPointLocator", CpuBackendName(threadCounts[t]), vtkStatic, staticNote,
-          double(divisions[0]) * divisions[1] * divisions[2] });
-      }
-      vtkSMPTools::Initialize(0);
-
-      // The table: every peer against octoray with the same thread count.
-      std::printf("%-42s %-13s %10s %10s %5s %9s  %s\n", "build", "threads", "median s", "min s", "runs",
-        "peer/ours", "notes");
-      for (const Row& row : rows)
-      {
-        const Timing& mine = row.backend == CpuBackendName(1) ? ours[0] : ours[1];
-        const bool isOurs = row.what == "octoray";
-        char ratio[32] = "";
-        if (!isOurs)
-        {
-          std::snprintf(ratio, sizeof ratio, "%.2fx", row.timing.median / mine.median);
-        }
-        std::printf("%-42s %-13s %10.4f %10.4f %5d %9s  %s\n", row.what.c_str(), row.backend.c_str(),
-          row.timing.median, row.timing.min, row.timing.repeats, ratio, row.note.c_str());
-        if (!isOurs)
-        {
-          Record r;
-          r.name = "build_vs_" + row.what + "/" + c.set;
-          r.backend = row.backend;
-          r.n = n;
-          r.depth = depth;
-          r.seconds = mine.median;
-          r.peer = row.what;
-          r.peerSeconds = row.timing.median;
-          r.With("min_seconds", mine.min)
-            .With("peer_min_seconds", row.timing.min)
-            .With("peer_runs", row.timing.repeats)
-            .With("leaves", double(leaves))
-            .With("branches", double(branches))
-            .With("peer_leaves", row.leaves)
-            .With("engine_bytes", double(engineBytes));
-          if (row.what == "pcl::octree::OctreePointCloudPointVector")
-          {
-            r.With("same_tree", same ? 1.0 : 0.0).With("paired_ratio", pairedRatio);
-          }
-          records.push_back(r);
-        }
-      }
-      std::printf("PCL / octoray (1 thread), median of %zu builds each paired with an octoray build: %.2fx\n", pairs,
-        pairedRatio);
-      if (threads > 1)
-      {
-        std::printf("octoray %d threads vs PCL (1 thread): %.2fx\n", threads, pcl.median / ours[1].median);
-      }
-      std::printf("octoray memory: %.1f B/point (%s; points, keys, sort buffers and nodes); dense pointer skeleton "
-                  "of depth %d: %s (8 B x (8^%d-1)/7)\n",
-        double(engineBytes) / n, HumanBytes(double(engineBytes)).c_str(), depth,
-        HumanBytes(DenseSkeletonBytes(depth)).c_str(), depth + 1);
-      std::printf("octoray: %zu leaves, %zu branches; PCL: %zu leaves, %zu branches%s\n", leaves, branches, pclLeaves,
-        pclBranches, same ? "" : "  <-- MISMATCH");
+      RunCase(c, s, records);
     }
-    SaveRecords(json, records);
+    SaveRecords(s.json, records);
   }
   catch (const std::exception& e)
   {
