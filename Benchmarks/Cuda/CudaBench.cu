@@ -727,235 +727,228 @@ int Usage(std::FILE* to = stderr)
     "[--profile-build N]\n");
 }
 
-int Run(int argc, char** argv)
+// Two builds of n points at depth 10 and nothing else, for a profiler's
+// list of the build's kernels; the first fills the allocator's pool.
+void ProfileBuild(Engine& engine, std::size_t n)
 {
-  std::string json;
-  std::string only = "all"; // or "build" or "render": that section alone
-  bool small = false;       // 1 M and 10 M points, not 100 M
-  std::size_t billion = 0;
-  std::size_t profileBuild = 0; // points: two builds at depth 10 alone, for a profiler's kernel list
-  CommandLine options;
-  options.Text("--json", json)
-    .Flag("--small", small)
-    .Choice("--only", only, { "all", "build", "render" })
-    .Count("--billion", billion)
-    .Count("--profile-build", profileBuild);
-  if (CommandLine::AsksForHelp(argc, argv))
+  const Cloud c = MakeCloud(n, 1);
+  BuildOptions o;
+  o.depth = 10;
+  for (int b = 0; b < 2; ++b)
   {
-    return Usage(stdout);
+    const BuildStats last = engine.Build(c.View(), o);
+    std::printf("build %d of n=%zu depth=10: upload %.3f, keys %.3f, sort %.3f, levels %.3f ms\n", b + 1, n,
+      last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3, last.levelSeconds * 1e3);
   }
-  if (!options.Parse(argc, argv))
-  {
-    return Usage();
-  }
-  const std::vector<std::size_t> sizes =
-    small ? std::vector<std::size_t>{ 1000000, 10000000 } : std::vector<std::size_t>{ 1000000, 10000000, 100000000 };
-  auto section = [&](const char* name) { return only == "all" || only == name; };
-  std::string why;
-  if (!CudaAvailable(&why))
-  {
-    std::printf("no usable GPU: %s\n", why.c_str());
-    return 0;
-  }
-  auto engine = CreateEngine(Backend::CUDA);
-  std::printf("device: %s\n", engine->Description().c_str());
-  if (profileBuild)
-  {
-    const Cloud c = MakeCloud(profileBuild, 1);
-    BuildOptions o;
-    o.depth = 10;
-    for (int b = 0; b < 2; ++b) // the first one fills the allocator's pool
-    {
-      const BuildStats last = engine->Build(c.View(), o);
-      std::printf("build %d of n=%zu depth=10: upload %.3f, keys %.3f, sort %.3f, levels %.3f ms\n", b + 1,
-        profileBuild, last.uploadSeconds * 1e3, last.keySeconds * 1e3, last.sortSeconds * 1e3,
-        last.levelSeconds * 1e3);
-    }
-    return 0;
-  }
-  std::vector<Record> records;
+}
 
-  // Build against the sort floor.
-  Cloud ten = section("build") ? Cloud() : MakeCloud(10000000, 1);
-  for (std::size_t n : section("build") ? sizes : std::vector<std::size_t>())
+// The upload of a cloud's pageable host arrays, and what it is measured
+// against: the pinned copy of the same bytes and the upload's peers. The
+// host half's threads and buffers stay while the cloud's builds run.
+struct UploadOf
+{
+  PinnedCopy pinned;
+  HostHalfOfStaging hostHalf;
+  double pinnedSeconds = 0;
+  UploadPeers peers;
+
+  explicit UploadOf(Cloud& c)
+    : pinned(c)
   {
-    Cloud c = MakeCloud(n, 1);
-    PinnedCopy pinned(c);
-    const double uploadMegabytes = pinned.Megabytes();
-    const double pinnedUpload = MedianOfRuns(5, [&] { return pinned.Seconds(); });
-    UploadPeers peers = MeasureUploadPeers(c);
-    HostHalfOfStaging hostHalf;
+    pinnedSeconds = MedianOfRuns(5, [this] { return pinned.Seconds(); });
+    peers = MeasureUploadPeers(c);
     peers.hostStaging = MedianOfRuns(5, [&] { return hostHalf.Seconds(c); });
     peers.hostBesideCopy = MedianOfRuns(5, [&] { return HostHalfBesidePinnedCopy(hostHalf, pinned, c); });
     peers.staged = StagedCopySeconds(c);
-    const DeviceCloud onDevice(c);
     std::printf("upload of %zu points' %.0f MB from pageable host arrays: pinned copy %.3f ms, plain cudaMemcpy "
                 "%.3f ms, cudaHostRegister + copy %.3f ms, the host's half of the staging on %d threads %.3f ms, "
                 "that and the pinned copy at once %.3f ms, the engine's staged copy alone %.3f ms (landing %.0f MB: "
                 "the reflectivity as 16-bit codes)\n",
-      n, uploadMegabytes, pinnedUpload * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
+      c.xyz.size() / 3, pinned.Megabytes(), pinnedSeconds * 1e3, peers.pageable * 1e3, peers.registered * 1e3,
       hostHalf.ThreadCount(), peers.hostStaging * 1e3, peers.hostBesideCopy * 1e3, peers.staged * 1e3,
       TotalBytes(c, Held::Landed) / 1e6);
+  }
+};
+
+// Builds of cloud c at `depth`: from host arrays, each paired with the
+// pinned copy, and from device arrays (the device phases), beside the sort
+// floor; then without the points kept.
+void MeasureBuild(Engine& engine, Cloud& c, UploadOf& upload, const DeviceCloud& onDevice, int depth,
+  std::vector<Record>& records)
+{
+  const std::size_t n = c.xyz.size() / 3;
+  BuildOptions o;
+  o.depth = depth;
+  const int repeats = 7;
+  // From device arrays first: the memory below is a build's from host arrays.
+  std::vector<BuildStats> fromDevice;
+  for (int r = 0; onDevice.Ok() && r < kWarmUpBuilds + repeats; ++r)
+  {
+    const BuildStats stats = engine.Build(onDevice.View(), o);
+    if (r >= kWarmUpBuilds)
+    {
+      fromDevice.push_back(stats);
+    }
+  }
+  const PairedBuild paired = TimeBuildAgainstCopy(repeats, upload.pinned, [&] { return engine.Build(c.View(), o); });
+  const BuildStats& whole = paired.phases; // medians
+  const BuildStats phases = fromDevice.empty() ? whole : MedianPhases(fromDevice);
+  const double t = paired.seconds;
+  const double floor = SortFloorSeconds(n, 3 * depth);
+  const double buildSort = BuildSortSeconds(n, depth);
+  const double bytesPerPoint = double(engine.Memory().Total()) / n;
+  const double arrayBytesPerPoint = double(engine.Memory().ArrayBytes()) / n;
+  // Without the points kept for updates: what a static scene holds.
+  BuildOptions lean = o;
+  lean.keepPoints = false;
+  const double leanSeconds = TimeMedian(repeats, [&] { engine.Build(c.View(), lean); });
+  const double leanBytesPerPoint = double(engine.Memory().Total()) / n;
+  const UploadPeers& peers = upload.peers;
+  std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms; from device "
+              "arrays keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
+              "sort %.3f ms (of 32-bit keys with 8-byte records %.3f ms), ratio %.2f, %zu nodes, %.1f GPU "
+              "bytes/point (%.1f in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input "
+              "%.3f ms beside it, "
+              "whole call %.2fx that (median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
+    n, depth, t * 1e3, whole.uploadSeconds * 1e3, whole.keySeconds * 1e3, whole.sortSeconds * 1e3,
+    whole.levelSeconds * 1e3, phases.keySeconds * 1e3, phases.sortSeconds * 1e3, phases.levelSeconds * 1e3,
+    floor * 1e3, buildSort * 1e3, t / floor, whole.nodes, bytesPerPoint, arrayBytesPerPoint,
+    upload.pinned.Megabytes(), paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3, leanBytesPerPoint);
+  records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
+    { { "upload_seconds", whole.uploadSeconds }, { "key_seconds", phases.keySeconds },
+      { "sort_seconds", phases.sortSeconds }, { "level_seconds", phases.levelSeconds },
+      { "host_input_key_seconds", whole.keySeconds }, { "host_input_sort_seconds", whole.sortSeconds },
+      { "host_input_level_seconds", whole.levelSeconds }, { "build_sort_seconds", buildSort },
+      { "nodes", double(whole.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
+      { "call_over_pinned_copy", paired.ratio }, { "pageable_upload_seconds", peers.pageable },
+      { "registered_upload_seconds", peers.registered }, { "host_staging_copy_seconds", peers.hostStaging },
+      { "host_staging_beside_copy_seconds", peers.hostBesideCopy }, { "staged_copy_seconds", peers.staged },
+      { "lean_seconds", leanSeconds }, { "warm_up_builds", double(kWarmUpBuilds) } } });
+  records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
+    { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });
+}
+
+// Builds of each size at depths 10, 16 and 21 against the sort floor and
+// the pinned copy; returns the 10 M-point cloud for the updates and the
+// rendering.
+Cloud MeasureBuilds(Engine& engine, const std::vector<std::size_t>& sizes, std::vector<Record>& records)
+{
+  Cloud ten;
+  for (std::size_t n : sizes)
+  {
+    Cloud c = MakeCloud(n, 1);
+    UploadOf upload(c);
+    const DeviceCloud onDevice(c);
     // Depth 21 at 100 M points would hold ~1e9 nodes (every point its own
     // chain below level ~9): 18 GB of colours alone. Measured up to 10 M.
     for (int depth : { 10, 16, 21 })
     {
-      if (depth == 21 && n > 10000000)
+      if (depth < 21 || n <= 10000000)
       {
-        continue;
+        MeasureBuild(engine, c, upload, onDevice, depth, records);
       }
-      BuildOptions o;
-      o.depth = depth;
-      const int repeats = 7;
-      // From device arrays first: the memory below is a build's from host arrays.
-      std::vector<BuildStats> fromDevice;
-      for (int r = 0; onDevice.Ok() && r < kWarmUpBuilds + repeats; ++r)
-      {
-        const BuildStats stats = engine->Build(onDevice.View(), o);
-        if (r >= kWarmUpBuilds)
-        {
-          fromDevice.push_back(stats);
-        }
-      }
-      const PairedBuild paired = TimeBuildAgainstCopy(repeats, pinned, [&] { return engine->Build(c.View(), o); });
-      const BuildStats& whole = paired.phases; // medians
-      const BuildStats phases = fromDevice.empty() ? whole : MedianPhases(fromDevice);
-      const double t = paired.seconds;
-      const double floor = SortFloorSeconds(n, 3 * depth);
-      const double buildSort = BuildSortSeconds(n, depth);
-      const double bytesPerPoint = double(engine->Memory().Total()) / n;
-      const double arrayBytesPerPoint = double(engine->Memory().ArrayBytes()) / n;
-      // Without the points kept for updates: what a static scene holds.
-      BuildOptions lean = o;
-      lean.keepPoints = false;
-      const double leanSeconds = TimeMedian(repeats, [&] { engine->Build(c.View(), lean); });
-      const double leanBytesPerPoint = double(engine->Memory().Total()) / n;
-      std::printf("build n=%zu depth=%d: %.3f ms (upload %.3f, keys %.3f, sort %.3f, levels %.3f ms; from device "
-                  "arrays keys %.3f, sort %.3f, levels %.3f ms), bare CUB "
-                  "sort %.3f ms (of 32-bit keys with 8-byte records %.3f ms), ratio %.2f, %zu nodes, %.1f GPU "
-                  "bytes/point (%.1f in arrays, the rest the allocator's cache); pinned copy of its %.0f MB input "
-                  "%.3f ms beside it, "
-                  "whole call %.2fx that (median of the pairs); without the points %.3f ms, %.1f GPU bytes/point\n",
-        n, depth, t * 1e3, whole.uploadSeconds * 1e3, whole.keySeconds * 1e3, whole.sortSeconds * 1e3,
-        whole.levelSeconds * 1e3, phases.keySeconds * 1e3, phases.sortSeconds * 1e3, phases.levelSeconds * 1e3,
-        floor * 1e3, buildSort * 1e3, t / floor, whole.nodes, bytesPerPoint, arrayBytesPerPoint, uploadMegabytes,
-        paired.copySeconds * 1e3, paired.ratio, leanSeconds * 1e3, leanBytesPerPoint);
-      records.push_back({ "octree build", n, depth, t, "cub radix sort", floor,
-        { { "upload_seconds", whole.uploadSeconds }, { "key_seconds", phases.keySeconds },
-          { "sort_seconds", phases.sortSeconds }, { "level_seconds", phases.levelSeconds },
-          { "host_input_key_seconds", whole.keySeconds }, { "host_input_sort_seconds", whole.sortSeconds },
-          { "host_input_level_seconds", whole.levelSeconds },
-          { "build_sort_seconds", buildSort },
-          { "nodes", double(whole.nodes) }, { "pinned_upload_seconds", paired.copySeconds },
-          { "call_over_pinned_copy", paired.ratio },
-          { "pageable_upload_seconds", peers.pageable }, { "registered_upload_seconds", peers.registered },
-          { "host_staging_copy_seconds", peers.hostStaging },
-          { "host_staging_beside_copy_seconds", peers.hostBesideCopy },
-          { "staged_copy_seconds", peers.staged },
-          { "lean_seconds", leanSeconds }, { "warm_up_builds", double(kWarmUpBuilds) } } });
-      records.push_back({ "gpu bytes per point", n, depth, bytesPerPoint, "", 0,
-        { { "array_bytes_per_point", arrayBytesPerPoint }, { "lean_bytes_per_point", leanBytesPerPoint } } });
     }
     if (n == 10000000)
     {
       ten = c;
     }
   }
+  return ten;
+}
 
-  // Memory with every attribute a lit scene of scalars and colours uses.
-  if (section("build") && std::find(sizes.begin(), sizes.end(), std::size_t(100000000)) != sizes.end())
+// Update of 1% and 100% of the points against a rebuild, at depth 10.
+void MeasureUpdates(Engine& engine, const Cloud& cloud, std::vector<Record>& records)
+{
+  BuildOptions o;
+  o.depth = 10;
+  const std::size_t n = cloud.xyz.size() / 3;
+  const double rebuild = TimeMedian(5, [&] { engine.Build(cloud.View(), o); });
+  for (double fraction : { 0.01, 1.0 })
   {
-    ReportEveryAttribute(*engine, 100000000, records);
-  }
-
-  // Update of 1% and 100% of 10 M points against a rebuild.
-  if (section("build"))
-  {
-    BuildOptions o;
-    o.depth = 10;
-    const std::size_t n = ten.xyz.size() / 3;
-    const double rebuild = TimeMedian(5, [&] { engine->Build(ten.View(), o); });
-    for (double fraction : { 0.01, 1.0 })
+    const std::size_t moved = static_cast<std::size_t>(n * fraction);
+    std::vector<std::uint32_t> idx(moved);
+    std::vector<float> xyz(3 * moved);
+    std::mt19937_64 rng(3);
+    // Distinct points spread over the cloud (the engine refuses duplicates).
+    const std::size_t stride = n / moved;
+    for (std::size_t k = 0; k < moved; ++k)
     {
-      const std::size_t moved = static_cast<std::size_t>(n * fraction);
-      std::vector<std::uint32_t> idx(moved);
-      std::vector<float> xyz(3 * moved);
-      std::mt19937_64 rng(3);
-      // Distinct points spread over the cloud (the engine refuses duplicates).
-      const std::size_t stride = n / moved;
-      for (std::size_t k = 0; k < moved; ++k)
-      {
-        idx[k] = static_cast<std::uint32_t>(k * stride + rng() % stride);
-      }
-      std::vector<double> times;
-      UpdateStats last;
-      for (int r = 0; r < 6; ++r)
-      {
-        engine->Build(ten.View(), o);
-        // A small contraction towards the origin (inside the clusters' box):
-        // every point moves, none leaves the root cube.
-        const float factor = r % 2 ? 0.9995f : 0.999f;
-        for (std::size_t k = 0; k < moved; ++k)
-          for (int a = 0; a < 3; ++a)
-            xyz[3 * k + a] = ten.xyz[3 * idx[k] + a] * factor;
-        PositionsView p;
-        p.count = moved;
-        p.xyzFloat = xyz.data();
-        p.indices = fraction < 1 ? idx.data() : nullptr;
-        cudaDeviceSynchronize();
-        const auto start = std::chrono::steady_clock::now();
-        last = engine->Update(p);
-        cudaDeviceSynchronize();
-        if (r > 0)
-          times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      }
-      const double t = Median(times);
-      std::printf("update %.0f%% of %zu: %.3f ms (%s, %zu left their leaf), rebuild %.3f ms, ratio %.2f\n",
-        fraction * 100, n, t * 1e3, ToString(last.path), last.changedLeaf, rebuild * 1e3, t / rebuild);
-      records.push_back({ fraction < 1 ? "update 1%" : "update 100%", n, 10, t, "rebuild", rebuild });
+      idx[k] = static_cast<std::uint32_t>(k * stride + rng() % stride);
     }
+    std::vector<double> times;
+    UpdateStats last;
+    for (int r = 0; r < 6; ++r)
+    {
+      engine.Build(cloud.View(), o);
+      // A small contraction towards the origin (inside the clusters' box):
+      // every point moves, none leaves the root cube.
+      const float factor = r % 2 ? 0.9995f : 0.999f;
+      for (std::size_t k = 0; k < moved; ++k)
+        for (int a = 0; a < 3; ++a)
+          xyz[3 * k + a] = cloud.xyz[3 * idx[k] + a] * factor;
+      PositionsView p;
+      p.count = moved;
+      p.xyzFloat = xyz.data();
+      p.indices = fraction < 1 ? idx.data() : nullptr;
+      cudaDeviceSynchronize();
+      const auto start = std::chrono::steady_clock::now();
+      last = engine.Update(p);
+      cudaDeviceSynchronize();
+      if (r > 0)
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    const double t = Median(times);
+    std::printf("update %.0f%% of %zu: %.3f ms (%s, %zu left their leaf), rebuild %.3f ms, ratio %.2f\n",
+      fraction * 100, n, t * 1e3, ToString(last.path), last.changedLeaf, rebuild * 1e3, t / rebuild);
+    records.push_back({ fraction < 1 ? "update 1%" : "update 100%", n, 10, t, "rebuild", rebuild });
   }
+}
 
-  // Rendering at 1920x1080.
-  for (int depth : section("render") ? std::vector<int>{ 10, 16 } : std::vector<int>())
+// Primary rays, and Phong + shadows + one bounce, at 1920x1080 at depths 10
+// and 16.
+void MeasureRendering(Engine& engine, const Cloud& cloud, std::vector<Record>& records)
+{
+  for (int depth : { 10, 16 })
   {
     BuildOptions o;
     o.depth = depth;
-    engine->Build(ten.View(), o);
+    engine.Build(cloud.View(), o);
     HostOctree t;
-    engine->CopyToHost(t);
+    engine.CopyToHost(t);
     RenderSettings s = Camera(t, 1920, 1080);
     s.maxBounces = 0;
     Image image;
     RenderStats stats;
-    const double withCopy = TimeMedian(9, [&] { stats = engine->Render(s, image); });
+    const double withCopy = TimeMedian(9, [&] { stats = engine.Render(s, image); });
     std::size_t hit = 0;
     for (std::size_t i = 0; i < image.depth.size(); ++i)
       hit += image.depth[i] < 1;
     s.copyToHost = false;
-    const double primary = FrameSeconds(*engine, s, stats);
+    const double primary = FrameSeconds(engine, s, stats);
     std::printf("render depth %d, primary: %.3f ms on the device, %.0f Mrays/s; %.3f ms with the copy to the host; "
                 "%.1f%% of pixels hit\n",
       depth, primary * 1e3, 1920.0 * 1080 / primary / 1e6, withCopy * 1e3, 100.0 * hit / (1920.0 * 1080));
-    records.push_back({ "render primary 1920x1080", ten.xyz.size() / 3, depth, primary, "", 0 });
+    records.push_back({ "render primary 1920x1080", cloud.xyz.size() / 3, depth, primary, "", 0 });
     AddShadowsAndBounce(s);
-    const double full = FrameSeconds(*engine, s, stats);
+    const double full = FrameSeconds(engine, s, stats);
     const double rays = double(stats.primaryRays + stats.secondaryRays);
     std::printf("render depth %d, Phong + shadows + 1 bounce: %.3f ms, %.0f Mrays/s (%zu secondary rays)\n", depth,
       full * 1e3, rays / full / 1e6, stats.secondaryRays);
-    records.push_back({ "render shadows+bounce 1920x1080", ten.xyz.size() / 3, depth, full, "", 0 });
+    records.push_back({ "render shadows+bounce 1920x1080", cloud.xyz.size() / 3, depth, full, "", 0 });
   }
+}
 
-  // The thesis's table 2 again (2015, GTX Titan): clouds like a thresholded
-  // slice stack (grid points inside an ellipsoid, slice by slice), depth 7,
-  // 800x600 rays. Thesis figures, for all five sizes: build 0.02-6.1 s
-  // (almost all allocation), ray tracing 24-45 ms per image, 2.4-2.5 GB.
-  // A fresh engine, so that buffers kept from the 100 M builds above do not
-  // count in its memory.
-  engine = CreateEngine(Backend::CUDA);
-  if (section("build"))
-    std::printf("thesis table 2 (depth 7, 800x600): points, build ms, trace ms/image, GPU MB\n");
-  for (std::size_t n : section("build") ? bench::ThesisTable2Counts() : std::vector<std::size_t>())
+// The thesis's table 2 again (2015, GTX Titan): clouds like a thresholded
+// slice stack (grid points inside an ellipsoid, slice by slice), depth 7,
+// 800x600 rays. Thesis figures, for all five sizes: build 0.02-6.1 s
+// (almost all allocation), ray tracing 24-45 ms per image, 2.4-2.5 GB.
+// A fresh engine, so that buffers kept from larger builds do not count in
+// its memory.
+void MeasureThesisTable(std::vector<Record>& records)
+{
+  auto engine = CreateEngine(Backend::CUDA);
+  std::printf("thesis table 2 (depth 7, 800x600): points, build ms, trace ms/image, GPU MB\n");
+  for (std::size_t n : bench::ThesisTable2Counts())
   {
     const Cloud c = bench::ThesisSliceStack(n);
     const std::size_t count = c.xyz.size() / 3;
@@ -982,10 +975,84 @@ int Run(int argc, char** argv)
       { { "bytes", double(engine->Memory().Total()) } } });
     records.push_back({ "thesis table 2 trace 800x600", count, 7, trace, "", 0 });
   }
+}
 
+// The records as a JSON list, the report's input.
+void WriteRecords(const std::string& json, const std::vector<Record>& records)
+{
+  std::ofstream out(json);
+  out << "[\n";
+  for (std::size_t i = 0; i < records.size(); ++i)
+  {
+    const Record& r = records[i];
+    out << "  {\"name\": \"" << r.name << "\", \"backend\": \"CUDA\", \"n\": " << r.n << ", \"depth\": " << r.depth
+        << ", \"seconds\": " << r.seconds << ", \"peer\": \"" << r.peer << "\", \"peer_seconds\": " << r.peerSeconds;
+    for (const auto& e : r.extra)
+      out << ", \"" << e.first << "\": " << e.second;
+    out << "}" << (i + 1 < records.size() ? "," : "") << "\n";
+  }
+  out << "]\n";
+}
+
+int Run(int argc, char** argv)
+{
+  std::string json;
+  std::string only = "all"; // or "build" or "render": that section alone
+  bool small = false;       // 1 M and 10 M points, not 100 M
+  std::size_t billion = 0;
+  std::size_t profileBuild = 0; // points: two builds at depth 10 alone, for a profiler's kernel list
+  CommandLine options;
+  options.Text("--json", json)
+    .Flag("--small", small)
+    .Choice("--only", only, { "all", "build", "render" })
+    .Count("--billion", billion)
+    .Count("--profile-build", profileBuild);
+  if (CommandLine::AsksForHelp(argc, argv))
+  {
+    return Usage(stdout);
+  }
+  if (!options.Parse(argc, argv))
+  {
+    return Usage();
+  }
+  const std::vector<std::size_t> sizes =
+    small ? std::vector<std::size_t>{ 1000000, 10000000 } : std::vector<std::size_t>{ 1000000, 10000000, 100000000 };
+  const bool builds = only != "render", rendering = only != "build";
+  std::string why;
+  if (!CudaAvailable(&why))
+  {
+    std::printf("no usable GPU: %s\n", why.c_str());
+    return 0;
+  }
+  auto engine = CreateEngine(Backend::CUDA);
+  std::printf("device: %s\n", engine->Description().c_str());
+  if (profileBuild)
+  {
+    ProfileBuild(*engine, profileBuild);
+    return 0;
+  }
+  std::vector<Record> records;
+  Cloud ten = builds ? MeasureBuilds(*engine, sizes, records) : MakeCloud(10000000, 1);
+  if (builds && !small)
+  {
+    // Memory with every attribute a lit scene of scalars and colours uses.
+    ReportEveryAttribute(*engine, 100000000, records);
+  }
+  if (builds)
+  {
+    MeasureUpdates(*engine, ten, records);
+  }
+  if (rendering)
+  {
+    MeasureRendering(*engine, ten, records);
+  }
+  engine.reset();
+  if (builds)
+  {
+    MeasureThesisTable(records);
+  }
   if (billion)
   {
-    engine.reset();
     ten = Cloud();
     try
     {
@@ -996,21 +1063,9 @@ int Run(int argc, char** argv)
       std::printf("device-generated %zu points: %s\n", billion, e.what());
     }
   }
-
   if (!json.empty())
   {
-    std::ofstream out(json);
-    out << "[\n";
-    for (std::size_t i = 0; i < records.size(); ++i)
-    {
-      const Record& r = records[i];
-      out << "  {\"name\": \"" << r.name << "\", \"backend\": \"CUDA\", \"n\": " << r.n << ", \"depth\": " << r.depth
-          << ", \"seconds\": " << r.seconds << ", \"peer\": \"" << r.peer << "\", \"peer_seconds\": " << r.peerSeconds;
-      for (const auto& e : r.extra)
-        out << ", \"" << e.first << "\": " << e.second;
-      out << "}" << (i + 1 < records.size() ? "," : "") << "\n";
-    }
-    out << "]\n";
+    WriteRecords(json, records);
   }
   return 0;
 }
