@@ -395,12 +395,22 @@ struct LeafGrid
   double LeafSize() const { return this->Size / static_cast<double>(1LL << this->Depth); }
 };
 
-inline LeafGrid ChooseLeafGrid(const Lattice& l, const double bounds[6], int maxDepth = 21)
+namespace detail
 {
-  LeafGrid grid;
-  double leaf = 0.0, diagonal2 = 0.0;
-  bool aligned = true;
-  int alongWorld[3] = { -1, -1, -1 }; // lattice axis running along each world axis
+// The leaf side a lattice asks for, and whether its step vectors run along
+// world axes (alongWorld[w]: the lattice axis along world axis w, or -1).
+// Leaf 0 where no axis has two samples or a step is not a finite length.
+struct LatticeLeaf
+{
+  double Leaf = 0.0;
+  bool Aligned = true;
+  int AlongWorld[3] = { -1, -1, -1 };
+};
+
+inline LatticeLeaf LeafOf(const Lattice& l)
+{
+  LatticeLeaf r;
+  double diagonal2 = 0.0;
   double drift[3] = { 0.0, 0.0, 0.0 }; // how far the lattice strays from its world axes over its extent
   for (int a = 0; a < 3; ++a)
   {
@@ -408,31 +418,55 @@ inline LeafGrid ChooseLeafGrid(const Lattice& l, const double bounds[6], int max
     {
       continue;
     }
-    const double length = detail::Length(l.Step[a]);
+    const double length = Length(l.Step[a]);
     if (!std::isfinite(length) || length <= 0.0)
     {
-      return grid;
+      return LatticeLeaf();
     }
-    leaf = std::max(leaf, length);
+    r.Leaf = std::max(r.Leaf, length);
     diagonal2 += length * length;
-    const int w = detail::MainAxis(l.Step[a]);
-    aligned = aligned && alongWorld[w] < 0;
-    alongWorld[w] = a;
+    const int w = MainAxis(l.Step[a]);
+    r.Aligned = r.Aligned && r.AlongWorld[w] < 0;
+    r.AlongWorld[w] = a;
     for (int u = 0; u < 3; ++u)
     {
       drift[u] += u == w ? 0.0 : std::abs(l.Step[a][u]) * static_cast<double>(l.Count[a] - 1);
     }
   }
-  if (leaf <= 0.0)
-  {
-    return grid;
-  }
   // Direction cosines written with a few digits (DICOM) stray a little:
   // aligned while no point strays a tenth of a leaf from its plane.
   for (int u = 0; u < 3; ++u)
   {
-    aligned = aligned && drift[u] <= 0.1 * leaf;
+    r.Aligned = r.Aligned && drift[u] <= 0.1 * r.Leaf;
   }
+  if (!r.Aligned)
+  {
+    r.Leaf = std::sqrt(diagonal2);
+  }
+  return r;
+}
+
+// The root cube's corner along world axis w: leaf centres on the lattice's
+// planes along it where the lattice is aligned and has an axis there (the
+// corner half a leaf before a lattice point, whole leaves before the lowest
+// bound); elsewhere the lowest bound centred in a leaf.
+inline double CubeCorner(const Lattice& l, const LatticeLeaf& leaf, const double bounds[6], int w)
+{
+  const double lo = bounds[2 * w];
+  if (!(leaf.Aligned && leaf.AlongWorld[w] >= 0))
+  {
+    return lo - 0.5 * leaf.Leaf;
+  }
+  const double phase = l.Origin[w] - 0.5 * leaf.Leaf;
+  const double corner = phase - leaf.Leaf * std::ceil((phase - lo) / leaf.Leaf);
+  return corner > lo ? corner - leaf.Leaf : corner; // rounding
+}
+}
+
+inline LeafGrid ChooseLeafGrid(const Lattice& l, const double bounds[6], int maxDepth = 21)
+{
+  LeafGrid grid;
+  const detail::LatticeLeaf leaf = detail::LeafOf(l);
   for (int w = 0; w < 3; ++w)
   {
     if (!(std::isfinite(bounds[2 * w]) && std::isfinite(bounds[2 * w + 1]) && bounds[2 * w] <= bounds[2 * w + 1]))
@@ -440,33 +474,19 @@ inline LeafGrid ChooseLeafGrid(const Lattice& l, const double bounds[6], int max
       return grid;
     }
   }
-  if (!aligned)
+  if (leaf.Leaf <= 0.0)
   {
-    leaf = std::sqrt(diagonal2);
+    return grid;
   }
   for (int w = 0; w < 3; ++w)
   {
-    const double lo = bounds[2 * w];
-    // Leaf centres on the lattice's planes along this axis (the cube's
-    // corner half a leaf before a lattice point, whole leaves before the
-    // lowest bound); elsewhere the bounds centred in a leaf.
-    double corner = lo - 0.5 * leaf;
-    if (aligned && alongWorld[w] >= 0)
-    {
-      const double phase = l.Origin[w] - 0.5 * leaf;
-      corner = phase - leaf * std::ceil((phase - lo) / leaf);
-      if (corner > lo) // rounding
-      {
-        corner -= leaf;
-      }
-    }
-    grid.Origin[w] = corner;
+    grid.Origin[w] = detail::CubeCorner(l, leaf, bounds, w);
   }
   for (int depth = 1; depth <= maxDepth; ++depth)
   {
     // The cube's side, leaf * 2^depth, must hold every bound strictly
     // inside, with room for rounding (as RootCube::FromBounds pads by 2^-20).
-    const double size = std::ldexp(leaf, depth);
+    const double size = std::ldexp(leaf.Leaf, depth);
     bool inside = true;
     for (int w = 0; w < 3; ++w)
     {
