@@ -719,13 +719,10 @@ int main(int argc, char** argv)
   }
 }
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_cuda [--json out.json] [--small] [--only all|build|render] [--billion N] "
-    "[--profile-build N]\n");
-}
+    "[--profile-build N]\n";
 
 // Two builds of n points at depth 10 and nothing else, for a profiler's
 // list of the build's kernels; the first fills the allocator's pool.
@@ -1007,13 +1004,9 @@ int Run(int argc, char** argv)
     .Choice("--only", only, { "all", "build", "render" })
     .Count("--billion", billion)
     .Count("--profile-build", profileBuild);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
-  }
-  if (!options.Parse(argc, argv))
-  {
-    return Usage();
+    return *stop;
   }
   const std::vector<std::size_t> sizes =
     small ? std::vector<std::size_t>{ 1000000, 10000000 } : std::vector<std::size_t>{ 1000000, 10000000, 100000000 };

@@ -26,13 +26,10 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_build [--points N[,N...]] [--sets uniform,clustered,narrow] [--depth L (0: automatic)]\n"
-    "                           [--backend cpu|cuda|all] [--threads N] [--repeats R] [--json PATH]\n");
-}
+    "                           [--backend cpu|cuda|all] [--threads N] [--repeats R] [--json PATH]\n";
 
 
 // The clusters' spread of a clustered set: "narrow" clusters, a two-hundredth
@@ -154,13 +151,9 @@ int main(int argc, char** argv)
     .Integer("--threads", threads, 1)
     .Integer("--repeats", repeats, 1)
     .Text("--json", json);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
-  }
-  if (!options.Parse(argc, argv))
-  {
-    return Usage();
+    return *stop;
   }
 
   std::string why;

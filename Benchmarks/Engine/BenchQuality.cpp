@@ -71,14 +71,11 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_quality [--backend cpu|cuda|all] [--scenes DIR] [--lidar PATH]\n"
     "                             [--only ct5n,lidar,spheres] [--size WxH] [--repeats R]\n"
-    "                             [--threads N] [--sphere-points N] [--json FILE] [--dump DIR]\n");
-}
+    "                             [--threads N] [--sphere-points N] [--json FILE] [--dump DIR]\n";
 
 struct Scene
 {
@@ -504,13 +501,9 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Text("--json", json)
     .Text("--dump", dump);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
-  }
-  if (!options.Parse(argc, argv))
-  {
-    return Usage();
+    return *stop;
   }
   // Quarter-size pictures repeat each pixel 4x4 times onto the full size,
   // and SSIM's window needs 11 pixels.

@@ -38,13 +38,10 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_quantisation [--backend cpu|cuda] [--depths FIRST-LAST] [--ct PATH] [--lidar PATH]\n"
-    "                                  [--sphere-points N] [--repeats R] [--json PATH]\n");
-}
+    "                                  [--sphere-points N] [--repeats R] [--json PATH]\n";
 
 struct Scene
 {
@@ -71,12 +68,10 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Integer("--repeats", repeats, 1)
     .Text("--json", json);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
+    return *stop;
   }
-  if (!options.Parse(argc, argv))
-    return Usage();
 
   try
   {

@@ -43,13 +43,10 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_render [--size WxH] [--repeats R] [--threads N] [--backend cpu|cuda|all]\n"
-    "                            [--lidar PATH] [--sphere-points N] [--parts modes,off] [--json PATH]\n");
-}
+    "                            [--lidar PATH] [--sphere-points N] [--parts modes,off] [--json PATH]\n";
 
 using Mode = NamedRenderMode;
 const auto& kModes = kRenderModes;
@@ -219,12 +216,10 @@ int main(int argc, char** argv)
     .Count("--sphere-points", spherePoints)
     .Text("--parts", parts)
     .Text("--json", json);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
+    return *stop;
   }
-  if (!options.Parse(argc, argv))
-    return Usage();
   parts = "," + parts + ",";
   const auto wanted = [&](const char* part) { return parts.find(std::string(",") + part + ",") != std::string::npos; };
 

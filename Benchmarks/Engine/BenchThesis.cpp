@@ -28,12 +28,9 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
-    "usage: octoray_bench_thesis [--backend cpu|cuda] [--repeats R] [--sphere-points N] [--json PATH]\n");
-}
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
+    "usage: octoray_bench_thesis [--backend cpu|cuda] [--repeats R] [--sphere-points N] [--json PATH]\n";
 
 // A build's record: its median, fastest time, memory and nodes (depth 7, the
 // thesis's).
@@ -88,12 +85,10 @@ int main(int argc, char** argv)
     .Integer("--repeats", repeats, 1)
     .Count("--sphere-points", spherePoints)
     .Text("--json", json);
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = options.ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
+    return *stop;
   }
-  if (!options.Parse(argc, argv))
-    return Usage();
 
   try
   {

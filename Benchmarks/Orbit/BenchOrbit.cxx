@@ -826,19 +826,13 @@ int main(int argc, char* argv[])
   });
   cli.Integer("--frames", o.Frames, 3).Real("--seconds", o.Seconds).Text("--json", o.Json).Text("--images", o.Images);
   cli.Real("--max-prepare", o.MaxPrepare).Real("--tile", o.Tile).Integer("--tile-depth", o.TileDepth, 1);
-  const auto usage = [](std::FILE* to) {
-    return octoray::CommandLine::PrintUsage(to,
-      "usage: octoray_bench_orbit [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points]\n"
-      "                           [--file particles.txt|cloud.pcd] [--frames 60] [--seconds 6] [--max-prepare 90]\n"
-      "                           [--json out.json] [--images DIR] [--tile N [--tile-depth 12]]\n");
-  };
-  if (octoray::CommandLine::AsksForHelp(argc, argv))
+  const char* usage =
+    "usage: octoray_bench_orbit [--points 1e6,1e7] [--sizes 1920x1080] [--methods octoray,points]\n"
+    "                           [--file particles.txt|cloud.pcd] [--frames 60] [--seconds 6] [--max-prepare 90]\n"
+    "                           [--json out.json] [--images DIR] [--tile N [--tile-depth 12]]\n";
+  if (const std::optional<int> stop = cli.ParseOrStop(argc, argv, usage))
   {
-    return usage(stdout);
-  }
-  if (!cli.Parse(argc, argv))
-  {
-    return usage(stderr);
+    return *stop;
   }
   if (!vtkOctreeVolumeMapper::IsCudaAvailable())
   {

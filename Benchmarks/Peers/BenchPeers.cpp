@@ -48,14 +48,11 @@ namespace
 using namespace octoray;
 using namespace octoray::bench;
 
-// The usage, on `to`; the exit status.
-int Usage(std::FILE* to = stderr)
-{
-  return CommandLine::PrintUsage(to,
+// The usage, printed for --help or -h and after a wrong argument.
+constexpr const char* kUsage =
     "usage: octoray_bench_peers [--cases SET:N[,SET:N...]] [--depth L (0: automatic)] [--threads N]\n"
     "                           [--repeats R] [--peer-repeats R] [--octree-locator-max N] [--json PATH]\n"
-    "  SET is uniform or clustered; N may be written 1e7\n");
-}
+    "  SET is uniform or clustered; N may be written 1e7\n";
 
 struct Case
 {
@@ -446,13 +443,9 @@ void RunCase(const Case& c, const Settings& s, std::vector<Record>& records)
 int main(int argc, char** argv)
 {
   Settings s;
-  if (CommandLine::AsksForHelp(argc, argv))
+  if (const std::optional<int> stop = OptionsOf(s).ParseOrStop(argc, argv, kUsage))
   {
-    return Usage(stdout);
-  }
-  if (!OptionsOf(s).Parse(argc, argv))
-  {
-    return Usage();
+    return *stop;
   }
   std::printf("octoray_bench_peers: octoray median of %d fresh builds after 1 warm-up; PCL and VTK median of %d "
               "fresh builds, no warm-up (10 M PCL builds take seconds each; vtkOctreePointLocator: 1 build from 5 M "

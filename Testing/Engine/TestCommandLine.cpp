@@ -95,4 +95,19 @@ TEST(CommandLine, HelpAnywhereGoesToStdoutWithStatusZero)
   EXPECT_EQ(CommandLine::PrintUsage(stderr, "usage: octoray_bench\n"), 2);
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "usage: octoray_bench\n");
 }
+
+TEST(CommandLine, ParseOrStopGoesOnOrGivesTheExitStatus)
+{
+  Options o;
+  Args good({ "--depth", "12" }), help({ "--depth", "12", "--help" }), wrong({ "--depth", "x" });
+  EXPECT_FALSE(o.line.ParseOrStop(good.argc(), good.argv(), "usage\n").has_value());
+  EXPECT_EQ(o.depth, 12);
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(o.line.ParseOrStop(help.argc(), help.argv(), "usage\n"), 0);
+  EXPECT_EQ(testing::internal::GetCapturedStdout(), "usage\n");
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(o.line.ParseOrStop(wrong.argc(), wrong.argv(), "usage\n"), 2);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(),
+    "octoray_bench: --depth expects a whole number from 0 to 21, not 'x'\nusage\n");
+}
 }

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -155,6 +156,23 @@ public:
       std::fprintf(stderr, "%s: %s\n", ProgramName(argv[0]).c_str(), error.c_str());
     }
     return error.empty();
+  }
+
+  // Parses a program's whole command line, argv[1..argc): nothing where the
+  // program goes on; else the exit status it stops with, 0 after `usage` on
+  // stdout where --help or -h asks for it, 2 after the message for what is
+  // wrong and `usage` on stderr.
+  std::optional<int> ParseOrStop(int argc, char** argv, const char* usage) const
+  {
+    if (AsksForHelp(argc, argv))
+    {
+      return PrintUsage(stdout, usage);
+    }
+    if (!Parse(argc, argv))
+    {
+      return PrintUsage(stderr, usage);
+    }
+    return std::nullopt;
   }
 
   // What is wrong with argv[first..argc), or "" where every argument parses.
