@@ -1,7 +1,7 @@
 // What the module's two text formats, particle text and PCD, share: which
-// bytes are blanks, and how a message names a place and shows a token. VTK-free,
-// like the format headers that include it (the fuzz targets call them
-// without VTK). Private to the module; not wrapped.
+// bytes are blanks, and how a message names a place and shows a token.
+// VTK-free, like the format headers that include it (the fuzz targets call
+// them without VTK). Private to the module; not wrapped.
 #ifndef octorayTextScan_h
 #define octorayTextScan_h
 
