@@ -375,10 +375,20 @@ void vtkOctreeVolumeRepresentation::UpdateMapperParameters()
   }
   this->Mapper->SelectScalarArray(colorArrayName);
   // The octree holds point attributes only (the mapper warns about cell
-  // scalars); no array means the voxels' own colours or white.
-  this->Mapper->SetScalarMode(fieldAssociation == vtkDataObject::FIELD_ASSOCIATION_CELLS
-      ? VTK_SCALAR_MODE_USE_CELL_FIELD_DATA
-      : VTK_SCALAR_MODE_USE_POINT_FIELD_DATA);
+  // scalars); no array means the voxels' own colours or white. A CT preset
+  // maps the data's values: with no array chosen (Solid Color) it maps the
+  // active point scalars, as choosing the preset asks.
+  const bool solidColor = !colorArrayName || !*colorArrayName;
+  if (solidColor && !this->Preset.empty())
+  {
+    this->Mapper->SetScalarModeToDefault();
+  }
+  else
+  {
+    this->Mapper->SetScalarMode(fieldAssociation == vtkDataObject::FIELD_ASSOCIATION_CELLS
+        ? VTK_SCALAR_MODE_USE_CELL_FIELD_DATA
+        : VTK_SCALAR_MODE_USE_POINT_FIELD_DATA);
+  }
 
   // As ParaView's Volume representation: "Map Scalars" off (or
   // multi-component mapping) makes 3/4-component arrays direct colours.

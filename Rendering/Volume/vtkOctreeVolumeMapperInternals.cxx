@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <sstream>
 #include <vector>
 
 namespace
@@ -149,6 +150,31 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::U
 }
 
 //------------------------------------------------------------------------------
+// An image none of whose voxels is above the background: why, once for an
+// input (every frame tries it again).
+void vtkOctreeVolumeMapper::vtkInternals::WarnNothingToDraw(const vtkOctreeInputHelper::Request& request)
+{
+  std::ostringstream why;
+  if (!request.Scalars)
+  {
+    why << "The image has no point scalars selected, so every voxel counts as 1, at or below the background "
+        << request.ImageBackground << "; nothing to draw. Select a point array (SelectScalarArray; in "
+        << "ParaView, the Coloring array).";
+  }
+  else
+  {
+    why << "Every voxel of the image is at or below the background " << request.ImageBackground
+        << "; nothing to draw.";
+  }
+  if (why.str() != this->EmptyWarning || request.Input->GetMTime() != this->EmptyWarningMTime)
+  {
+    this->EmptyWarning = why.str();
+    this->EmptyWarningMTime = request.Input->GetMTime();
+    vtkWarningWithObjectMacro(this->Self, << this->EmptyWarning);
+  }
+}
+
+//------------------------------------------------------------------------------
 vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::Build(
   const vtkOctreeInputHelper::Request& request)
 {
@@ -160,8 +186,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     this->Input.PointCloud(request, [self](double progress) { self->UpdateProgress(progress); });
   if (view.count == 0)
   {
-    vtkWarningWithObjectMacro(self, "Every voxel of the image is at or below the background "
-        << request.ImageBackground << "; nothing to draw.");
+    this->WarnNothingToDraw(request);
     return Step::Stop;
   }
   self->UpdateProgress(0.5);

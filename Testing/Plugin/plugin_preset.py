@@ -8,7 +8,9 @@ of Data/External (the reader's image output):
   map, opacity function and the ImageBackground set in the panel;
 - the pictures: bone-coloured (red > green > blue) with ct-bone, different
   from the picture without a preset;
-- an unknown name is an error and leaves no preset.
+- an unknown name is an error and leaves no preset;
+- a preset on a display left at Solid Color maps the image's active
+  scalars: ct-bone's picture.
 
 usage: plugin_preset.py PLUGIN DATA_DIR OUTPUT_DIR
 """
@@ -116,5 +118,13 @@ check("an unknown name leaves no preset: the panel's ImageBackground",
       mapper.GetImageBackground() == 100.0)
 check("an unknown name leaves no preset: ParaView's colour map",
       actor.GetProperty().GetRGBTransferFunction(0) is paraview_colour)
+
+# As the README writes it: the preset on a display left at Solid Color maps
+# the image's active scalars (the picture is ct-bone's, not empty).
+ColorBy(display, None)
+display.Preset = "ct-bone"
+solid = picture("preset_ct-bone_solid_color.png")
+check("ct-bone with Solid Color draws ct-bone's picture (%.2f %% of the pixels off by more than 32)"
+      % (100 * (abs(solid - bone).max(axis=1) > 32).mean()), (abs(solid - bone).max(axis=1) > 32).mean() < 0.01)
 
 finish()

@@ -9,7 +9,9 @@ python, vtk; run under a display by ctest):
 - with RootBounds around the voxel centres (what parallel ranks set) the
   build succeeds;
 - gradient normals (ImageGradientNormals): a sphere's shading follows the
-  sphere (Lambert's law), not the voxels.
+  sphere (Lambert's law), not the voxels;
+- an image with nothing above ImageBackground says why (its values, or no
+  scalars selected) once for an input, not at every frame.
 """
 import numpy as np
 import pytest
@@ -172,3 +174,46 @@ def test_gradient_normals_follow_the_sphere():
     # Off, the normals come from the octree's occupancy: blockier.
     off_correlation, off_error = lambert_profile(False)
     assert off_error > 2 * error, (off_error, error)
+
+
+
+@pytest.mark.parametrize("select,expected", [
+    (None, "Every voxel of the image is at or below the background 5; nothing to draw."),
+    ("NoSuchArray", "The image has no point scalars selected, so every voxel counts as 1, at or below the "
+     "background 5; nothing to draw. Select a point array"),
+])
+def test_nothing_to_draw_is_said_once_with_its_reason(select, expected):
+    """An image with no voxel above ImageBackground draws nothing and says
+    why (its values, or no scalars selected) once for that input, not at
+    every frame; a modified input is said again."""
+    data = image(np.ones((4, 4, 4)), (1.0, 1.0, 1.0))
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(data)
+    mapper.SetImageBackground(5)
+    if select:
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectScalarArray(select)
+    said = []
+
+    def observe(caller, event, text):
+        said.append(text)
+    observe.CallDataType = vtk.VTK_STRING
+    mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetProperty(vtk.vtkVolumeProperty())
+    ren = vtk.vtkRenderer()
+    ren.AddVolume(volume)
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(32, 32)
+    window.AddRenderer(ren)
+    ren.ResetCamera()
+    for azimuth in (0, 10, 20):
+        ren.GetActiveCamera().Azimuth(azimuth)
+        window.Render()
+    assert len(said) == 1 and expected in said[0], said
+    data.Modified()
+    window.Render()
+    window.Render()
+    assert len(said) == 2 and expected in said[1], said
