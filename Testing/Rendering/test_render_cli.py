@@ -103,6 +103,27 @@ def test_missing_input_is_an_error(tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
+def test_bad_line_is_named_once(tmp_path):
+    """A file the reader refuses: the reader's message, with file, line and
+    column, as the last line; no VTK pipeline report."""
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1 2 3\n4 abc 6\n")
+    r = run(str(bad), "-o", str(tmp_path / "x.png"), "--backend", "cpu")
+    assert r.returncode == 1
+    assert r.stderr.splitlines()[-1] == "error: %s:2:3: expected a number for column 2 (y), found 'abc'" % bad
+    assert "vtkExecutive" not in r.stderr, r.stderr
+    assert r.stderr.count("reading") == 1, r.stderr  # into a pipe the bar is written once, not redrawn
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_unwritable_picture_is_an_error(tmp_path):
+    out = tmp_path / "no-such-folder" / "x.png"
+    r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "64x48")
+    assert r.returncode == 1
+    assert "error: %s: cannot write the picture: no folder %s" % (out, out.parent) in r.stderr
+    assert "wrote" not in r.stdout
+
+
 def test_render_pcd(tmp_path):
     """A .pcd file goes to vtkPCDReader: a binary PCD of a coloured 20 x 20
     grid written here."""

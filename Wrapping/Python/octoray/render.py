@@ -136,7 +136,8 @@ def main(argv=None):
     if args.particles:
         data = reader.GetOutput()
     if data is None or data.GetNumberOfPoints() == 0:
-        print("error: nothing read from %s" % args.input, file=sys.stderr)
+        why = reader.GetErrorMessage() if hasattr(reader, "GetErrorMessage") else ""
+        print("error: %s" % (why or "nothing read from %s" % args.input), file=sys.stderr)
         return 1
     image = isinstance(data, vtk.vtkImageData)
 
@@ -225,9 +226,14 @@ def main(argv=None):
     if mapper.GetLastUsedBackend() < 0:
         print("error: nothing was drawn (see the messages above)", file=sys.stderr)
         return 1
-    scene.write_png(scene.grab(window), args.output)
+    try:
+        scene.write_png(scene.grab(window), args.output)
+    except OSError as e:
+        print("error: %s" % e, file=sys.stderr)
+        return 1
 
-    print("backend: %s (%s)" % (mapper.GetLastUsedBackendName(), mapper.GetBackendDescription()))
+    no_cuda = args.backend == "auto" and not mapper.IsCudaAvailable()
+    print("backend: %s%s" % (mapper.GetBackendDescription(), ", no usable CUDA device" if no_cuda else ""))
     if image:
         d = data.GetDimensions()
         print("input: %d voxels (%d x %d x %d)" % (data.GetNumberOfPoints(), d[0], d[1], d[2]))

@@ -41,12 +41,15 @@ VIRIDIS = [
 
 
 class ProgressBar:
-    """A text progress bar on stderr, fed by an algorithm's ProgressEvent."""
+    """A text progress bar on stderr, fed by an algorithm's ProgressEvent.
+    On a terminal it is redrawn in place; into a file or a pipe only the
+    finished bar is written, one line, so that logs stay readable."""
 
     def __init__(self, label, stream=None):
         self.label = label
         self.shown = -1
         self.stream = stream or sys.stderr
+        self.live = self.stream.isatty()
 
     def __call__(self, algorithm, event):
         self.show(algorithm.GetProgress())
@@ -55,13 +58,21 @@ class ProgressBar:
         percent = int(100 * fraction)
         if self.shown >= 100:
             return  # one bar: the pipeline may report a step again
-        if percent != self.shown:
+        if percent != self.shown and (self.live or percent >= 100):
             self.shown = percent
             bar = "#" * (percent // 4)
-            self.stream.write("\r%-10s [%-25s] %3d%%" % (self.label, bar, percent))
+            self.stream.write("%s%-10s [%-25s] %3d%%" % ("\r" if self.live else "", self.label, bar, percent))
             if percent >= 100:
                 self.stream.write("\n")
             self.stream.flush()
+
+    def finish(self):
+        """Ends a bar left unfinished (a failed read), so that what is
+        written next starts on its own line."""
+        if 0 <= self.shown < 100:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.shown = 100
 
 
 class Timer:
@@ -103,14 +114,22 @@ def make_reader(path, file_range=(0, 0)):
 def read(path, file_range=(0, 0), progress_label="reading", stream=None, configure=None):
     """Reads `path` with a progress line; returns (reader, data, seconds).
     Slice stacks give the reader's image output (vtkImageData), the others
-    the points (vtkPolyData). `configure(reader)` is called before reading."""
+    the points (vtkPolyData). `configure(reader)` is called before reading.
+    A failed read prints nothing (not VTK's pipeline report either): where
+    nothing was read, the caller says reader.GetErrorMessage(), which names
+    the file and the line or slice. Warnings are printed as they come."""
     reader = make_reader(path, file_range)
+    for source in (reader, reader.GetExecutive()):
+        source.AddObserver("ErrorEvent", lambda caller, event: None)
     if configure:
         configure(reader)
-    if progress_label:
-        reader.AddObserver("ProgressEvent", ProgressBar(progress_label, stream))
+    bar = ProgressBar(progress_label, stream) if progress_label else None
+    if bar:
+        reader.AddObserver("ProgressEvent", bar)
     with Timer() as t:
         reader.Update()
+    if bar:
+        bar.finish()
     data = reader.GetImageOutput() if isinstance(reader, octoray.vtkSliceStackReader) else reader.GetOutput()
     return reader, data, t.seconds
 
@@ -358,11 +377,17 @@ def grab(window):
 
 
 def write_png(image, path):
+    """Writes the picture; OSError naming the file where it cannot."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OSError("%s: cannot write the picture: no folder %s" % (path, folder))
     w = vtk.vtkPNGWriter()
     w.SetFileName(path)
     w.SetCompressionLevel(9)
     w.SetInputData(image)
     w.Write()
+    if w.GetErrorCode() != 0:
+        raise OSError("%s: cannot write the picture (see VTK's message above)" % path)
 
 
 def side_by_side(images):
