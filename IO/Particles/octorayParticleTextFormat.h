@@ -354,10 +354,16 @@ inline bool ReadPrologueLine(Prologue& r, const char* data, const char* p, const
 }
 
 // Reads the prologue; its Error names the file, line and column of what is
-// wrong, or says that no data line follows it.
+// wrong, or says that the file is empty or that no data line follows.
 inline Prologue ParsePrologue(const char* data, size_t size, const std::string& file)
 {
   Prologue r;
+  if (size == 0)
+  {
+    r.Error = file + ": the file is empty (0 bytes); expected one particle a line: x y z [r g b [reflectivity "
+                     "refraction]]";
+    return r;
+  }
   const char* const end = data + size;
   long long lineNo = 0;
   for (const char* p = data; p < end && r.FirstDataLine == 0;)

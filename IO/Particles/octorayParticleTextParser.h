@@ -78,13 +78,6 @@ public:
 
   Outcome Parse(const char* data, size_t size, vtkPolyData* output)
   {
-    if (size == 0)
-    {
-      this->Result.Error = this->Settings.File +
-        ": the file is empty (0 bytes); expected one particle a line: x y z [r g b "
-        "[reflectivity refraction]]";
-      return Outcome::Failed;
-    }
     this->Data = data;
     this->End = data + size;
     if (!this->ReadPrologue())

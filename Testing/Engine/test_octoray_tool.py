@@ -3,9 +3,9 @@
 - bad arguments: exit status 2, a message naming the option, what it
   expects and what it got (or the missing value, or the missing -o), and
   no picture written;
-- a depth the engine refuses, a file that does not exist, a PCD file and a
-  gzip-compressed one: exit status 1 and the engine's or the loader's
-  message;
+- a depth the engine refuses, a file that does not exist, a folder, an
+  empty file, a PCD file and a gzip-compressed one: exit status 1 and the
+  engine's or the loader's message;
 - `stats`: the points counted as the file holds them, one root node, and
   the nodes per level adding up to the node count; a header line naming
   the columns, and a bad value named as vtkParticleTextReader names it;
@@ -109,6 +109,18 @@ class Failures(unittest.TestCase):
         status, _, err = run("stats", missing, "--backend", "cpu")
         self.assertEqual(status, 1)
         self.assertIn(missing + ": cannot open the file", err)
+
+    def test_folder_and_empty_file(self):
+        """A folder is named as one; an empty file gets the reader's message,
+        not a line 0."""
+        status, _, err = run("stats", WORK, "--backend", "cpu")
+        self.assertEqual(status, 1)
+        self.assertIn(WORK + ": a folder, not a particle file", err)
+        empty = os.path.join(WORK, "empty.txt")
+        open(empty, "w").close()
+        status, _, err = run("stats", empty, "--backend", "cpu")
+        self.assertEqual(status, 1)
+        self.assertIn(empty + ": the file is empty (0 bytes); expected one particle a line", err)
 
     def test_bad_line_as_the_reader_says(self):
         """A bad value is named by line, column and layout in

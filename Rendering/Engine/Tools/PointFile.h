@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -47,6 +48,11 @@ struct PointFile
   // Throws octoray::Error naming the file and line of the first bad line.
   static PointFile Load(const std::string& path)
   {
+    std::error_code notAFolder;
+    if (std::filesystem::is_directory(path, notAFolder))
+    {
+      throw Error(path + ": a folder, not a particle file (the VTK slice readers read folders of slices)");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in)
     {
