@@ -10,7 +10,8 @@
   the nodes per level adding up to the node count; a header line naming
   the columns, and a bad value named as vtkParticleTextReader names it;
 - `render` to a PPM file: the picture has the requested size, every pixel a
-  primary ray, and the points drawn (pixels off the background);
+  primary ray, and the points drawn (pixels off the background); points
+  all at one place show their voxel whole, inside the frame;
 - `--help`: the usage on stdout, exit status 0;
 - OnCuda (run alone as engine.tool.cuda, skipped where CUDA is not
   available): `stats` gives the CPU's octree level for level, and `render`
@@ -188,6 +189,23 @@ class Commands(unittest.TestCase):
         drawn = sum(1 for p in pixels if p != BACKGROUND)
         self.assertGreater(drawn, 0.05 * len(pixels))  # the tile fills about a third of the frame
         self.assertLess(drawn, len(pixels))
+
+    def test_points_at_one_place_show_their_voxel_whole(self):
+        """Points all at one place make a leaf with a corner at them: the
+        camera frames that voxel, seen whole from outside, not from inside
+        it or cut off by the frame."""
+        same = os.path.join(WORK, "same.txt")
+        with open(same, "w") as f:
+            f.write("1 2 3\n1 2 3\n1 2 3\n")
+        picture = os.path.join(WORK, "same.ppm")
+        status, _, err = run("render", same, "-o", picture, "--backend", "cpu", "--size", "80x60")
+        self.assertEqual(status, 0, err)
+        width, height, pixels = read_ppm(picture)
+        drawn = [i for i, p in enumerate(pixels) if p != BACKGROUND]
+        border = [i for i in drawn if i % width in (0, width - 1) or i // width in (0, height - 1)]
+        self.assertGreater(len(drawn), 0.1 * len(pixels))
+        self.assertLess(len(drawn), 0.6 * len(pixels))
+        self.assertEqual(border, [])
 
 
 def stats_lines(out):

@@ -303,8 +303,10 @@ struct RenderOptions
 // depth `depth`): the camera orbiting their bounding box's centre, whose
 // bounding sphere fills the vertical field of view at zoom 1, a sun for
 // the shadows, and an opacity for composite.
-octoray::RenderSettings SceneSettings(const RenderOptions& o, const octoray::PointCloudView& points, int depth)
+octoray::RenderSettings SceneSettings(const RenderOptions& o, const octoray::PointCloudView& points,
+  const octoray::BuildStats& built)
 {
+  const int depth = built.depth;
   octoray::RenderSettings s;
   s.width = o.width;
   s.height = o.height;
@@ -313,8 +315,18 @@ octoray::RenderSettings SceneSettings(const RenderOptions& o, const octoray::Poi
   s.shadows = o.shadows;
   s.shade = o.mode->shade;
   s.blend = o.mode->blend;
+  // The camera frames the leaves that hold the points, not the points
+  // alone: points at one place (whose leaf is an eighth of the root cube,
+  // with a corner at them) are seen from outside their voxel, whole.
   double lo[3], hi[3];
   octoray::Bounds(points, lo, hi);
+  const double leaf = std::ldexp(built.cube.size, -depth);
+  for (int k = 0; k < 3; ++k)
+  {
+    const double origin = built.cube.origin[k];
+    lo[k] = origin + leaf * std::floor((lo[k] - origin) / leaf);
+    hi[k] = origin + leaf * (std::floor((hi[k] - origin) / leaf) + 1);
+  }
   octoray::OrbitCamera camera;
   camera.azimuth = o.azimuth;
   camera.elevation = o.elevation;
@@ -369,7 +381,7 @@ int Render(int argc, char** argv)
     return Usage();
   }
   const Built b = LoadAndBuild(argv[2], o.engine);
-  const octoray::RenderSettings s = SceneSettings(o, b.file.View(), b.stats.depth);
+  const octoray::RenderSettings s = SceneSettings(o, b.file.View(), b.stats);
   octoray::Image image;
   b.engine->Render(s, image); // first frame: buffers, caches
   const octoray::RenderStats stats = b.engine->Render(s, image);
