@@ -105,7 +105,8 @@ Built LoadAndBuild(const std::string& path, const EngineOptions& o)
 // The lines both commands print first: the file and the backend.
 void PrintSource(const Built& b)
 {
-  std::printf("file            %s (%zu points, read in %.3f s)\n", b.path.c_str(), b.stats.points, b.loadSeconds);
+  std::printf("file            %s (%zu point%s, read in %.3f s)\n", b.path.c_str(), b.stats.points,
+    b.stats.points == 1 ? "" : "s", b.loadSeconds);
   std::printf("backend         %s%s%s\n", b.engine->Description().c_str(),
     b.cudaNotUsed.empty() ? "" : ", CUDA not used: ", b.cudaNotUsed.c_str());
 }

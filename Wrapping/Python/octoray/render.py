@@ -239,7 +239,7 @@ def main(argv=None):
         print("input: %d voxels (%d x %d x %d)" % (data.GetNumberOfPoints(), d[0], d[1], d[2]))
         print("threshold: %g (voxels at or below are empty)" % mapper.GetImageBackground())
     else:
-        print("input: %d points" % data.GetNumberOfPoints())
+        print("input: %d point%s" % (data.GetNumberOfPoints(), "" if data.GetNumberOfPoints() == 1 else "s"))
     print("points: %d (in the octree%s)" % (mapper.GetNumberOfOctreePoints(), ", of the image" if image else ""))
     print("depth: %d%s" % (mapper.GetOctreeDepth(), " (automatic)" if args.depth == 0 else ""))
     print("leaf: %.6g" % mapper.GetLeafSize())
