@@ -15,6 +15,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -342,6 +343,15 @@ inline bool ReadPrologueLine(Prologue& r, const char* data, const char* p, const
   }
   r.FirstData = static_cast<size_t>(p - data);
   r.FirstDataLine = lineNo;
+  const char* binary = FirstBinaryByte(q, e);
+  if (binary != e)
+  {
+    char byte[8];
+    std::snprintf(byte, sizeof(byte), "0x%02x", static_cast<unsigned char>(*binary));
+    r.Error = Where(file, lineNo, binary - p + 1) + "a byte " + byte +
+      ", which no particle line holds: a binary file (an image, a LAS file?), not particle text";
+    return false;
+  }
   if (!r.HaveHeader && !LayoutFromCount(tokens.size(), r.Columns))
   {
     r.Error = where +
@@ -366,7 +376,8 @@ inline Prologue ParsePrologue(const char* data, size_t size, const std::string& 
   }
   const char* const end = data + size;
   long long lineNo = 0;
-  for (const char* p = data; p < end && r.FirstDataLine == 0;)
+  // A UTF-8 byte order mark is not part of the first line.
+  for (const char* p = data + (StartsUtf8Mark(data, size) ? 3 : 0); p < end && r.FirstDataLine == 0;)
   {
     ++lineNo;
     const size_t look = std::min<size_t>(static_cast<size_t>(end - p), MaxPrologueLine + 1);
@@ -390,7 +401,7 @@ inline Prologue ParsePrologue(const char* data, size_t size, const std::string& 
   }
   if (r.FirstDataLine == 0)
   {
-    r.Error = Where(file, lineNo, 1) + "no particle lines in the file (only " +
+    r.Error = Where(file, std::max(lineNo, 1LL), 1) + "no particle lines in the file (only " +
       (r.HaveHeader ? "a header, " : "") + "comments or blank lines); expected lines of " +
       (r.HaveHeader ? r.Layout : std::string("x y z ..."));
     return r;

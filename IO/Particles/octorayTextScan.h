@@ -24,6 +24,29 @@ inline bool StartsGzip(const void* p, std::size_t n)
   return n >= 2 && b[0] == 0x1f && b[1] == 0x8b;
 }
 
+// Whether `n` bytes from p start with UTF-8's byte order mark, which
+// spreadsheets write before a "CSV UTF-8" file.
+inline bool StartsUtf8Mark(const void* p, std::size_t n)
+{
+  const unsigned char* b = static_cast<const unsigned char*>(p);
+  return n >= 3 && b[0] == 0xef && b[1] == 0xbb && b[2] == 0xbf;
+}
+
+// The first byte of [p, e) that no text line holds (a control byte other
+// than the blanks, or one past ASCII), or e.
+inline const char* FirstBinaryByte(const char* p, const char* e)
+{
+  for (; p < e; ++p)
+  {
+    const unsigned char c = static_cast<unsigned char>(*p);
+    if ((c < 0x20 && !IsBlank(*p)) || c >= 0x7f)
+    {
+      return p;
+    }
+  }
+  return e;
+}
+
 // The first byte of [p, e) that is no blank, or e.
 inline const char* SkipBlanks(const char* p, const char* e)
 {

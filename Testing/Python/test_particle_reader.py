@@ -178,6 +178,25 @@ def test_errors_strict(tmp_path, text, message):
     assert path in r.GetErrorMessage()
 
 
+def test_utf8_byte_order_mark(tmp_path):
+    """A spreadsheet's "CSV UTF-8" starts with a byte order mark: read past
+    it, header and all."""
+    path = write(tmp_path, "excel.csv", b"\xef\xbb\xbfx,y,z\r\n1,2,3\r\n4,5,6\r\n", "wb")
+    r, out, msgs = read(path)
+    assert not msgs.errors, msgs.errors
+    assert points(out).tolist() == [[1, 2, 3], [4, 5, 6]]
+
+
+def test_binary_file_is_named(tmp_path):
+    """A binary file (here a PNG's first bytes) is named for what it is, at
+    its first byte that no particle line holds."""
+    path = write(tmp_path, "picture.txt", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "wb")
+    r, out, msgs = read(path)
+    assert out.GetNumberOfPoints() == 0
+    assert r.GetErrorMessage() == (path + ":1:1: a byte 0x89, which no particle line holds: a binary file (an image, "
+                                   "a LAS file?), not particle text"), r.GetErrorMessage()
+
+
 def test_missing_file(tmp_path):
     path = os.path.join(str(tmp_path), "nope.txt")
     r, out, msgs = read(path)
