@@ -116,6 +116,20 @@ def test_bad_line_is_named_once(tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
+def test_points_at_one_place_show_their_voxel(tmp_path):
+    """The camera frames the voxels, not only the points: points all at one
+    place fill a leaf with a corner at them, seen whole inside the frame."""
+    same = tmp_path / "same.txt"
+    same.write_text("1 2 3\n1 2 3\n1 2 3\n")
+    out = tmp_path / "same.png"
+    r = run(str(same), "-o", str(out), "--backend", "cpu", "--size", "80x60")
+    assert r.returncode == 0, r.stderr
+    w, h, rgb = read_pixels(str(out))
+    drawn = rgb[:, :3].max(axis=1).reshape(h, w) > 0
+    assert 0.1 < drawn.mean() < 0.7, drawn.mean()
+    assert not (drawn[0].any() or drawn[-1].any() or drawn[:, 0].any() or drawn[:, -1].any())
+
+
 def test_unwritable_picture_is_an_error(tmp_path):
     out = tmp_path / "no-such-folder" / "x.png"
     r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "64x48")

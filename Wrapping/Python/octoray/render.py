@@ -215,7 +215,13 @@ def main(argv=None):
     window.SetSize(*args.size)
     window.AddRenderer(ren)
     front, up = scene.default_view(data, kind, reader)
-    bounds = scene.visible_bounds(data, mapper.GetImageBackground()) if image else data.GetBounds()
+    # Points: the voxels' bounds, which reach past the points by up to a
+    # leaf (points all at one place fill a leaf with a corner at them).
+    bounds = [0.0] * 6
+    if image:
+        bounds = scene.visible_bounds(data, mapper.GetImageBackground())
+    else:
+        mapper.GetVoxelBounds(bounds)
     scene.look_at(ren, bounds, front, up, args.azimuth, args.elevation, args.zoom)
     ren.GetActiveCamera().SetParallelProjection(args.parallel)
 
