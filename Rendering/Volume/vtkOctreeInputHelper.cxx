@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 namespace
@@ -240,6 +241,24 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
     }
   });
 }
+
+//------------------------------------------------------------------------------
+// A selected point array with fewer tuples than the input has points: the
+// engine reads one tuple a point, so the input is refused, naming the array.
+std::string ShortArray(const vtkOctreeInputHelper::Request& r)
+{
+  const vtkIdType points = r.Input->GetNumberOfPoints();
+  for (vtkDataArray* a : { r.Scalars, r.Reflectivity, r.Refraction, r.Normals })
+  {
+    if (a && a->GetNumberOfTuples() < points)
+    {
+      const std::string name = a->GetName() ? a->GetName() : "(unnamed)";
+      return "The point array '" + name + "' has " + std::to_string(a->GetNumberOfTuples()) + " tuples for " +
+        std::to_string(points) + " points; nothing to draw.";
+    }
+  }
+  return "";
+}
 }
 
 //------------------------------------------------------------------------------
@@ -289,6 +308,7 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   r.LeafDepth = mapper->GetLeafDepth();
   std::copy(mapper->GetRootBounds(), mapper->GetRootBounds() + 6, r.RootBounds.begin());
   r.EngineGeneration = engineGeneration;
+  r.Problem = ShortArray(r);
   return r;
 }
 
@@ -303,7 +323,9 @@ vtkOctreeInputHelper::Signature vtkOctreeInputHelper::Sign(const Request& r)
   auto* pointSet = vtkPointSet::SafeDownCast(r.Input);
   if (!pointSet)
   {
-    s.Layout += "+image:" + std::to_string(r.ImageBackground) + (r.FillBetweenSlices ? "+fill" : "") +
+    char background[32]; // exact: a change in the sixth decimal still rebuilds
+    std::snprintf(background, sizeof(background), "%a", r.ImageBackground);
+    s.Layout += std::string("+image:") + background + (r.FillBetweenSlices ? "+fill" : "") +
       (r.ImageGradientNormals ? "+gradient" : "");
   }
   s.Arrays = { Stamp(r.Scalars), Stamp(r.Reflectivity), Stamp(r.Refraction), Stamp(r.Normals), Stamp(r.Lattice) };

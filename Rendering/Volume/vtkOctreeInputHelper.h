@@ -64,6 +64,10 @@ public:
     int LeafDepth = 0;
     std::array<double, 6> RootBounds{};
     unsigned long EngineGeneration = 0; // a new engine holds no octree
+    // Why the input cannot be drawn as it is (a selected point array with
+    // fewer tuples than points, which the engine would read past); "" where
+    // it can.
+    std::string Problem;
   };
 
   /**

@@ -119,6 +119,11 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
     this->CellScalarsWarned = true;
     vtkWarningWithObjectMacro(this->Self, "Cell scalars are not supported; the points are drawn without them.");
   }
+  if (!request.Problem.empty())
+  {
+    this->WarnOncePerInput(input, request.Problem);
+    return Step::Stop;
+  }
   switch (this->Input.Compare(request))
   {
     case vtkOctreeInputHelper::Change::None:
@@ -150,8 +155,20 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::U
 }
 
 //------------------------------------------------------------------------------
-// An image none of whose voxels is above the background: why, once for an
-// input (every frame tries it again).
+// A warning about the input that stops the frame, said once for an input:
+// every frame tries the input again.
+void vtkOctreeVolumeMapper::vtkInternals::WarnOncePerInput(vtkDataSet* input, const std::string& message)
+{
+  if (message != this->InputWarning || input->GetMTime() != this->InputWarningMTime)
+  {
+    this->InputWarning = message;
+    this->InputWarningMTime = input->GetMTime();
+    vtkWarningWithObjectMacro(this->Self, << message);
+  }
+}
+
+//------------------------------------------------------------------------------
+// An image none of whose voxels is above the background: why.
 void vtkOctreeVolumeMapper::vtkInternals::WarnNothingToDraw(const vtkOctreeInputHelper::Request& request)
 {
   std::ostringstream why;
@@ -166,12 +183,7 @@ void vtkOctreeVolumeMapper::vtkInternals::WarnNothingToDraw(const vtkOctreeInput
     why << "Every voxel of the image is at or below the background " << request.ImageBackground
         << "; nothing to draw.";
   }
-  if (why.str() != this->EmptyWarning || request.Input->GetMTime() != this->EmptyWarningMTime)
-  {
-    this->EmptyWarning = why.str();
-    this->EmptyWarningMTime = request.Input->GetMTime();
-    vtkWarningWithObjectMacro(this->Self, << this->EmptyWarning);
-  }
+  this->WarnOncePerInput(request.Input, why.str());
 }
 
 //------------------------------------------------------------------------------

@@ -63,6 +63,7 @@ public:
   template <typename Call>
   Step Run(const char* what, Call&& call);
   Step Report(vtkOctreeBackend::Status status);
+  void WarnOncePerInput(vtkDataSet* input, const std::string& message);
   void WarnNothingToDraw(const vtkOctreeInputHelper::Request& request);
 
   vtkOctreeVolumeMapper* Self;
@@ -78,10 +79,10 @@ public:
   vtkMTimeType BuiltMTime = 0;
   bool BuiltWithPoints = false; // KeepPointsForUpdates at the last build: Update can run
   bool CellScalarsWarned = false;
-  // The last "nothing to draw" warning and the input it was for: said once
-  // for an input, not at every frame that finds it empty again.
-  std::string EmptyWarning;
-  vtkMTimeType EmptyWarningMTime = 0;
+  // The last warning that stopped a frame and the input it was for
+  // (WarnOncePerInput): said once for an input, not at every frame.
+  std::string InputWarning;
+  vtkMTimeType InputWarningMTime = 0;
   bool InteropUnusable = false; // said once; the host path from then on
 
   // The last picture and what it was traced from.

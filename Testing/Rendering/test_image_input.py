@@ -11,7 +11,9 @@ python, vtk; run under a display by ctest):
 - gradient normals (ImageGradientNormals): a sphere's shading follows the
   sphere (Lambert's law), not the voxels;
 - an image with nothing above ImageBackground says why (its values, or no
-  scalars selected) once for an input, not at every frame.
+  scalars selected) once for an input, not at every frame;
+- ImageBackground is compared exactly: a change in the seventh decimal
+  rebuilds.
 """
 import numpy as np
 import pytest
@@ -217,3 +219,21 @@ def test_nothing_to_draw_is_said_once_with_its_reason(select, expected):
     window.Render()
     window.Render()
     assert len(said) == 2 and expected in said[1], said
+
+
+def test_a_small_change_of_the_background_rebuilds():
+    """ImageBackground is compared exactly: a change in the seventh decimal
+    (a float image of densities) gives the octree of the new threshold."""
+    z, y, x = np.mgrid[:20, :20, :20]
+    values = np.maximum(0, 10 - np.sqrt((x - 9.5) ** 2 + (y - 9.5) ** 2 + (z - 9.5) ** 2)) * 1e-8
+    data = image(values, (1.0, 1.0, 1.0))
+
+    def configure(mapper):
+        mapper.SetImageBackground(1e-9)
+    mapper, window = render(data, configure=configure)
+    low = mapper.GetNumberOfOctreePoints()
+    mapper.SetImageBackground(5e-8)
+    window.Render()
+    assert mapper.GetNumberOfBuilds() == 2
+    assert mapper.GetNumberOfOctreePoints() == int((values > 5e-8).sum()) < low
+

@@ -40,6 +40,45 @@ def test_mappers_are_in_the_package():
     assert "LeafDepth: 7" in str(cpu)
 
 
+def test_a_short_point_array_is_refused_by_name():
+    """A point array with fewer tuples than points (the engine reads one a
+    point) is refused, once, naming the array; nothing is drawn, nothing
+    crashes."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+    cloud = vtk.vtkPolyData()
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.random.default_rng(1).random((20000, 3)), deep=1))
+    cloud.SetPoints(points)
+    short = vtk.vtkFloatArray()
+    short.SetName("Reflectivity")
+    short.SetNumberOfTuples(1)
+    cloud.GetPointData().AddArray(short)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    said = []
+
+    def observe(caller, event, text):
+        said.append(text)
+    observe.CallDataType = vtk.VTK_STRING
+    mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetProperty(vtk.vtkVolumeProperty())
+    ren = vtk.vtkRenderer()
+    ren.AddVolume(volume)
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(32, 32)
+    window.AddRenderer(ren)
+    ren.ResetCamera()
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1, said
+    assert "The point array 'Reflectivity' has 1 tuples for 20000 points; nothing to draw." in said[0], said
+    assert mapper.GetNumberOfBuilds() == 0
+
+
 def test_render_particles(tmp_path):
     out = tmp_path / "out.png"
     r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "160x120", "--mode", "phong",
