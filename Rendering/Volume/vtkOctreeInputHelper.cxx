@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 
 namespace
@@ -568,7 +569,18 @@ void vtkOctreeInputHelper::FindScalarRange(const octoray::PointCloudView& view)
   {
     return;
   }
-  const auto range = std::minmax_element(view.scalar, view.scalar + view.count);
-  this->Range[0] = *range.first;
-  this->Range[1] = *range.second;
+  // The finite values' range, as the engine codes them (NaN and infinities
+  // have codes of their own): one NaN or inf would leave the transfer
+  // function no range, or an infinite one.
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < view.count; ++i)
+  {
+    if (std::isfinite(view.scalar[i]))
+    {
+      lo = std::min<double>(lo, view.scalar[i]);
+      hi = std::max<double>(hi, view.scalar[i]);
+    }
+  }
+  this->Range[0] = lo <= hi ? lo : 0.0;
+  this->Range[1] = lo <= hi ? hi : 0.0;
 }

@@ -79,6 +79,48 @@ def test_a_short_point_array_is_refused_by_name():
     assert mapper.GetNumberOfBuilds() == 0
 
 
+def test_non_finite_scalars_leave_the_transfer_function_its_range():
+    """A NaN or an infinity among the scalars: the transfer function spans
+    the finite values (a NaN first failed the frame, an infinity turned the
+    cloud one colour)."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    rng = np.random.default_rng(2)
+    for bad in (float("nan"), float("inf")):
+        scalars = numpy_to_vtk(rng.random(2000).astype(np.float32), deep=1)
+        scalars.SetValue(0, bad)
+        cloud = vtk.vtkPolyData()
+        points = vtk.vtkPoints()
+        points.SetData(numpy_to_vtk(rng.random((2000, 3)), deep=1))
+        cloud.SetPoints(points)
+        cloud.GetPointData().SetScalars(scalars)
+        mapper = octoray.vtkCPUOctreeVolumeMapper()
+        mapper.SetInputData(cloud)
+        prop = vtk.vtkVolumeProperty()
+        ramp = vtk.vtkColorTransferFunction()
+        ramp.AddRGBPoint(0.0, 1, 0, 0)
+        ramp.AddRGBPoint(1.0, 0, 0, 1)
+        prop.SetColor(ramp)
+        volume = vtk.vtkVolume()
+        volume.SetMapper(mapper)
+        volume.SetProperty(prop)
+        ren = vtk.vtkRenderer()
+        ren.AddVolume(volume)
+        window = vtk.vtkRenderWindow()
+        window.SetOffScreenRendering(1)
+        window.SetSize(64, 64)
+        window.AddRenderer(ren)
+        ren.ResetCamera()
+        window.Render()
+        grab = vtk.vtkWindowToImageFilter()
+        grab.SetInput(window)
+        grab.Update()
+        rgb = vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
+        reddish = ((rgb[:, 0] > 2 * rgb[:, 2]) & (rgb[:, 0] > 60)).mean()
+        bluish = ((rgb[:, 2] > 2 * rgb[:, 0]) & (rgb[:, 2] > 60)).mean()
+        assert reddish > 0.02 and bluish > 0.02, (bad, reddish, bluish)
+
+
 def test_render_particles(tmp_path):
     out = tmp_path / "out.png"
     r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "160x120", "--mode", "phong",
