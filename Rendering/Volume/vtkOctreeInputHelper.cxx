@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 namespace
 {
@@ -260,6 +261,39 @@ std::string ShortArray(const vtkOctreeInputHelper::Request& r)
   }
   return "";
 }
+
+//------------------------------------------------------------------------------
+// RootBounds that are set (min <= max) must be finite, have a size and hold
+// the input's bounds; "" where they do or are not set.
+std::string RootBoundsProblem(const vtkOctreeInputHelper::Request& r)
+{
+  const std::array<double, 6>& b = r.RootBounds;
+  if (b[0] > b[1] || b[2] > b[3] || b[4] > b[5])
+  {
+    return ""; // not set: the cube is fitted to the points
+  }
+  auto text = [](const double* v) {
+    std::ostringstream t;
+    t << "(" << v[0] << ", " << v[1] << ", " << v[2] << ", " << v[3] << ", " << v[4] << ", " << v[5] << ")";
+    return t.str();
+  };
+  const bool finite = std::all_of(b.begin(), b.end(), [](double v) { return std::isfinite(v); });
+  if (!finite || std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] }) <= 0.0)
+  {
+    return "RootBounds " + text(b.data()) + " must be finite and wider than a point; nothing to draw.";
+  }
+  double in[6];
+  r.Input->GetBounds(in);
+  for (int a = 0; a < 3; ++a)
+  {
+    if (in[2 * a] < b[2 * a] || in[2 * a + 1] > b[2 * a + 1])
+    {
+      return "RootBounds " + text(b.data()) + " do not hold the input's bounds " + text(in) +
+        "; nothing to draw.";
+    }
+  }
+  return "";
+}
 }
 
 //------------------------------------------------------------------------------
@@ -310,6 +344,10 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   std::copy(mapper->GetRootBounds(), mapper->GetRootBounds() + 6, r.RootBounds.begin());
   r.EngineGeneration = engineGeneration;
   r.Problem = ShortArray(r);
+  if (r.Problem.empty())
+  {
+    r.Problem = RootBoundsProblem(r);
+  }
   return r;
 }
 
@@ -368,6 +406,18 @@ void vtkOctreeInputHelper::Remember(const Request& request)
 {
   this->Current = Sign(request);
   this->Built = true;
+  this->Failed = false;
+}
+
+void vtkOctreeInputHelper::RememberFailure(const Request& request)
+{
+  this->FailedBuild = Sign(request);
+  this->Failed = true;
+}
+
+bool vtkOctreeInputHelper::FailedBefore(const Request& request) const
+{
+  return this->Failed && Sign(request) == this->FailedBuild;
 }
 
 //------------------------------------------------------------------------------

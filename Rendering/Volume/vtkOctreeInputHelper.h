@@ -103,6 +103,14 @@ public:
   void Forget() { this->Built = false; }
 
   /**
+   * A build of `request` failed (its error said): FailedBefore() is true
+   * for the same input and settings, so that frames do not build it again
+   * and repeat the error, until something changes.
+   */
+  void RememberFailure(const Request& request);
+  bool FailedBefore(const Request& request) const;
+
+  /**
    * The lattice the points of the last PointCloud() lie on, and their
    * bounds: false when they lie on none (scattered points, a point set
    * without the field-data array, or one whose points left the lattice).
@@ -136,6 +144,7 @@ private:
     std::array<double, 6> RootBounds{};
     unsigned long EngineGeneration = 0;
     bool SameExceptPoints(const Signature& o) const;
+    bool operator==(const Signature& o) const { return this->SameExceptPoints(o) && this->Points == o.Points; }
   };
   static Signature Sign(const Request& request);
 
@@ -145,6 +154,8 @@ private:
 
   bool Built = false;
   Signature Current;
+  bool Failed = false;
+  Signature FailedBuild;
   bool HasLattice = false;
   octoray::lattice::Lattice Lattice;
   double LatticeBounds[6] = { 0, 0, 0, 0, 0, 0 };

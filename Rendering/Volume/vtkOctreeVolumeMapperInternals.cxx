@@ -124,6 +124,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
     this->WarnOncePerInput(input, request.Problem);
     return Step::Stop;
   }
+  if (this->Input.FailedBefore(request))
+  {
+    return Step::Stop; // its error was said at the failed build
+  }
   switch (this->Input.Compare(request))
   {
     case vtkOctreeInputHelper::Change::None:
@@ -251,6 +255,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     ++this->OctreeVersion;
     ++self->NumberOfBuilds;
     self->LastBuildSeconds = Now() - start;
+  }
+  else if (step == Step::Stop)
+  {
+    this->Input.RememberFailure(request);
   }
   self->UpdateProgress(1.0);
   return step;

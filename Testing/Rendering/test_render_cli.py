@@ -40,28 +40,17 @@ def test_mappers_are_in_the_package():
     assert "LeafDepth: 7" in str(cpu)
 
 
-def test_a_short_point_array_is_refused_by_name():
-    """A point array with fewer tuples than points (the engine reads one a
-    point) is refused, once, naming the array; nothing is drawn, nothing
-    crashes."""
+def offscreen_view(mapper, size=(32, 32)):
+    """A window drawing `mapper`'s volume, with the mapper's warnings and
+    errors gathered: (window, [texts])."""
     import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
-    cloud = vtk.vtkPolyData()
-    points = vtk.vtkPoints()
-    points.SetData(numpy_to_vtk(np.random.default_rng(1).random((20000, 3)), deep=1))
-    cloud.SetPoints(points)
-    short = vtk.vtkFloatArray()
-    short.SetName("Reflectivity")
-    short.SetNumberOfTuples(1)
-    cloud.GetPointData().AddArray(short)
-    mapper = octoray.vtkCPUOctreeVolumeMapper()
-    mapper.SetInputData(cloud)
     said = []
 
     def observe(caller, event, text):
         said.append(text)
     observe.CallDataType = vtk.VTK_STRING
     mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
+    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(vtk.vtkVolumeProperty())
@@ -69,9 +58,66 @@ def test_a_short_point_array_is_refused_by_name():
     ren.AddVolume(volume)
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
-    window.SetSize(32, 32)
+    window.SetSize(*size)
     window.AddRenderer(ren)
     ren.ResetCamera()
+    return window, said
+
+
+def random_cloud(n, seed=1):
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+    cloud = vtk.vtkPolyData()
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.random.default_rng(seed).random((n, 3)), deep=1))
+    cloud.SetPoints(points)
+    return cloud
+
+
+def test_root_bounds_that_miss_the_points_are_named_once():
+    """RootBounds that do not hold the points: one warning naming them, no
+    build tried (it said 'point 0 lies outside the root cube' at every
+    frame)."""
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    mapper.SetRootBounds(0, 0.5, 0, 1, 0, 1)
+    window, said = offscreen_view(mapper)
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "RootBounds (0, 0.5, 0, 1, 0, 1) do not hold the input's bounds" in said[0], said
+    assert mapper.GetNumberOfBuilds() == 0
+
+
+def test_a_failed_build_is_said_once_until_the_input_changes():
+    """A build the engine refuses (a NaN coordinate) is not tried again at
+    every frame: one error, until the input changes."""
+    cloud = random_cloud(1000)
+    cloud.GetPoints().SetPoint(5, float("nan"), 0, 0)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper)
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "point 5 has a non-finite coordinate" in said[0], said
+    cloud.GetPoints().SetPoint(5, 0.5, 0.5, 0.5)
+    cloud.GetPoints().Modified()
+    window.Render()
+    assert len(said) == 1 and mapper.GetNumberOfBuilds() == 1
+
+
+def test_a_short_point_array_is_refused_by_name():
+    """A point array with fewer tuples than points (the engine reads one a
+    point) is refused, once, naming the array; nothing is drawn, nothing
+    crashes."""
+    import vtk
+    cloud = random_cloud(20000)
+    short = vtk.vtkFloatArray()
+    short.SetName("Reflectivity")
+    short.SetNumberOfTuples(1)
+    cloud.GetPointData().AddArray(short)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper)
     for _ in range(3):
         window.Render()
     assert len(said) == 1, said
@@ -87,30 +133,17 @@ def test_non_finite_scalars_leave_the_transfer_function_its_range():
     from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
     rng = np.random.default_rng(2)
     for bad in (float("nan"), float("inf")):
+        cloud = random_cloud(2000, seed=3)
         scalars = numpy_to_vtk(rng.random(2000).astype(np.float32), deep=1)
         scalars.SetValue(0, bad)
-        cloud = vtk.vtkPolyData()
-        points = vtk.vtkPoints()
-        points.SetData(numpy_to_vtk(rng.random((2000, 3)), deep=1))
-        cloud.SetPoints(points)
         cloud.GetPointData().SetScalars(scalars)
         mapper = octoray.vtkCPUOctreeVolumeMapper()
         mapper.SetInputData(cloud)
-        prop = vtk.vtkVolumeProperty()
+        window, said = offscreen_view(mapper, (64, 64))
         ramp = vtk.vtkColorTransferFunction()
         ramp.AddRGBPoint(0.0, 1, 0, 0)
         ramp.AddRGBPoint(1.0, 0, 0, 1)
-        prop.SetColor(ramp)
-        volume = vtk.vtkVolume()
-        volume.SetMapper(mapper)
-        volume.SetProperty(prop)
-        ren = vtk.vtkRenderer()
-        ren.AddVolume(volume)
-        window = vtk.vtkRenderWindow()
-        window.SetOffScreenRendering(1)
-        window.SetSize(64, 64)
-        window.AddRenderer(ren)
-        ren.ResetCamera()
+        window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty().SetColor(ramp)
         window.Render()
         grab = vtk.vtkWindowToImageFilter()
         grab.SetInput(window)
@@ -118,7 +151,7 @@ def test_non_finite_scalars_leave_the_transfer_function_its_range():
         rgb = vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
         reddish = ((rgb[:, 0] > 2 * rgb[:, 2]) & (rgb[:, 0] > 60)).mean()
         bluish = ((rgb[:, 2] > 2 * rgb[:, 0]) & (rgb[:, 2] > 60)).mean()
-        assert reddish > 0.02 and bluish > 0.02, (bad, reddish, bluish)
+        assert said == [] and reddish > 0.02 and bluish > 0.02, (bad, said, reddish, bluish)
 
 
 def test_render_particles(tmp_path):
