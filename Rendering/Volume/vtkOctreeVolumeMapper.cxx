@@ -13,6 +13,7 @@
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkRectilinearGrid.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 #include "vtkUnsignedCharArray.h"
@@ -115,6 +116,16 @@ void vtkOctreeVolumeMapper::SetInputData(vtkDataSet* input)
     return;
   }
   this->SetInputDataInternal(0, input);
+}
+
+void vtkOctreeVolumeMapper::SetInputData(vtkImageData* input)
+{
+  this->SetInputData(static_cast<vtkDataSet*>(input));
+}
+
+void vtkOctreeVolumeMapper::SetInputData(vtkRectilinearGrid* input)
+{
+  this->SetInputData(static_cast<vtkDataSet*>(input));
 }
 
 //------------------------------------------------------------------------------

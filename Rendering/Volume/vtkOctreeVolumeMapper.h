@@ -379,8 +379,9 @@ public:
    * The input: a vtkPointSet (e.g. vtkPolyData) or a vtkImageData.
    * (vtkVolumeMapper's own SetInputData accepts images only.)
    */
-  using Superclass::SetInputData;
   void SetInputData(vtkDataSet* input) override;
+  void SetInputData(vtkImageData* input) override;
+  void SetInputData(vtkRectilinearGrid* input) override; // refused by name, as any other type
   ///@}
 
   void Render(vtkRenderer* ren, vtkVolume* vol) override;

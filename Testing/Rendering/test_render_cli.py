@@ -74,6 +74,26 @@ def random_cloud(n, seed=1):
     return cloud
 
 
+def test_a_rectilinear_grid_is_refused_by_name():
+    """SetInputData takes point sets and images: a rectilinear grid, which
+    vtkVolumeMapper has an overload for, is an error naming its type, as any
+    other data set is, and leaves no input (it printed pipeline errors at
+    every frame)."""
+    import vtk
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    said = []
+
+    def observe(caller, event, text):
+        said.append(text)
+    observe.CallDataType = vtk.VTK_STRING
+    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
+    mapper.SetInputData(vtk.vtkRectilinearGrid())
+    assert len(said) == 1 and "not a vtkRectilinearGrid" in said[0], said
+    assert mapper.GetInput() is None
+    mapper.SetInputData(vtk.vtkImageData())
+    assert mapper.GetInput().IsA("vtkImageData") and len(said) == 1
+
+
 def test_root_bounds_that_miss_the_points_are_named_once():
     """RootBounds that do not hold the points: one warning naming them, no
     build tried (it said 'point 0 lies outside the root cube' at every
