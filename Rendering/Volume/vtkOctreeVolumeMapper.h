@@ -168,10 +168,11 @@ public:
   /**
    * Build the octree inside the cube around these bounds (xmin, xmax, ymin,
    * ymax, zmin, zmax) instead of one fitted to the input's points; every
-   * point must lie inside. Data split over parallel ranks then gives every
-   * rank the same voxel grid, so the composited picture matches one rank's
-   * (with a fixed LeafDepth). Uninitialized bounds (the default, min > max)
-   * fit the cube to the points.
+   * point must lie inside and the bounds must be finite (else a warning
+   * names them and nothing is drawn). Data split over parallel ranks then
+   * gives every rank the same voxel grid, so the composited picture matches
+   * one rank's (with a fixed LeafDepth). Uninitialized bounds (the default,
+   * min > max) fit the cube to the points.
    */
   vtkSetVector6Macro(RootBounds, double);
   vtkGetVector6Macro(RootBounds, double);
@@ -376,8 +377,9 @@ public:
 
   ///@{
   /**
-   * The input: a vtkPointSet (e.g. vtkPolyData) or a vtkImageData.
-   * (vtkVolumeMapper's own SetInputData accepts images only.)
+   * The input: a vtkPointSet (e.g. vtkPolyData) or a vtkImageData; any
+   * other data set (vtkVolumeMapper's overload for a vtkRectilinearGrid
+   * among them) is an error naming its type, and leaves no input.
    */
   void SetInputData(vtkDataSet* input) override;
   void SetInputData(vtkImageData* input) override;
