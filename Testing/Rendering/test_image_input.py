@@ -21,6 +21,7 @@ import vtk
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 import octoray
+from mapper_views import offscreen_view
 
 
 def image(values, spacing, origin=(0.0, 0.0, 0.0)):
@@ -41,24 +42,16 @@ def render(data, size=(64, 64), configure=None, camera=None, lights=None):
     mapper.SetInputData(data)
     if configure:
         configure(mapper)
-    prop = vtk.vtkVolumeProperty()
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(prop)
-    ren = vtk.vtkRenderer()
-    ren.AddVolume(volume)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(*size)
-    window.AddRenderer(ren)
+    window, said = offscreen_view(mapper, size)
+    ren = window.GetRenderers().GetFirstRenderer()
     if lights:
-        lights(ren, prop)
+        lights(ren, ren.GetVolumes().GetLastProp().GetProperty())
     ren.ResetCamera()
     if camera:
         camera(ren.GetActiveCamera())
         ren.ResetCameraClippingRange()
     window.Render()
-    assert mapper.GetLastUsedBackend() == mapper.BACKEND_CPU
+    assert mapper.GetLastUsedBackend() == mapper.BACKEND_CPU, said
     return mapper, window
 
 
@@ -195,22 +188,8 @@ def test_nothing_to_draw_is_said_once_with_its_reason(select, expected):
     if select:
         mapper.SetScalarModeToUsePointFieldData()
         mapper.SelectScalarArray(select)
-    said = []
-
-    def observe(caller, event, text):
-        said.append(text)
-    observe.CallDataType = vtk.VTK_STRING
-    mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(vtk.vtkVolumeProperty())
-    ren = vtk.vtkRenderer()
-    ren.AddVolume(volume)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(32, 32)
-    window.AddRenderer(ren)
-    ren.ResetCamera()
+    window, said = offscreen_view(mapper)
+    ren = window.GetRenderers().GetFirstRenderer()
     for azimuth in (0, 10, 20):
         ren.GetActiveCamera().Azimuth(azimuth)
         window.Render()

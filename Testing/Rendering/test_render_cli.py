@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 import octoray
+from mapper_views import offscreen_view
 from octoray.png import read_png
 
 DATA = os.environ.get("OCTORAY_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "Data"))
@@ -38,30 +39,6 @@ def test_mappers_are_in_the_package():
     cpu.SetBlendModeToSurface()
     assert cpu.GetBlendMode() == octoray.vtkOctreeVolumeMapper.SURFACE_BLEND
     assert "LeafDepth: 7" in str(cpu)
-
-
-def offscreen_view(mapper, size=(32, 32)):
-    """A window drawing `mapper`'s volume, with the mapper's warnings and
-    errors gathered: (window, [texts])."""
-    import vtk
-    said = []
-
-    def observe(caller, event, text):
-        said.append(text)
-    observe.CallDataType = vtk.VTK_STRING
-    mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
-    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(vtk.vtkVolumeProperty())
-    ren = vtk.vtkRenderer()
-    ren.AddVolume(volume)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(*size)
-    window.AddRenderer(ren)
-    ren.ResetCamera()
-    return window, said
 
 
 def random_cloud(n, seed=1):
