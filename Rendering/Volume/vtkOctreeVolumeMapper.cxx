@@ -177,6 +177,7 @@ void vtkOctreeVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     this->Internals->RenderOctree(ren, vol, window, input);
   }
+
   // What the frame cost, for VTK's level-of-detail and interactive-rate
   // logic (vtkVolume adds it to its estimated render time); never zero, as
   // VTK's own mappers do.
@@ -195,7 +196,7 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
 {
   output->Initialize();
   octoray::Engine* engine = this->Internals->Backend.Engine();
-  if (!this->Internals->Input.HasOctree() || !engine)
+  if (!this->Internals->OctreeOf(this->GetInput()) || !engine)
   {
     return;
   }
@@ -249,14 +250,14 @@ void vtkOctreeVolumeMapper::GetLeafVoxels(vtkPolyData* output)
 //------------------------------------------------------------------------------
 int vtkOctreeVolumeMapper::GetOctreeDepth()
 {
-  return this->Internals->Input.HasOctree() ? this->Internals->BuiltDepth : 0;
+  return this->Internals->OctreeOf(this->GetInput()) ? this->Internals->BuiltDepth : 0;
 }
 
 //------------------------------------------------------------------------------
 double vtkOctreeVolumeMapper::GetLeafSize()
 {
   octoray::Engine* engine = this->Internals->Backend.Engine();
-  if (!this->Internals->Input.HasOctree() || !engine)
+  if (!this->Internals->OctreeOf(this->GetInput()) || !engine)
   {
     return 0.0;
   }
@@ -330,7 +331,7 @@ void vtkOctreeVolumeMapper::GetVoxelBounds(double bounds[6])
 vtkIdType vtkOctreeVolumeMapper::GetNumberOfOctreePoints()
 {
   octoray::Engine* engine = this->Internals->Backend.Engine();
-  return (this->Internals->Input.HasOctree() && engine) ? static_cast<vtkIdType>(engine->PointCount()) : 0;
+  return (this->Internals->OctreeOf(this->GetInput()) && engine) ? static_cast<vtkIdType>(engine->PointCount()) : 0;
 }
 
 //------------------------------------------------------------------------------

@@ -122,6 +122,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
   if (!request.Problem.empty())
   {
     this->WarnOncePerInput(input, request.Problem);
+    this->Input.Forget(); // the last octree does not describe this input
     return Step::Stop;
   }
   if (this->Input.FailedBefore(request))

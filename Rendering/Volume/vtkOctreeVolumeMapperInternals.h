@@ -64,6 +64,8 @@ public:
   Step Run(const char* what, Call&& call);
   Step Report(vtkOctreeBackend::Status status);
   void WarnOncePerInput(vtkDataSet* input, const std::string& message);
+  // Whether the octree held is `input`'s (the getters describe no other).
+  bool OctreeOf(vtkDataSet* input) const { return this->Input.HasOctree() && this->BuiltFor == input; }
   void WarnNothingToDraw(const vtkOctreeInputHelper::Request& request);
 
   vtkOctreeVolumeMapper* Self;

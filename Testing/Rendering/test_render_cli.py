@@ -51,6 +51,27 @@ def random_cloud(n, seed=1):
     return cloud
 
 
+def test_the_octree_getters_describe_the_current_input():
+    """After the input becomes an empty one (which VTK does not even ask the
+    mapper to draw), the getters describe no octree; the first input again
+    gives its octree back without a rebuild."""
+    import vtk
+    cloud = random_cloud(3000)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper)
+    window.Render()
+    built = (mapper.GetNumberOfOctreePoints(), mapper.GetOctreeDepth(), mapper.GetLeafSize())
+    assert built[0] == 3000 and built[1] > 0 and built[2] > 0
+    mapper.SetInputData(vtk.vtkPolyData())
+    window.Render()
+    assert (mapper.GetNumberOfOctreePoints(), mapper.GetOctreeDepth(), mapper.GetLeafSize()) == (0, 0, 0.0)
+    mapper.SetInputData(cloud)
+    window.Render()
+    assert (mapper.GetNumberOfOctreePoints(), mapper.GetOctreeDepth(), mapper.GetLeafSize()) == built
+    assert mapper.GetNumberOfBuilds() == 1 and said == [], said
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any
