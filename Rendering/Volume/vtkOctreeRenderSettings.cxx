@@ -63,7 +63,6 @@ void vtkOctreeRenderSettings::SetShading(
 int vtkOctreeRenderSettings::SetLights(
   vtkLightCollection* lights, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings)
 {
-  const std::size_t kMaxLights = 8; // the engine's per-frame light array
   vtkNew<vtkMatrix4x4> dataFromWorld;
   vtkMatrix4x4::Invert(volumeMatrix, dataFromWorld);
   settings.lights.clear();
@@ -72,7 +71,7 @@ int vtkOctreeRenderSettings::SetLights(
   lights->InitTraversal(it);
   while (vtkLight* light = lights->GetNextLight(it))
   {
-    if (!light->GetSwitch() || ++on > static_cast<int>(kMaxLights))
+    if (!light->GetSwitch() || ++on > octoray::kMaxLights)
     {
       continue;
     }
@@ -106,7 +105,7 @@ int vtkOctreeRenderSettings::SetLights(
     dark.intensity = 0.0f;
     settings.lights.push_back(dark);
   }
-  return std::max(0, on - static_cast<int>(kMaxLights));
+  return std::max(0, on - octoray::kMaxLights);
 }
 
 //------------------------------------------------------------------------------

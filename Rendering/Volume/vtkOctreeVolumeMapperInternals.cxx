@@ -283,9 +283,12 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
   s.shadows = self->Shadows;
   s.maxBounces = self->MaximumBounces;
   s.lodPixels = static_cast<float>(self->LODPixelThreshold);
-  if (vtkOctreeRenderSettings::SetLights(ren->GetLights(), vol->GetMatrix(), s) > 0)
+  const int ignoredLights = vtkOctreeRenderSettings::SetLights(ren->GetLights(), vol->GetMatrix(), s);
+  if (ignoredLights > 0 && !this->LightsWarned)
   {
-    vtkWarningWithObjectMacro(self, "The octree engine takes at most 8 lights; the others are ignored.");
+    this->LightsWarned = true; // once: the renderer's lights rarely change, and frames come many a second
+    vtkWarningWithObjectMacro(self, "The octree engine takes at most " << octoray::kMaxLights << " lights; "
+        << ignoredLights << " more are ignored.");
   }
   // Transfer function on the scalars (unless the points carry colours).
   if (this->Input.HasScalar())

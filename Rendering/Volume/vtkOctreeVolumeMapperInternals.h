@@ -81,6 +81,7 @@ public:
   vtkMTimeType BuiltMTime = 0;
   bool BuiltWithPoints = false; // KeepPointsForUpdates at the last build: Update can run
   bool CellScalarsWarned = false;
+  bool LightsWarned = false;
   // The last warning that stopped a frame and the input it was for
   // (WarnOncePerInput): said once for an input, not at every frame.
   std::string InputWarning;

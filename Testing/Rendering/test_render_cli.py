@@ -72,6 +72,21 @@ def test_the_octree_getters_describe_the_current_input():
     assert mapper.GetNumberOfBuilds() == 1 and said == [], said
 
 
+def test_lights_past_the_engines_say_so_once():
+    """The engine takes eight lights: with ten, one warning over frames,
+    naming how many are ignored."""
+    import vtk
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    window, said = offscreen_view(mapper)
+    ren = window.GetRenderers().GetFirstRenderer()
+    for _ in range(10):
+        ren.AddLight(vtk.vtkLight())
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "takes at most 8 lights; 2 more are ignored." in said[0], said
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any

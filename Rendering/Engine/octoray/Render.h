@@ -42,6 +42,9 @@ struct TransferFunction
   std::vector<Rgba> table; // non-premultiplied; empty = node colours, opaque
 };
 
+// The most lights a frame takes (the kernels hold them in a fixed array).
+constexpr int kMaxLights = 8;
+
 struct RenderSettings
 {
   int width = 0, height = 0;
@@ -53,7 +56,8 @@ struct RenderSettings
   ShadeMode shade = ShadeMode::Flat;
   float ambient = 0.1f, diffuse = 0.7f, specular = 0.2f, specularPower = 10.0f;
   float depthCue = 0.7f; // fraction of brightness lost at the far side
-  // Lights in world coordinates; none = a headlight at the camera.
+  // Lights in world coordinates, at most kMaxLights; none = a headlight at
+  // the camera.
   std::vector<Light> lights;
   bool shadows = false;
   int maxBounces = 2;          // reflections and refractions together

@@ -8,8 +8,6 @@
 
 namespace octoray
 {
-constexpr int kMaxLights = 8;
-
 struct UnitLight
 {
   Vec3f position; // unit-cube position, or direction towards the light
