@@ -8,6 +8,8 @@
 #include "vtkNew.h"
 #include "vtkOctreeVolumeMapper.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
@@ -106,6 +108,60 @@ int vtkOctreeRenderSettings::SetLights(
     settings.lights.push_back(dark);
   }
   return std::max(0, on - octoray::kMaxLights);
+}
+
+//------------------------------------------------------------------------------
+// A world plane in data coordinates: n . (p - o) >= 0 for the world point
+// p = M q of the data point q is (L^T n) . (q - M^-1 o) >= 0, with L the
+// linear part of the volume's matrix M.
+static octoray::ClipPlane DataPlane(vtkPlane* plane, vtkMatrix4x4* volumeMatrix, vtkMatrix4x4* dataFromWorld)
+{
+  double origin[4] = { 0, 0, 0, 1 }, normal[3], dataOrigin[4];
+  plane->GetOrigin(origin);
+  plane->GetNormal(normal);
+  dataFromWorld->MultiplyPoint(origin, dataOrigin);
+  octoray::ClipPlane p;
+  for (int a = 0; a < 3; ++a)
+  {
+    p.origin[a] = dataOrigin[a] / dataOrigin[3];
+    p.normal[a] = 0.0;
+    for (int k = 0; k < 3; ++k)
+    {
+      p.normal[a] += volumeMatrix->GetElement(k, a) * normal[k];
+    }
+  }
+  return p;
+}
+
+//------------------------------------------------------------------------------
+int vtkOctreeRenderSettings::SetClipPlanes(vtkPlaneCollection* planes, vtkMatrix4x4* volumeMatrix,
+  const double* croppingBox, octoray::RenderSettings& settings)
+{
+  std::vector<octoray::ClipPlane> all;
+  if (planes)
+  {
+    vtkNew<vtkMatrix4x4> dataFromWorld;
+    vtkMatrix4x4::Invert(volumeMatrix, dataFromWorld);
+    vtkCollectionSimpleIterator it;
+    planes->InitTraversal(it);
+    while (vtkPlane* plane = planes->GetNextPlane(it))
+    {
+      all.push_back(DataPlane(plane, volumeMatrix, dataFromWorld));
+    }
+  }
+  for (int face = 0; croppingBox && face < 6; ++face)
+  {
+    // Face 2a is the box's low side on axis a, kept above it; 2a + 1 its
+    // high side, kept below.
+    octoray::ClipPlane p;
+    p.normal[0] = p.normal[1] = p.normal[2] = 0.0;
+    p.origin[face / 2] = croppingBox[face];
+    p.normal[face / 2] = face % 2 == 0 ? 1.0 : -1.0;
+    all.push_back(p);
+  }
+  const std::size_t kept = std::min(all.size(), static_cast<std::size_t>(octoray::kMaxClipPlanes));
+  settings.clipPlanes.assign(all.begin(), all.begin() + kept);
+  return static_cast<int>(all.size() - kept);
 }
 
 //------------------------------------------------------------------------------

@@ -22,6 +22,7 @@
 class vtkCamera;
 class vtkLightCollection;
 class vtkMatrix4x4;
+class vtkPlaneCollection;
 class vtkVolumeProperty;
 
 class vtkOctreeRenderSettings
@@ -56,6 +57,16 @@ public:
    */
   static int SetLights(
     vtkLightCollection* lights, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings);
+
+  /**
+   * The mapper's clipping planes (world coordinates, as VTK's volume
+   * mappers take them; may be null) in data coordinates, then, where
+   * `croppingBox` is given (xmin, xmax, ymin, ymax, zmin, zmax in data
+   * coordinates: cropping to the sub-volume), the box's six faces. Returns
+   * how many planes past the engine's kMaxClipPlanes were left out.
+   */
+  static int SetClipPlanes(vtkPlaneCollection* planes, vtkMatrix4x4* volumeMatrix, const double* croppingBox,
+    octoray::RenderSettings& settings);
 
   /**
    * The colour (or grey) transfer function and scalar opacity of component

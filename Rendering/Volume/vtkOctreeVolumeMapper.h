@@ -26,6 +26,12 @@
  *   SURFACE_BLEND (first hit; also used for ISOSURFACE_BLEND), the default;
  * - renderer lights (headlight, camera and scene lights, positional or
  *   directional, colour and intensity) become engine lights;
+ * - clipping planes (AddClippingPlane, in world coordinates) and cropping
+ *   to the sub-volume (SetCropping, CroppingRegionPlanes with
+ *   SetCroppingRegionFlagsToSubVolume) take voxels away for every ray:
+ *   what they remove is neither seen, nor casts shadows, nor is reflected;
+ *   a voxel they cut is drawn up to the cut. At most 12 planes together;
+ *   VTK's other cropping regions are said once and not applied;
  * - work only when needed: the octree is rebuilt when the input or the
  *   arrays it uses change, updated in place when only point positions change
  *   (animation), and the picture is re-traced only when the camera, lights,

@@ -7,6 +7,7 @@
 #include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
+#include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
 #include <octoray/DepthSignature.h>
@@ -290,12 +291,56 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
     vtkWarningWithObjectMacro(self, "The octree engine takes at most " << octoray::kMaxLights << " lights; "
         << ignoredLights << " more are ignored.");
   }
+  this->SetClipPlanes(vol, s);
   // Transfer function on the scalars (unless the points carry colours).
   if (this->Input.HasScalar())
   {
     vtkOctreeRenderSettings::SetTransfer(property, this->Input.ScalarRange(), s);
   }
   return s;
+}
+
+//------------------------------------------------------------------------------
+// The clipping planes and the cropping box; what the engine cannot take is
+// said once.
+void vtkOctreeVolumeMapper::vtkInternals::SetClipPlanes(vtkVolume* vol, octoray::RenderSettings& s)
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  const int ignored =
+    vtkOctreeRenderSettings::SetClipPlanes(self->GetClippingPlanes(), vol->GetMatrix(), this->CroppingBox(), s);
+  if (ignored > 0 && !this->ClipPlanesWarned)
+  {
+    this->ClipPlanesWarned = true;
+    vtkWarningWithObjectMacro(self, "The octree engine takes at most " << octoray::kMaxClipPlanes
+        << " clipping planes, a cropping box's six faces among them; " << ignored << " more are ignored.");
+  }
+}
+
+//------------------------------------------------------------------------------
+// The box to crop to, where the mapper crops to the sub-volume. VTK's other
+// cropping regions (fence, cross and their inverses) are not convex; they
+// are said once, and the volume is drawn uncropped.
+const double* vtkOctreeVolumeMapper::vtkInternals::CroppingBox()
+{
+  vtkOctreeVolumeMapper* self = this->Self;
+  if (!self->GetCropping())
+  {
+    return nullptr;
+  }
+  if (self->GetCroppingRegionFlags() == VTK_CROP_SUBVOLUME)
+  {
+    return self->GetCroppingRegionPlanes();
+  }
+  if (!this->CroppingWarned)
+  {
+    this->CroppingWarned = true;
+    std::ostringstream flags; // VTK's warning stream takes no manipulators
+    flags << "0x" << std::hex << self->GetCroppingRegionFlags();
+    vtkWarningWithObjectMacro(self, "The octree engine crops to the sub-volume only "
+                                    "(SetCroppingRegionFlagsToSubVolume); with CroppingRegionFlags "
+        << flags.str() << " the volume is drawn uncropped.");
+  }
+  return nullptr;
 }
 
 //------------------------------------------------------------------------------

@@ -55,6 +55,8 @@ public:
   Step Update(const vtkOctreeInputHelper::Request& request);
   Step Trace(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window);
   octoray::RenderSettings FrameSettings(vtkRenderer* ren, vtkVolume* vol, int width, int height);
+  void SetClipPlanes(vtkVolume* vol, octoray::RenderSettings& settings);
+  const double* CroppingBox();
   Step OpaqueDepth(vtkOpenGLRenderWindow* window, int x0, int y0, int width, int height,
     octoray::RenderSettings& settings, std::uint64_t& signature);
   bool UsesInterop() const;
@@ -82,6 +84,8 @@ public:
   bool BuiltWithPoints = false; // KeepPointsForUpdates at the last build: Update can run
   bool CellScalarsWarned = false;
   bool LightsWarned = false;
+  bool ClipPlanesWarned = false;
+  bool CroppingWarned = false;
   // The last warning that stopped a frame and the input it was for
   // (WarnOncePerInput): said once for an input, not at every frame.
   std::string InputWarning;

@@ -320,68 +320,104 @@ TEST_P(SceneTest, MirrorPlaneShowsTheVoxelsMirrorImage)
   EXPECT_GT(outside, 1000);
 }
 
+namespace
+{
+// Floor cells at z-level 0 (top face z = 1/32) and a 4x4x2 green block
+// above, lit by the sun from `toSun`, seen from above.
+struct FloorAndBlock
+{
+  static constexpr double kBlockLo[3] = { 12 / 32.0, 12 / 32.0, 6 / 32.0 };
+  static constexpr double kBlockHi[3] = { 16 / 32.0, 16 / 32.0, 8 / 32.0 };
+  static constexpr int kSize = 128;
+  static constexpr double kFovy = 45;
+  double toSun[3] = { 0.6, 0.3, 1.0 };
+  Matrix vp;
+
+  FloorAndBlock()
+  {
+    Normalize3(toSun);
+    const double eye[3] = { 0.5, -0.5, 1.2 }, target[3] = { 0.5, 0.5, 0 };
+    vp = ViewProjection(eye, target, kZUp, kFovy, 1.0, 0.1, 5);
+  }
+
+  static Scene Points()
+  {
+    Scene s;
+    const float grey[3] = { 0.6f, 0.6f, 0.6f }, green[3] = { 0.2f, 0.8f, 0.2f };
+    for (int i = 0; i < 32; ++i)
+      for (int j = 0; j < 32; ++j)
+        s.AddCell(5, i, j, 0, grey);
+    for (int i = 12; i < 16; ++i)
+      for (int j = 12; j < 16; ++j)
+        for (int k = 6; k < 8; ++k)
+          s.AddCell(5, i, j, k, green);
+    return s;
+  }
+
+  RenderSettings Sunlit() const
+  {
+    RenderSettings settings = Settings(vp, kSize, kSize);
+    settings.shade = ShadeMode::Phong;
+    settings.ambient = 0.2f;
+    settings.diffuse = 0.7f;
+    settings.specular = 0.0f; // lit floor = (ambient + diffuse n.l) grey, exactly
+    settings.shadows = true;
+    Light sun;
+    std::copy(toSun, toSun + 3, sun.position);
+    sun.position[3] = 0;
+    settings.lights.push_back(sun);
+    return settings;
+  }
+
+  // The lit floor: its normal is +z (its occupancy gradient vanishes inside
+  // the floor, so the entry face gives it), so n.l = toSun.z.
+  float LitFloor() const { return float((0.2 + 0.7 * toSun[2]) * 0.6); }
+
+  // Whether the first hit b is on the floor's top face, away from the rim
+  // (whose gradient normal tilts outwards).
+  static bool OnFloorInside(const BruteHit& b)
+  {
+    if (!b.hit || std::fabs(b.p[2] - 1 / 32.0) > 1e-9)
+      return false;
+    const int ci = int(b.p[0] * 32), cj = int(b.p[1] * 32);
+    return ci > 0 && ci < 31 && cj > 0 && cj < 31;
+  }
+};
+}
+
 TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
 {
-  // Floor cells at z-level 0 (top face z = 1/32) and a 4x4x2 block above.
-  Scene s;
-  const float grey[3] = { 0.6f, 0.6f, 0.6f }, green[3] = { 0.2f, 0.8f, 0.2f };
-  for (int i = 0; i < 32; ++i)
-    for (int j = 0; j < 32; ++j)
-      s.AddCell(5, i, j, 0, grey);
-  for (int i = 12; i < 16; ++i)
-    for (int j = 12; j < 16; ++j)
-      for (int k = 6; k < 8; ++k)
-        s.AddCell(5, i, j, k, green);
-  engine->Build(s.View(), UnitCubeOptions(5));
+  const FloorAndBlock scene;
+  engine->Build(FloorAndBlock::Points().View(), UnitCubeOptions(5));
   HostOctree t;
   engine->CopyToHost(t);
-  const double blockLo[3] = { 12 / 32.0, 12 / 32.0, 6 / 32.0 }, blockHi[3] = { 16 / 32.0, 16 / 32.0, 8 / 32.0 };
+  const int w = FloorAndBlock::kSize, h = FloorAndBlock::kSize;
+  const Matrix& vp = scene.vp;
+  const double* l = scene.toSun;
+  const Image image = RenderChecked(*engine, scene.Sunlit());
 
-  double l[3] = { 0.6, 0.3, 1.0 };
-  Normalize3(l);
-  const int w = 128, h = 128;
-  const double eye[3] = { 0.5, -0.5, 1.2 }, target[3] = { 0.5, 0.5, 0 };
-  const double fovy = 45;
-  const Matrix vp = ViewProjection(eye, target, kZUp, fovy, 1.0, 0.1, 5);
-  RenderSettings settings = Settings(vp, w, h);
-  settings.shade = ShadeMode::Phong;
-  settings.ambient = 0.2f;
-  settings.diffuse = 0.7f;
-  settings.specular = 0.0f; // lit floor = (ambient + diffuse n.l) grey, exactly
-  settings.shadows = true;
-  Light sun;
-  for (int a = 0; a < 3; ++a)
-    sun.position[a] = l[a];
-  sun.position[3] = 0;
-  settings.lights.push_back(sun);
-  const Image image = RenderChecked(*engine, settings);
-
-  // The floor's normal is +z (its occupancy gradient vanishes inside the
-  // floor, so the entry face gives it), so n.l = l.z.
   const float shadowed[3] = { 0.2f * 0.6f, 0.2f * 0.6f, 0.2f * 0.6f };
-  const float litValue = float((0.2 + 0.7 * l[2]) * 0.6);
-  const float lit[3] = { litValue, litValue, litValue };
+  const float lit[3] = { scene.LitFloor(), scene.LitFloor(), scene.LitFloor() };
   int inShadow = 0, inLight = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
     {
       const BruteHit b = BruteForceFirstHit(t, vp, w, h, x, y);
-      if (!b.hit || std::fabs(b.p[2] - 1 / 32.0) > 1e-9)
-        continue; // not the floor's top face
-      const int ci = int(b.p[0] * 32), cj = int(b.p[1] * 32);
-      if (ci <= 0 || ci >= 31 || cj <= 0 || cj >= 31)
-        continue; // the rim, whose gradient normal tilts outwards
+      if (!FloorAndBlock::OnFloorInside(b))
+        continue;
       // The shadow from geometry: does the ray from the hit point towards
       // the light meet the block? The band left unchecked is 1 pixel's
       // footprint on the floor (the pixel's size at that distance over the
       // cosine of the view ray with the floor), on either side.
       const WorldRay r = PixelRay(vp, w, h, x, y);
       const double dist = b.t * Length(r.d) + 0.1;
-      const double footprint = dist * 2 * std::tan(fovy * M_PI / 360) / h / (std::fabs(r.d[2]) / Length(r.d));
+      const double footprint =
+        dist * 2 * std::tan(FloorAndBlock::kFovy * M_PI / 360) / h / (std::fabs(r.d[2]) / Length(r.d));
       WorldRay toLight;
       for (int a = 0; a < 3; ++a)
         toLight.o[a] = b.p[a], toLight.d[a] = l[a];
-      const int blocked = BoxHitWithMargin(toLight, blockLo, blockHi, footprint, 0, 1e9);
+      const int blocked =
+        BoxHitWithMargin(toLight, FloorAndBlock::kBlockLo, FloorAndBlock::kBlockHi, footprint, 0, 1e9);
       const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
       if (blocked == 1)
       {
@@ -398,32 +434,69 @@ TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
   EXPECT_GT(inLight, 1000);
 }
 
+// A clipping plane that takes the block away takes its shadow too: no ray
+// sees the block, and the whole floor is lit.
+TEST_P(SceneTest, ClippedBlockCastsNoShadow)
+{
+  const FloorAndBlock scene;
+  engine->Build(FloorAndBlock::Points().View(), UnitCubeOptions(5));
+  HostOctree t;
+  engine->CopyToHost(t);
+  const int w = FloorAndBlock::kSize, h = FloorAndBlock::kSize;
+  RenderSettings settings = scene.Sunlit();
+  ClipPlane below;
+  below.origin[2] = 5 / 32.0; // under the block, over the floor
+  below.normal[2] = -1;
+  settings.clipPlanes = { below };
+  const Image image = RenderChecked(*engine, settings);
+  const float lit[3] = { scene.LitFloor(), scene.LitFloor(), scene.LitFloor() };
+  int floor = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+    {
+      const BruteHit b = BruteForceFirstHit(t, scene.vp, w, h, x, y, settings.clipPlanes);
+      const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
+      ASSERT_EQ(pixel[3] > 0, b.hit) << "pixel " << x << "," << y;
+      if (FloorAndBlock::OnFloorInside(b))
+      {
+        ++floor;
+        EXPECT_TRUE(SameRgb(pixel, lit, 1e-5f)) << "pixel " << x << "," << y << " should be lit: " << pixel[0];
+      }
+    }
+  EXPECT_GT(floor, 5000);
+}
+
 // ---------------------------------------------------------------- volume blend modes
 
 namespace
 {
 // Brute-force ray marcher: every leaf the pixel's ray passes, in double,
-// ordered by entry; distances in the unit cube (the scenes use the unit
-// cube, so world and unit lengths agree). `ambiguous` when some leaf is
-// only grazed (a contact shorter than 1e-5), where the two may differ.
+// ordered by entry, each within the part of the ray the clipping planes
+// keep; distances in the unit cube (the scenes use the unit cube, so world
+// and unit lengths agree). `ambiguous` when some leaf is only grazed (a
+// contact shorter than 1e-5), where the two may differ.
 struct Segment
 {
   double t0, length;
   std::uint32_t node;
 };
 
-std::vector<Segment> MarchLeaves(const HostOctree& t, const WorldRay& r, bool& ambiguous)
+std::vector<Segment> MarchLeaves(
+  const HostOctree& t, const WorldRay& r, const std::vector<ClipPlane>& planes, bool& ambiguous)
 {
   std::vector<Segment> segments;
   ambiguous = false;
   const double scale = Length(r.d);
+  double kept0 = 0, kept1 = 1;
+  if (!KeptSpan(r, planes, kept0, kept1))
+    return segments;
   for (std::uint32_t n = t.levelBegin[t.depth]; n < t.levelBegin[t.depth + 1]; ++n)
   {
-    double lo[3], hi[3], t0 = 0, t1 = 1;
+    double lo[3], hi[3], t0 = kept0, t1 = kept1;
     NodeBox(t, n, t.depth, lo, hi);
     // Grown by 1e-5: a contact with the grown box but not a solid one with
     // the box itself is a graze.
-    double gl[3], gh[3], g0 = 0, g1 = 1;
+    double gl[3], gh[3], g0 = kept0 - 1e-5 / scale, g1 = kept1 + 1e-5 / scale;
     for (int a = 0; a < 3; ++a)
       gl[a] = lo[a] - 1e-5, gh[a] = hi[a] + 1e-5;
     const bool near = Slab(r, gl, gh, g0, g1);
@@ -465,80 +538,91 @@ TEST_P(SceneTest, VolumeBlendModesMatchABruteForceRayMarcher)
   const double eye[3] = { 2.2, -1.6, 1.5 }, target[3] = { 0.5, 0.5, 0.5 };
   const Matrix vp = ViewProjection(eye, target, kZUp, 40, 1.0, 0.5, 8);
 
-  for (BlendMode mode : { BlendMode::Composite, BlendMode::Minimum, BlendMode::Average, BlendMode::Additive })
+  // Clipped, rays start and end inside voxels: one plane the rays enter
+  // through, one they leave through.
+  ClipPlane enter, leave;
+  enter.origin[0] = 0.7, enter.origin[1] = 0.3, enter.origin[2] = 0.6;
+  enter.normal[0] = -1, enter.normal[1] = 1, enter.normal[2] = -0.5;
+  leave.origin[0] = 0.6, leave.origin[1] = 0.6, leave.origin[2] = 0.5;
+  leave.normal[0] = 0.3, leave.normal[1] = -1, leave.normal[2] = 0.8;
+  for (const std::vector<ClipPlane>& planes : { std::vector<ClipPlane>(), std::vector<ClipPlane>{ enter, leave } })
   {
-    SCOPED_TRACE("blend mode " + std::to_string(int(mode)));
-    RenderSettings settings = Settings(vp, w, h);
-    settings.blend = mode;
-    settings.transfer.range[0] = 0;
-    settings.transfer.range[1] = mode == BlendMode::Additive ? 0.5f : 1.0f;
-    for (int i = 0; i <= 100; ++i)
+    for (BlendMode mode : { BlendMode::Composite, BlendMode::Minimum, BlendMode::Average, BlendMode::Additive })
     {
-      const float v = i / 100.0f;
-      settings.transfer.table.push_back(
-        mode == BlendMode::Composite ? Rgba{ v, 1 - v, 0.5f, 0.3f } : Rgba{ v, v, v, 1.0f });
-    }
-    // Opacity 0.3 per 0.1 of length: about 0.2 per voxel of 1/16, so that
-    // rays composite several voxels before they saturate.
-    settings.opacityUnitDistance = 0.1f;
-    const Image image = RenderChecked(*engine, settings);
-    const TransferFunction& tf = settings.transfer;
-    int checked = 0, skipped = 0, empty = 0;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
+      SCOPED_TRACE("blend mode " + std::to_string(int(mode)) + ", clipping planes " + std::to_string(planes.size()));
+      RenderSettings settings = Settings(vp, w, h);
+      settings.clipPlanes = planes;
+      settings.blend = mode;
+      settings.transfer.range[0] = 0;
+      settings.transfer.range[1] = mode == BlendMode::Additive ? 0.5f : 1.0f;
+      for (int i = 0; i <= 100; ++i)
       {
-        bool ambiguous;
-        const std::vector<Segment> seg = MarchLeaves(t, PixelRay(vp, w, h, x, y), ambiguous);
-        const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
-        if (ambiguous)
+        const float v = i / 100.0f;
+        settings.transfer.table.push_back(
+          mode == BlendMode::Composite ? Rgba{ v, 1 - v, 0.5f, 0.3f } : Rgba{ v, v, v, 1.0f });
+      }
+      // Opacity 0.3 per 0.1 of length: about 0.2 per voxel of 1/16, so that
+      // rays composite several voxels before they saturate.
+      settings.opacityUnitDistance = 0.1f;
+      const Image image = RenderChecked(*engine, settings);
+      const TransferFunction& tf = settings.transfer;
+      int checked = 0, skipped = 0, empty = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
         {
-          ++skipped;
-          continue;
-        }
-        if (seg.empty())
-        {
-          ++empty;
-          EXPECT_EQ(pixel[3], 0.0f) << "pixel " << x << "," << y << " meets no voxel";
-          continue;
-        }
-        ++checked;
-        if (mode == BlendMode::Composite)
-        {
-          // Front to back, opacity corrected for each voxel's length, with
-          // the engine's documented early termination at alpha 0.995.
-          double acc[4] = { 0, 0, 0, 0 };
+          bool ambiguous;
+          const std::vector<Segment> seg = MarchLeaves(t, PixelRay(vp, w, h, x, y), planes, ambiguous);
+          const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
+          if (ambiguous)
+          {
+            ++skipped;
+            continue;
+          }
+          if (seg.empty())
+          {
+            ++empty;
+            EXPECT_EQ(pixel[3], 0.0f) << "pixel " << x << "," << y << " meets no voxel";
+            continue;
+          }
+          ++checked;
+          if (mode == BlendMode::Composite)
+          {
+            // Front to back, opacity corrected for each voxel's length, with
+            // the engine's documented early termination at alpha 0.995.
+            double acc[4] = { 0, 0, 0, 0 };
+            for (const Segment& sg : seg)
+            {
+              const Rgba c = tf.table[TableIndex(t.Scalar(sg.node), tf)];
+              const double alpha = 1 - std::pow(1 - c.a, sg.length / settings.opacityUnitDistance);
+              const double wgt = (1 - acc[3]) * alpha;
+              acc[0] += wgt * c.r, acc[1] += wgt * c.g, acc[2] += wgt * c.b, acc[3] += wgt;
+              if (acc[3] > 0.995)
+                break;
+            }
+            for (int k = 0; k < 4; ++k)
+              EXPECT_NEAR(pixel[k], acc[k], 1e-4) << "pixel " << x << "," << y << " channel " << k;
+            continue;
+          }
+          double value = mode == BlendMode::Minimum ? INFINITY : 0.0, length = 0;
           for (const Segment& sg : seg)
           {
-            const Rgba c = tf.table[TableIndex(t.Scalar(sg.node), tf)];
-            const double alpha = 1 - std::pow(1 - c.a, sg.length / settings.opacityUnitDistance);
-            const double wgt = (1 - acc[3]) * alpha;
-            acc[0] += wgt * c.r, acc[1] += wgt * c.g, acc[2] += wgt * c.b, acc[3] += wgt;
-            if (acc[3] > 0.995)
-              break;
+            if (mode == BlendMode::Minimum)
+              value = std::min(value, double(t.Scalar(sg.node)));
+            else
+              value += t.Scalar(sg.node) * sg.length, length += sg.length;
           }
-          for (int k = 0; k < 4; ++k)
-            EXPECT_NEAR(pixel[k], acc[k], 1e-4) << "pixel " << x << "," << y << " channel " << k;
-          continue;
+          if (mode == BlendMode::Average)
+            value /= length;
+          // One table step of slack: a value on a bin boundary may round
+          // either way in float.
+          const float expected = tf.table[TableIndex(value, tf)].r;
+          EXPECT_NEAR(pixel[0], expected, 0.0101f) << "pixel " << x << "," << y << " value " << value;
+          EXPECT_EQ(pixel[3], 1.0f);
         }
-        double value = mode == BlendMode::Minimum ? INFINITY : 0.0, length = 0;
-        for (const Segment& sg : seg)
-        {
-          if (mode == BlendMode::Minimum)
-            value = std::min(value, double(t.Scalar(sg.node)));
-          else
-            value += t.Scalar(sg.node) * sg.length, length += sg.length;
-        }
-        if (mode == BlendMode::Average)
-          value /= length;
-        // One table step of slack: a value on a bin boundary may round
-        // either way in float.
-        const float expected = tf.table[TableIndex(value, tf)].r;
-        EXPECT_NEAR(pixel[0], expected, 0.0101f) << "pixel " << x << "," << y << " value " << value;
-        EXPECT_EQ(pixel[3], 1.0f);
-      }
-    EXPECT_GT(checked, 300);
-    EXPECT_GT(empty, 50);
-    EXPECT_LT(skipped, checked / 10);
+      EXPECT_GT(checked, planes.empty() ? 300 : 200);
+      EXPECT_GT(empty, 50);
+      EXPECT_LT(skipped, checked / 10);
+    }
   }
 }
 

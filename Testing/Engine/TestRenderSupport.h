@@ -78,6 +78,33 @@ inline bool Slab(const WorldRay& r, const double lo[3], const double hi[3], doub
   return t0 <= t1;
 }
 
+// The part [t0, t1] of a ray that every clipping plane keeps (the side its
+// normal points to), in world coordinates; false when none is kept.
+inline bool KeptSpan(const WorldRay& r, const std::vector<ClipPlane>& planes, double& t0, double& t1)
+{
+  for (const ClipPlane& p : planes)
+  {
+    double start = 0, rate = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      start += p.normal[a] * (r.o[a] - p.origin[a]);
+      rate += p.normal[a] * r.d[a];
+    }
+    if (rate == 0)
+    {
+      if (start < 0)
+        return false;
+      continue;
+    }
+    const double t = -start / rate;
+    if (rate > 0)
+      t0 = std::max(t0, t);
+    else
+      t1 = std::min(t1, t);
+  }
+  return t0 <= t1;
+}
+
 // World box of node n at `level` of a host octree.
 inline void NodeBox(const HostOctree& t, std::uint32_t n, int level, double lo[3], double hi[3])
 {
@@ -114,14 +141,19 @@ struct BruteHit
 };
 
 // Every leaf box against the pixel's ray, in double; world coordinates.
-inline BruteHit BruteForceFirstHit(const HostOctree& t, const Matrix& vp, int w, int h, int x, int y)
+// With clipping planes, the part of the ray they keep.
+inline BruteHit BruteForceFirstHit(
+  const HostOctree& t, const Matrix& vp, int w, int h, int x, int y, const std::vector<ClipPlane>& planes = {})
 {
   const WorldRay r = PixelRay(vp, w, h, x, y);
   BruteHit best;
   best.t = std::numeric_limits<double>::infinity();
+  double kept0 = 0, kept1 = 1; // the clipping range is t in [0, 1]
+  if (!KeptSpan(r, planes, kept0, kept1))
+    return best;
   for (std::uint32_t n = t.levelBegin[t.depth]; n < t.levelBegin[t.depth + 1]; ++n)
   {
-    double lo[3], hi[3], t0 = 0, t1 = 1; // the clipping range is t in [0, 1]
+    double lo[3], hi[3], t0 = kept0, t1 = kept1;
     NodeBox(t, n, t.depth, lo, hi);
     // Half-open boxes where the ray runs along a face plane, as the engine
     // defines them (a ray on a shared face belongs to exactly one voxel).

@@ -87,6 +87,61 @@ def test_lights_past_the_engines_say_so_once():
     assert len(said) == 1 and "takes at most 8 lights; 2 more are ignored." in said[0], said
 
 
+def test_clipping_planes_past_the_engines_say_so_once():
+    """The engine takes twelve planes, a cropping box's six faces among
+    them: with eight planes and a cropping box, one warning over frames,
+    naming how many are ignored; the clipping planes clip."""
+    import vtk
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    window, said = offscreen_view(mapper, (48, 48))
+    window.Render()
+    whole = window_pixels(window)
+    for _ in range(8):
+        plane = vtk.vtkPlane()
+        plane.SetOrigin(0.5, 0.5, 0.5)
+        plane.SetNormal(1, 0, 0)
+        mapper.AddClippingPlane(plane)
+    mapper.SetCropping(1)
+    mapper.SetCroppingRegionFlagsToSubVolume()
+    mapper.SetCroppingRegionPlanes(0, 1, 0, 1, 0, 1)
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "takes at most 12 clipping planes, a cropping box's six faces among them; " \
+        "2 more are ignored." in said[0], said
+    clipped = window_pixels(window)
+    assert (clipped != whole).any(axis=1).sum() > 50
+
+
+def test_cropping_regions_other_than_the_sub_volume_say_so_once():
+    """VTK's fence, cross and inverted cropping regions are not convex: the
+    engine does not crop to them, says so once, and draws the volume whole."""
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    window, said = offscreen_view(mapper, (48, 48))
+    window.Render()
+    whole = window_pixels(window)
+    mapper.SetCropping(1)
+    mapper.SetCroppingRegionFlagsToCross()
+    mapper.SetCroppingRegionPlanes(0.2, 0.8, 0.2, 0.8, 0.2, 0.8)
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "crops to the sub-volume only (SetCroppingRegionFlagsToSubVolume); with " \
+        "CroppingRegionFlags 0x417410 the volume is drawn uncropped." in said[0], said
+    assert (window_pixels(window) == whole).all()
+
+
+def window_pixels(window):
+    """The window's RGB pixels, one row each."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(window)
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    return vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars()).reshape(-1, 3).copy()
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any

@@ -61,9 +61,8 @@ void TraceShadowPackets(const FrameConstants& f, const OctreeView& tree, const C
       if ((hit >> lane) & 1u)
       {
         const LightSample light = SampleLight(f, i, shadows[lane].surface);
-        if (light.cosine > 0.0f)
+        if (light.cosine > 0.0f && ShadowRay(f, shadows[lane].surface, hits[lane].hit, light, rays[lane]))
         {
-          rays[lane] = ShadowRay(shadows[lane].surface, hits[lane].hit, light);
           facing |= 1u << lane;
         }
       }
@@ -108,6 +107,10 @@ void RenderRow(
     if constexpr (F::kVolume)
     {
       std::fill_n(visitors, kPacketLanes, BlendVisitor{ &f, &tree });
+      for (int lane = 0; lane < lanes; ++lane)
+      {
+        visitors[lane].tEnd = (valid >> lane) & 1u ? rays[lane].tMax : 0.0f;
+      }
     }
     TracePacket(tree, rays, lods, valid, visitors);
     TracedShadows shadows[kPacketLanes];

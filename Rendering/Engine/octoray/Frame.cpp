@@ -81,6 +81,31 @@ void Multiply(const double a[16], const double b[16], double out[16])
   }
 }
 
+std::string Triple(const double v[3])
+{
+  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+void CheckClipPlanes(const std::vector<ClipPlane>& planes)
+{
+  if (planes.size() > static_cast<std::size_t>(kMaxClipPlanes))
+  {
+    throw Error("octoray: at most " + std::to_string(kMaxClipPlanes) + " clipping planes, got " +
+      std::to_string(planes.size()));
+  }
+  for (std::size_t i = 0; i < planes.size(); ++i)
+  {
+    const ClipPlane& p = planes[i];
+    const Vec3d normal{ p.normal[0], p.normal[1], p.normal[2] };
+    const Vec3d origin{ p.origin[0], p.origin[1], p.origin[2] };
+    if (!(Length(normal) > 0.0) || !std::isfinite(Length(normal)) || !std::isfinite(Length(origin)))
+    {
+      throw Error("octoray: clipping plane " + std::to_string(i) +
+        " needs a finite origin and a non-zero normal, got " + Triple(p.origin) + " and " + Triple(p.normal));
+    }
+  }
+}
+
 // Settings no frame can be drawn with: an error naming what is wrong.
 void CheckSettings(const RenderSettings& s)
 {
@@ -98,6 +123,7 @@ void CheckSettings(const RenderSettings& s)
   {
     throw Error("octoray: at most " + std::to_string(kMaxLights) + " lights, got " + std::to_string(s.lights.size()));
   }
+  CheckClipPlanes(s.clipPlanes);
   if (!s.transfer.table.empty() && !(s.transfer.range[1] > s.transfer.range[0]))
   {
     throw Error("octoray: the transfer function's scalar range is empty");
@@ -135,6 +161,25 @@ void SetLights(const RenderSettings& s, const RootCube& cube, FrameConstants& f)
     u.directional = l.position[3] == 0.0;
     u.position = ToFloat(u.directional ? position / (len > 0 ? len : 1.0) : (position - origin) / cube.size);
     u.color = Vec3f{ l.color[0], l.color[1], l.color[2] } * l.intensity;
+  }
+}
+
+// The clipping planes in the unit cube: with p = origin + size u, the kept
+// side n . (p - o) >= 0 is (n / |n|) . u + n . (origin - o) / (|n| size) >= 0.
+void SetClipPlanes(const RenderSettings& s, const RootCube& cube, FrameConstants& f)
+{
+  f.clipPlaneCount = static_cast<int>(s.clipPlanes.size());
+  for (int i = 0; i < f.clipPlaneCount; ++i)
+  {
+    const ClipPlane& p = s.clipPlanes[i];
+    const Vec3d normal{ p.normal[0], p.normal[1], p.normal[2] };
+    const Vec3d toCube{ cube.origin[0] - p.origin[0], cube.origin[1] - p.origin[1], cube.origin[2] - p.origin[2] };
+    const double length = Length(normal);
+    for (int a = 0; a < 3; ++a)
+    {
+      f.clipPlanes[i][a] = normal[a] / length;
+    }
+    f.clipPlanes[i][3] = Dot(normal, toCube) / (length * cube.size);
   }
 }
 
@@ -191,6 +236,7 @@ FrameConstants MakeFrame(const RenderSettings& s, const OctreeView& tree)
   f.lodPixels = s.lodPixels;
   f.opacityUnitDistance = s.opacityUnitDistance > 0 ? s.opacityUnitDistance / static_cast<float>(cube.size) : 1.0f;
   SetLights(s, cube, f);
+  SetClipPlanes(s, cube, f);
   SetFootprintAndCue(s, f);
   if (!s.transfer.table.empty())
   {

@@ -45,6 +45,19 @@ struct TransferFunction
 // The most lights a frame takes (the kernels hold them in a fixed array).
 constexpr int kMaxLights = 8;
 
+// A clipping plane, as VTK's mappers take them (vtkAbstractMapper's
+// clipping planes): the side the normal points to is kept,
+// normal . (p - origin) >= 0; the rest of the scene is not there for any ray.
+struct ClipPlane
+{
+  double origin[3] = { 0, 0, 0 };
+  double normal[3] = { 0, 0, 1 };
+};
+
+// The most clipping planes a frame takes: six of a mapper's own and the six
+// faces of its cropping box.
+constexpr int kMaxClipPlanes = 12;
+
 struct RenderSettings
 {
   int width = 0, height = 0;
@@ -60,6 +73,8 @@ struct RenderSettings
   // the camera.
   std::vector<Light> lights;
   bool shadows = false;
+  // In world coordinates, at most kMaxClipPlanes; each normal non-zero.
+  std::vector<ClipPlane> clipPlanes;
   int maxBounces = 2;          // reflections and refractions together
   float lodPixels = 0.0f;      // stop descending at voxels smaller than this many pixels; 0 = leaves
   float opacityUnitDistance = 1.0f / 256; // composite: opacity is per this length (unit cube)

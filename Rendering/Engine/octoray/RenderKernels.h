@@ -35,6 +35,8 @@ struct FrameConstants
   int transferSize = 0;
   float transferRange[2] = { 0, 1 };
   const float* depthBuffer = nullptr;
+  int clipPlaneCount = 0;
+  double clipPlanes[kMaxClipPlanes][4]; // a . u + d >= 0 is kept, u in the unit cube
 };
 
 // What a frame uses, fixed at compile time: each combination is its own
@@ -102,10 +104,66 @@ OCTORAY_HD bool PixelLine(const FrameConstants& f, int x, int y, Vec3d& nearPoin
   return true;
 }
 
+// How far inside the kept side a clipped ray starts and ends (unit-cube
+// lengths, d of unit length): a plane on a voxel face (a cropping box on the
+// lattice) leaves the ray in float on either side of the face by a few
+// ulps, and the voxel beyond it would be drawn for a touch of no length.
+// A thousandth of a leaf at depth 10, a sixteenth at depth 16.
+constexpr double kClipMargin = 1e-6;
+
+// Narrows [t0, t1] of the line p + t d to the part that every clipping
+// plane keeps (a half-space each, so what is kept of a line is one span),
+// kClipMargin inside each plane. False when nothing is left.
+OCTORAY_HD bool ClipLine(const FrameConstants& f, const Vec3d& p, const Vec3d& d, double& t0, double& t1)
+{
+  for (int i = 0; i < f.clipPlaneCount; ++i)
+  {
+    const double* c = f.clipPlanes[i];
+    const double start = c[0] * p.x + c[1] * p.y + c[2] * p.z + c[3];
+    const double rate = c[0] * d.x + c[1] * d.y + c[2] * d.z;
+    if (rate == 0.0)
+    {
+      if (start < 0.0)
+      {
+        return false;
+      }
+      continue;
+    }
+    const double t = -start / rate;
+    if (rate > 0.0)
+    {
+      t0 = t + kClipMargin > t0 ? t + kClipMargin : t0;
+    }
+    else
+    {
+      t1 = t - kClipMargin < t1 ? t - kClipMargin : t1;
+    }
+  }
+  return t0 <= t1;
+}
+
+// A secondary ray's [tMin, tMax] narrowed to what the clipping planes keep:
+// false when they keep none of it, and the ray need not be traced.
+OCTORAY_HD bool ClipRay(const FrameConstants& f, Ray& ray)
+{
+  if (f.clipPlaneCount == 0)
+  {
+    return true;
+  }
+  double t0 = ray.tMin, t1 = ray.tMax;
+  if (!ClipLine(f, ToDouble(ray.origin), ToDouble(ray.direction), t0, t1))
+  {
+    return false;
+  }
+  ray.tMin = static_cast<float>(t0);
+  ray.tMax = static_cast<float>(t1);
+  return ray.tMin <= ray.tMax;
+}
+
 // A pixel's primary ray, its origin moved to where it enters the root cube
 // (computed in double). `tBase` is that entry's distance from the near plane.
-// False when the ray misses the cube, or the clipping range or opaque
-// geometry ends it before.
+// False when the ray misses the cube, or the clipping range, the clipping
+// planes or opaque geometry end it before.
 OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, double& tBase)
 {
   Vec3d nearPoint, d;
@@ -147,7 +205,7 @@ OCTORAY_HD bool PrimaryRay(const FrameConstants& f, int x, int y, Ray& ray, doub
     t0 = ta > t0 ? ta : t0;
     t1 = tb < t1 ? tb : t1;
   }
-  if (!(t0 <= t1))
+  if (!(t0 <= t1) || !ClipLine(f, nearPoint, d, t0, t1))
   {
     return false;
   }
@@ -313,15 +371,17 @@ OCTORAY_HD LightSample SampleLight(const FrameConstants& f, int i, const Surface
   return light;
 }
 
-// The shadow ray from a surface hit towards a light it faces.
-OCTORAY_HD Ray ShadowRay(const SurfacePoint& s, const NodeHit& hit, const LightSample& light)
+// The shadow ray from a surface hit towards a light it faces, within what
+// the clipping planes keep. False when they keep none of it: nothing there
+// can cast a shadow.
+OCTORAY_HD bool ShadowRay(
+  const FrameConstants& f, const SurfacePoint& s, const NodeHit& hit, const LightSample& light, Ray& shadow)
 {
-  Ray shadow;
   shadow.origin = ShadowRayOrigin(s.point, s.normal, hit);
   SetDirection(shadow, light.direction);
   shadow.tMin = 0.0f;
   shadow.tMax = light.distance;
-  return shadow;
+  return ClipRay(f, shadow);
 }
 
 // Whether a voxel lies on the ray.
@@ -330,6 +390,14 @@ OCTORAY_HD bool Occluded(const OctreeView& tree, const Ray& ray, const LevelOfDe
   FirstHitVisitor blocker;
   Traverse(tree, ray, lod, blocker);
   return blocker.found;
+}
+
+// Whether a voxel lies between a surface hit and a light it faces.
+OCTORAY_HD bool Shadowed(const FrameConstants& f, const OctreeView& tree, const SurfacePoint& s, const NodeHit& hit,
+  const LightSample& light, const LevelOfDetail& lod)
+{
+  Ray shadow;
+  return ShadowRay(f, s, hit, light, shadow) && Occluded(tree, shadow, lod);
 }
 
 // The shadow rays of one hit, traced by the caller already (the CPU's
@@ -371,7 +439,7 @@ OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, c
     if constexpr (F::kShadows)
     {
       ++secondaryRays;
-      if (traced ? traced->occluded[i] : Occluded(tree, ShadowRay(s, hit, light), lod))
+      if (traced ? traced->occluded[i] : Shadowed(f, tree, s, hit, light, lod))
       {
         continue;
       }
@@ -394,11 +462,15 @@ struct BlendVisitor
   float length = 0.0f; // path length through voxels
   bool any = false;
   float firstT = 0.0f;
+  // The ray's end (its tMax: opaque geometry, a clipping plane): a voxel
+  // that reaches past it counts only up to it, as the first counts only
+  // from the ray's start at 0.
+  float tEnd = INFINITY;
 
   OCTORAY_HD bool Visit(const NodeHit& hit)
   {
     const float t0 = hit.tEnter > 0.0f ? hit.tEnter : 0.0f;
-    const float dt = hit.tExit - t0;
+    const float dt = (hit.tExit < tEnd ? hit.tExit : tEnd) - t0;
     if (!any)
     {
       firstT = t0;
@@ -494,6 +566,18 @@ OCTORAY_HD void StartRay(Ray& ray, const Vec3f& p, const Vec3f& d, float tMin)
   ray.tMax = INFINITY;
 }
 
+// Whether the clipping planes keep a point of the unit cube.
+OCTORAY_HD bool KeptByClipPlanes(const FrameConstants& f, const Vec3d& p)
+{
+  double t0 = 0.0, t1 = 0.0;
+  return ClipLine(f, p, Vec3d{ 0.0, 0.0, 0.0 }, t0, t1);
+}
+
+OCTORAY_HD Vec3d CellCentre(const std::uint32_t cell[3], float size)
+{
+  return Vec3d{ (cell[0] + 0.5) * size, (cell[1] + 0.5) * size, (cell[2] + 0.5) * size };
+}
+
 // The plane on axis a through which a ray going d leaves the cell `cell`
 // of side `size`.
 OCTORAY_HD float ExitPlane(const std::uint32_t cell[3], float size, const Vec3f& d, int a)
@@ -529,9 +613,10 @@ OCTORAY_HD int CellExit(const std::uint32_t cell[3], float size, const Vec3f& p,
 // voxel, reflecting totally inside where Snell allows no exit, until it
 // leaves through a face, where it refracts back into air. The emerging ray
 // goes into `out` (its weight and bounces set by the caller; each internal
-// reflection costs a bounce). False when the bounces run out inside.
-OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const NodeHit& hit, const Vec3f& n,
-  float ior, int maxBounces, PendingRay& out)
+// reflection costs a bounce). False when the bounces run out inside. A
+// voxel whose centre the clipping planes take away is not medium.
+OCTORAY_HD bool TraceThroughMedium(const FrameConstants& f, const OctreeView& tree, const Ray& in, const NodeHit& hit,
+  const Vec3f& n, float ior, PendingRay& out)
 {
   Vec3f d;
   if (!Refract(in.direction, n, 1.0f / ior, d))
@@ -566,7 +651,8 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
       std::uint32_t c[3] = { cell[0], cell[1], cell[2] };
       c[axis] = static_cast<std::uint32_t>(next);
       const std::uint32_t node = tree.Find(level, EncodeMorton(c[0], c[1], c[2]));
-      medium = node != kInvalidIndex && (!tree.refraction || tree.refraction[node] > 0.0f);
+      medium = node != kInvalidIndex && (!tree.refraction || tree.refraction[node] > 0.0f) &&
+        KeptByClipPlanes(f, CellCentre(c, size));
     }
     if (medium)
     {
@@ -582,7 +668,7 @@ OCTORAY_HD bool TraceThroughMedium(const OctreeView& tree, const Ray& in, const 
       StartRay(out.ray, p, outDir, 1e-4f * size);
       return true;
     }
-    if (out.bounces >= maxBounces)
+    if (out.bounces >= f.maxBounces)
     {
       return false;
     }
@@ -673,8 +759,11 @@ OCTORAY_HD void SpawnRays(const FrameConstants& f, const OctreeView& tree, const
     mirror.weight = path.weight * reflectivity;
     mirror.bounces = path.bounces + 1;
     mirror.tFromNear = path.tFromNear + tHit;
-    pending[top++] = mirror;
-    ++secondaryRays;
+    if (ClipRay(f, mirror.ray))
+    {
+      pending[top++] = mirror;
+      ++secondaryRays;
+    }
   }
   if (ior > 0.0f && top < kMaxPendingRays)
   {
@@ -682,7 +771,7 @@ OCTORAY_HD void SpawnRays(const FrameConstants& f, const OctreeView& tree, const
     through.weight = path.weight * (1.0f - reflectivity) * RgbOf(NodeColor(f, tree, hit.node));
     through.bounces = path.bounces + 1;
     through.tFromNear = path.tFromNear + tHit;
-    if (TraceThroughMedium(tree, path.ray, hit, n, ior, f.maxBounces, through))
+    if (TraceThroughMedium(f, tree, path.ray, hit, n, ior, through) && ClipRay(f, through.ray))
     {
       pending[top++] = through;
       ++secondaryRays;
@@ -778,6 +867,7 @@ OCTORAY_HD void RenderPixel(const FrameConstants& f, const OctreeView& tree, int
   if constexpr (F::kVolume)
   {
     BlendVisitor blend{ &f, &tree };
+    blend.tEnd = pixel.ray.tMax;
     Traverse(tree, pixel.ray, pixel.lod, blend);
     ShadeBlend(f, pixel, blend, rgba, depth);
   }

@@ -8,6 +8,9 @@
 #include "vtkMatrix4x4.h"
 #include "vtkOctreeRenderSettings.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
+#include "vtkTransform.h"
 
 using namespace octoray_test;
 
@@ -130,6 +133,64 @@ void TestLights()
   CHECK(s.lights.size() == 1 && s.lights[0].intensity == 0.0f);
 }
 
+// Which side of an engine plane a data point lies on: + kept, - removed.
+double Side(const octoray::ClipPlane& p, const double q[3])
+{
+  return p.normal[0] * (q[0] - p.origin[0]) + p.normal[1] * (q[1] - p.origin[1]) + p.normal[2] * (q[2] - p.origin[2]);
+}
+
+void TestClipPlanes()
+{
+  // A world plane through the volume turned, stretched and moved: each data
+  // point is kept by the data plane exactly where its world point is kept
+  // by the world plane.
+  vtkNew<vtkTransform> turn;
+  turn->Translate(0.5, -1, 2);
+  turn->RotateWXYZ(35, 1, 2, 0.5);
+  turn->Scale(2, 0.5, 1.5);
+  vtkNew<vtkPlane> plane;
+  plane->SetOrigin(0.3, 0.2, 1.9);
+  plane->SetNormal(0.4, -1, 0.7);
+  vtkNew<vtkPlaneCollection> planes;
+  planes->AddItem(plane);
+  octoray::RenderSettings s;
+  CHECK(vtkOctreeRenderSettings::SetClipPlanes(planes, turn->GetMatrix(), nullptr, s) == 0);
+  CHECK(s.clipPlanes.size() == 1);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-2, 2);
+  int kept = 0;
+  for (int i = 0; i < 200; ++i)
+  {
+    const double q[3] = { u(rng), u(rng), u(rng) };
+    double world[3];
+    turn->TransformPoint(q, world);
+    const double worldSide = plane->EvaluateFunction(world), dataSide = Side(s.clipPlanes[0], q);
+    CHECK((worldSide >= 0) == (dataSide >= 0) || std::fabs(worldSide) < 1e-9);
+    kept += worldSide >= 0;
+  }
+  CHECK(kept > 40 && kept < 160);
+
+  // Cropping to a sub-volume: six faces in data coordinates, after the
+  // planes; past twelve, the rest is counted, not kept.
+  const double box[6] = { -1, 1, -2, 2, -3, 3 };
+  CHECK(vtkOctreeRenderSettings::SetClipPlanes(nullptr, turn->GetMatrix(), box, s) == 0);
+  CHECK(s.clipPlanes.size() == 6);
+  const double inside[3] = { 0.9, -1.9, 2.9 }, outside[3] = { 0, 0, -3.1 };
+  bool keepsInside = true, keepsOutside = true;
+  for (const octoray::ClipPlane& p : s.clipPlanes)
+  {
+    keepsInside = keepsInside && Side(p, inside) >= 0;
+    keepsOutside = keepsOutside && Side(p, outside) >= 0;
+  }
+  CHECK(keepsInside && !keepsOutside);
+  for (int i = 0; i < 8; ++i)
+  {
+    planes->AddItem(plane);
+  }
+  CHECK(vtkOctreeRenderSettings::SetClipPlanes(planes, turn->GetMatrix(), box, s) == 3);
+  CHECK(s.clipPlanes.size() == octoray::kMaxClipPlanes);
+}
+
 void TestTransfer()
 {
   vtkNew<vtkVolumeProperty> property;
@@ -191,6 +252,7 @@ int TestOctreeRenderSettings(int, char*[])
   TestCamera();
   TestModes();
   TestLights();
+  TestClipPlanes();
   TestTransfer();
   TestDepthAndKey();
   return Result();
