@@ -50,7 +50,6 @@ def ct_particles(ctx):
     ctx.run, so the report records the command."""
     out = os.path.join(scenes_dir(ctx), "ct5n.particles")
     if not os.path.exists(out) or "scene-ct5n" not in ctx.commands:
-        os.makedirs(os.path.dirname(out), exist_ok=True)
         ctx.run("scene-ct5n", [sys.executable, os.path.abspath(__file__), "ct5n", out], env=python_env(ctx))
     return out
 
@@ -67,6 +66,7 @@ def write_ct5n(out):
     reader.Update()
     if reader.GetErrorCode() or reader.GetOutput().GetNumberOfPoints() == 0:
         raise RuntimeError(f"{CT5N}: {reader.GetErrorMessage() or 'no points'}")
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     writer = octoray.vtkParticleTextWriter()
     writer.SetInputData(reader.GetOutput())
     writer.SetFileName(out)

@@ -1,6 +1,7 @@
 #include "vtkParticleTextWriter.h"
 
 #include "vtkDataArray.h"
+#include "vtkErrorCode.h"
 #include "vtkInformation.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -168,6 +169,8 @@ void vtkParticleTextWriter::WriteData()
   std::FILE* f = std::fopen(this->FileName, "wb");
   if (!f)
   {
+    // The error code makes Write() return 0, as VTK's own writers do.
+    this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
     vtkErrorMacro(<< this->FileName << ": cannot open for writing");
     return;
   }
@@ -175,6 +178,7 @@ void vtkParticleTextWriter::WriteData()
   ok = (std::fclose(f) == 0) && ok;
   if (!ok)
   {
+    this->SetErrorCode(vtkErrorCode::OutOfDiskSpaceError);
     vtkErrorMacro(<< this->FileName << ": write failed (disk full?)");
   }
 }

@@ -337,6 +337,23 @@ def test_round_trip(tmp_path, data_dir):
     np.testing.assert_array_equal(array(out2, "Colors"), ref[:, 3:6])
 
 
+def test_writer_says_when_it_cannot_write(tmp_path):
+    """A file the writer cannot open (its folder does not exist): Write()
+    returns 0, the error code says why and the message names the file, as
+    VTK's own writers do; the next good write clears it."""
+    r, out, _ = read(write(tmp_path, "p.txt", "1 2 3\n4 5 6\n"))
+    w = octoray.vtkParticleTextWriter()
+    msgs = Messages(w)
+    w.SetInputData(out)
+    missing = os.path.join(str(tmp_path), "no-such-folder", "copy.txt")
+    w.SetFileName(missing)
+    assert w.Write() == 0
+    assert w.GetErrorCode() == vtk.vtkErrorCode.CannotOpenFileError
+    assert len(msgs.errors) == 1 and missing + ": cannot open for writing" in msgs.errors[0]
+    w.SetFileName(os.path.join(str(tmp_path), "copy.txt"))
+    assert w.Write() == 1 and w.GetErrorCode() == vtk.vtkErrorCode.NoError
+
+
 def test_round_trip_float_and_extras(tmp_path):
     rng = np.random.default_rng(5)
     vals = rng.normal(size=(50, 5)).astype(np.float32)
