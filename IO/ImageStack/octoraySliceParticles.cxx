@@ -272,6 +272,31 @@ bool SelectAxes(const int dims[3], const double spacing[3], const ParticleOption
 } // namespace
 
 //------------------------------------------------------------------------------
+std::string ParticleOptionsProblem(const int dims[3], const ParticleOptions& options)
+{
+  const char* axis[3] = { "x (pixels across)", "y (pixels up)", "z (slices)" };
+  for (int a = 0; a < 3; ++a)
+  {
+    const int lo = options.RegionOfInterest[2 * a], hi = options.RegionOfInterest[2 * a + 1];
+    const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+    if (options.Stride[a] < 1)
+    {
+      return "Stride " + std::to_string(options.Stride[a]) + " on " + axis[a] + ": a stride is at least 1";
+    }
+    if (lo >= 0 && hi >= 0 && lo > hi)
+    {
+      return "RegionOfInterest " + range + " on " + axis[a] + ": its minimum lies above its maximum";
+    }
+    if (lo >= dims[a] || hi >= dims[a])
+    {
+      return "RegionOfInterest " + range + " on " + axis[a] + " reaches past the stack's " +
+        std::to_string(dims[a]) + " (indices 0.." + std::to_string(dims[a] - 1) + "; -1: to the edge)";
+    }
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------
 void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyData* output)
 {
   int dims[3];

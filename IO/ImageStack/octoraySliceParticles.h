@@ -7,6 +7,8 @@
 #ifndef octoraySliceParticles_h
 #define octoraySliceParticles_h
 
+#include <string>
+
 class vtkImageData;
 class vtkPolyData;
 
@@ -24,9 +26,16 @@ struct ParticleOptions
   bool GenerateVertices = true;
 };
 
+// What is wrong with `options` for a stack of dims[0] x dims[1] pixels and
+// dims[2] slices, naming the property: a stride below 1, a region of
+// interest whose minimum lies above its maximum or past the stack's edge.
+// Empty when nothing is.
+std::string ParticleOptionsProblem(const int dims[3], const ParticleOptions& options);
+
 // Points (float), `Scalars` (intensity: grey, or the mean of R, G, B), for
 // colour images `Colors` (RGB bytes), vertex cells, PointLattice; no points
-// when the region of interest is empty.
+// when the region of interest is empty (options as ParticleOptionsProblem
+// passes them).
 void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyData* output);
 } // namespace slices
 } // namespace octoray

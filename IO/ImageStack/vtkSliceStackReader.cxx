@@ -182,13 +182,7 @@ bool vtkSliceStackReader::ReadStack(
         image->SetSpacing(this->Spacing);
         image->SetOrigin(this->Origin);
       }
-      octoray::slices::ParticleOptions options;
-      std::copy_n(this->RegionOfInterest, 6, options.RegionOfInterest);
-      std::copy_n(this->Stride, 3, options.Stride);
-      options.FillBetweenSlices = this->FillBetweenSlices;
-      std::copy_n(this->BackgroundRange, 2, options.BackgroundRange);
-      options.GenerateVertices = this->GenerateVertices;
-      octoray::slices::MakeParticles(image, options, particles);
+      ok = this->MakeParticles(image, particles);
     }
     else
     {
@@ -203,6 +197,51 @@ bool vtkSliceStackReader::ReadStack(
   }
   this->SliceFiles = read.SliceFiles;
   return ok;
+}
+
+//------------------------------------------------------------------------------
+// The particles of the image read, as the reader's options select them;
+// false after Fail() for options that do not fit the stack.
+bool vtkSliceStackReader::MakeParticles(vtkImageData* image, vtkPolyData* particles)
+{
+  octoray::slices::ParticleOptions options;
+  std::copy_n(this->RegionOfInterest, 6, options.RegionOfInterest);
+  std::copy_n(this->Stride, 3, options.Stride);
+  options.FillBetweenSlices = this->FillBetweenSlices;
+  std::copy_n(this->BackgroundRange, 2, options.BackgroundRange);
+  options.GenerateVertices = this->GenerateVertices;
+  const std::string problem = octoray::slices::ParticleOptionsProblem(image->GetDimensions(), options);
+  if (!problem.empty())
+  {
+    this->Fail(problem);
+    return false;
+  }
+  octoray::slices::MakeParticles(image, options, particles);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// Spacing and Origin no image can have: what is wrong, naming the property;
+// empty when nothing is.
+static std::string GeometryProblem(const double spacing[3], const double origin[3])
+{
+  const auto triple = [](const double v[3]) {
+    std::ostringstream text;
+    text << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+    return text.str();
+  };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(std::isfinite(spacing[a]) && spacing[a] > 0.0))
+    {
+      return "Spacing " + triple(spacing) + ": each must be finite and above zero";
+    }
+    if (!std::isfinite(origin[a]))
+    {
+      return "Origin " + triple(origin) + ": each must be finite";
+    }
+  }
+  return std::string();
 }
 
 //------------------------------------------------------------------------------
@@ -240,6 +279,12 @@ int vtkSliceStackReader::RequestData(
   output->Initialize();
   image->Initialize();
 
+  const std::string geometry = GeometryProblem(this->Spacing, this->Origin);
+  if (!geometry.empty())
+  {
+    this->Fail(geometry);
+    return this->KeepLastOutputs(output, image);
+  }
   std::vector<std::string> files;
   if (!this->ListSlices(files))
   {

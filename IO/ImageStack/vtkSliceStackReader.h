@@ -110,7 +110,9 @@ public:
 
   ///@{
   /// Pixel spacing (x, y) and slice spacing (z); DICOM tags override them
-  /// when UseMetadata is on (default).
+  /// when UseMetadata is on (default). A spacing that is not finite and
+  /// above zero, or an origin that is not finite, fails the update, naming
+  /// the property.
   vtkSetVector3Macro(Spacing, double);
   vtkGetVector3Macro(Spacing, double);
   vtkSetVector3Macro(Origin, double);
@@ -129,7 +131,9 @@ public:
   ///@{
   /// Region of interest as pixel indices (imin, imax, jmin, jmax, kmin, kmax)
   /// of the stack (after ordering; j counted upwards for pictures); -1 for a
-  /// bound means "to the edge". Only the particles use it.
+  /// bound means "to the edge". Only the particles use it. A bound past the
+  /// stack, a minimum above its maximum or a stride below 1 fails the
+  /// update, naming the property and the axis.
   vtkSetVector6Macro(RegionOfInterest, int);
   vtkGetVector6Macro(RegionOfInterest, int);
   vtkSetVector3Macro(Stride, int);
@@ -211,6 +215,7 @@ private:
   bool ListSlices(std::vector<std::string>& files);
   bool ReadStack(
     const std::vector<std::string>& files, vtkImageData* image, vtkPolyData* particles);
+  bool MakeParticles(vtkImageData* image, vtkPolyData* particles);
   int KeepLastOutputs(vtkPolyData* output, vtkImageData* image);
   void Fail(const std::string& message);
 };

@@ -445,6 +445,27 @@ def test_error_different_types(tmp_path):
     assert "is 4x4 RGB uint8 but slice '%s' is 4x4 grey uint8" % a[0] in r.GetErrorMessage()
 
 
+@pytest.mark.parametrize("options,message", [
+    (dict(Spacing=(1.0, 1.0, 0.0)), "Spacing (1, 1, 0): each must be finite and above zero"),
+    (dict(Spacing=(1.0, float("nan"), 1.0)), "Spacing (1, nan, 1): each must be finite and above zero"),
+    (dict(Origin=(0.0, float("inf"), 0.0)), "Origin (0, inf, 0): each must be finite"),
+    (dict(Stride=(1, 0, 1)), "Stride 0 on y (pixels up): a stride is at least 1"),
+    (dict(RegionOfInterest=(4, 2, -1, -1, -1, -1)),
+     "RegionOfInterest 4..2 on x (pixels across): its minimum lies above its maximum"),
+    (dict(RegionOfInterest=(-1, -1, -1, -1, 1, 3)),
+     "RegionOfInterest 1..3 on z (slices) reaches past the stack's 3 (indices 0..2; -1: to the edge)"),
+])
+def test_error_settings_no_stack_can_have(tmp_path, options, message):
+    """Settings that fit no stack, or not this one, are refused by name:
+    nothing is read into the outputs, and the message says which property
+    and why (they used to be clamped or passed through without a word)."""
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "s%d.png", np.ones((3, 4, 5), np.uint8))
+    r, out, msgs = reader_for(Files=files, **options)
+    assert r.GetErrorMessage() == message
+    assert len(msgs.errors) == 1 and message in msgs.errors[0]
+    assert out.GetNumberOfPoints() == 0 and r.GetImageOutput().GetNumberOfPoints() == 0
+
+
 def test_error_nothing_given():
     r, out, msgs = reader_for()
     assert r.GetErrorMessage() == "no slices given: set file names, a directory or a file pattern"
