@@ -17,7 +17,9 @@ the reader's own format code). Checked here, on files written to WORK_DIR:
   file, in the order of the proxies' XML names): CSVReader for .txt, .txt.gz
   and .csv (ParaView's GUI asks the user instead), OctorayParticleReader for
   a particle .xyz (before P3DReader and xyzreader);
-- the reader reads the .txt: the LiDAR tile's 1065 points with Colors.
+- the reader reads the .txt: the LiDAR tile's 1065 points with Colors;
+- the bundled LiDAR scan as .xyzrgbi (x y z r g b intensity, Data/README.md)
+  opens with OpenDataFile, through the particle reader alone.
 """
 import gzip
 import os
@@ -102,6 +104,16 @@ r = OctorayParticleReader(FileName=txt)
 r.UpdatePipeline()
 check(".txt read: points", r.GetDataInformation().GetNumberOfPoints(), 1065)
 check(".txt read: Colors", "Colors" in r.PointData.keys(), True)
+
+# The bundled scan's own extension, which no ParaView reader claims.
+scan = os.path.join(data, "PointClouds", "simple_las.xyzrgbi")
+check(".xyzrgbi: File > Open offers", readers_for(scan), ["OctorayParticleReader"])
+opened = OpenDataFile(scan)
+check("OpenDataFile(.xyzrgbi)", opened.GetXMLName() if opened else None, "OctorayParticleReader")
+if opened:
+    opened.UpdatePipeline()
+    check(".xyzrgbi read: points", opened.GetDataInformation().GetNumberOfPoints(), 1065)
+    check(".xyzrgbi read: intensity", "intensity" in opened.PointData.keys(), True)
 
 if failures:
     print("FAILED:", ", ".join(failures))
