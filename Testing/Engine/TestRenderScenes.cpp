@@ -322,9 +322,9 @@ TEST_P(SceneTest, MirrorPlaneShowsTheVoxelsMirrorImage)
 
 namespace
 {
-// Floor cells at z-level 0 (top face z = 1/32) and a 4x4x2 green block
-// above, lit by the sun from `toSun`, seen from above.
-struct FloorAndBlock
+// FloorAndBlock's scene with a green block, lit by the sun from `toSun`,
+// seen from above.
+struct SunlitFloorAndBlock
 {
   static constexpr double kBlockLo[3] = { 12 / 32.0, 12 / 32.0, 6 / 32.0 };
   static constexpr double kBlockHi[3] = { 16 / 32.0, 16 / 32.0, 8 / 32.0 };
@@ -333,7 +333,7 @@ struct FloorAndBlock
   double toSun[3] = { 0.6, 0.3, 1.0 };
   Matrix vp;
 
-  FloorAndBlock()
+  SunlitFloorAndBlock()
   {
     Normalize3(toSun);
     const double eye[3] = { 0.5, -0.5, 1.2 }, target[3] = { 0.5, 0.5, 0 };
@@ -342,16 +342,8 @@ struct FloorAndBlock
 
   static Scene Points()
   {
-    Scene s;
-    const float grey[3] = { 0.6f, 0.6f, 0.6f }, green[3] = { 0.2f, 0.8f, 0.2f };
-    for (int i = 0; i < 32; ++i)
-      for (int j = 0; j < 32; ++j)
-        s.AddCell(5, i, j, 0, grey);
-    for (int i = 12; i < 16; ++i)
-      for (int j = 12; j < 16; ++j)
-        for (int k = 6; k < 8; ++k)
-          s.AddCell(5, i, j, k, green);
-    return s;
+    const float green[3] = { 0.2f, 0.8f, 0.2f };
+    return FloorAndBlock(green);
   }
 
   RenderSettings Sunlit() const
@@ -387,11 +379,11 @@ struct FloorAndBlock
 
 TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
 {
-  const FloorAndBlock scene;
-  engine->Build(FloorAndBlock::Points().View(), UnitCubeOptions(5));
+  const SunlitFloorAndBlock scene;
+  engine->Build(SunlitFloorAndBlock::Points().View(), UnitCubeOptions(5));
   HostOctree t;
   engine->CopyToHost(t);
-  const int w = FloorAndBlock::kSize, h = FloorAndBlock::kSize;
+  const int w = SunlitFloorAndBlock::kSize, h = SunlitFloorAndBlock::kSize;
   const Matrix& vp = scene.vp;
   const double* l = scene.toSun;
   const Image image = RenderChecked(*engine, scene.Sunlit());
@@ -403,7 +395,7 @@ TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
     for (int x = 0; x < w; ++x)
     {
       const BruteHit b = BruteForceFirstHit(t, vp, w, h, x, y);
-      if (!FloorAndBlock::OnFloorInside(b))
+      if (!SunlitFloorAndBlock::OnFloorInside(b))
         continue;
       // The shadow from geometry: does the ray from the hit point towards
       // the light meet the block? The band left unchecked is 1 pixel's
@@ -412,12 +404,12 @@ TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
       const WorldRay r = PixelRay(vp, w, h, x, y);
       const double dist = b.t * Length(r.d) + 0.1;
       const double footprint =
-        dist * 2 * std::tan(FloorAndBlock::kFovy * M_PI / 360) / h / (std::fabs(r.d[2]) / Length(r.d));
+        dist * 2 * std::tan(SunlitFloorAndBlock::kFovy * M_PI / 360) / h / (std::fabs(r.d[2]) / Length(r.d));
       WorldRay toLight;
       for (int a = 0; a < 3; ++a)
         toLight.o[a] = b.p[a], toLight.d[a] = l[a];
       const int blocked =
-        BoxHitWithMargin(toLight, FloorAndBlock::kBlockLo, FloorAndBlock::kBlockHi, footprint, 0, 1e9);
+        BoxHitWithMargin(toLight, SunlitFloorAndBlock::kBlockLo, SunlitFloorAndBlock::kBlockHi, footprint, 0, 1e9);
       const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
       if (blocked == 1)
       {
@@ -438,11 +430,11 @@ TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
 // sees the block, and the whole floor is lit.
 TEST_P(SceneTest, ClippedBlockCastsNoShadow)
 {
-  const FloorAndBlock scene;
-  engine->Build(FloorAndBlock::Points().View(), UnitCubeOptions(5));
+  const SunlitFloorAndBlock scene;
+  engine->Build(SunlitFloorAndBlock::Points().View(), UnitCubeOptions(5));
   HostOctree t;
   engine->CopyToHost(t);
-  const int w = FloorAndBlock::kSize, h = FloorAndBlock::kSize;
+  const int w = SunlitFloorAndBlock::kSize, h = SunlitFloorAndBlock::kSize;
   RenderSettings settings = scene.Sunlit();
   ClipPlane below;
   below.origin[2] = 5 / 32.0; // under the block, over the floor
@@ -457,7 +449,7 @@ TEST_P(SceneTest, ClippedBlockCastsNoShadow)
       const BruteHit b = BruteForceFirstHit(t, scene.vp, w, h, x, y, settings.clipPlanes);
       const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
       ASSERT_EQ(pixel[3] > 0, b.hit) << "pixel " << x << "," << y;
-      if (FloorAndBlock::OnFloorInside(b))
+      if (SunlitFloorAndBlock::OnFloorInside(b))
       {
         ++floor;
         EXPECT_TRUE(SameRgb(pixel, lit, 1e-5f)) << "pixel " << x << "," << y << " should be lit: " << pixel[0];

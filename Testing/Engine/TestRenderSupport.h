@@ -283,6 +283,22 @@ struct Scene
   }
 };
 
+// Floor cells at z-level 0 of depth 5 (top face z = 1/32), grey, and a
+// 4x4x2 block of `blockColour` above it (cells 12..15, 12..15, 6..7).
+inline Scene FloorAndBlock(const float blockColour[3])
+{
+  Scene s;
+  const float grey[3] = { 0.6f, 0.6f, 0.6f };
+  for (int i = 0; i < 32; ++i)
+    for (int j = 0; j < 32; ++j)
+      s.AddCell(5, i, j, 0, grey);
+  for (int i = 12; i < 16; ++i)
+    for (int j = 12; j < 16; ++j)
+      for (int k = 6; k < 8; ++k)
+        s.AddCell(5, i, j, k, blockColour);
+  return s;
+}
+
 // Whether a ray (t >= tFrom) meets the box [lo, hi] grown by `margin` on
 // every side: +1 when it meets even the box shrunk by the margin, 0 when it
 // misses even the grown box, -1 in between (the band within `margin` of

@@ -914,15 +914,8 @@ TEST_P(Stability, LightInsideAVoxel)
   // with shadows every surface gets the ambient term alone; without, the
   // floor around the block is lit. No NaN either way (the light's own voxel
   // puts p - light near zero).
-  Scene s;
   const float grey[3] = { 0.6f, 0.6f, 0.6f };
-  for (int i = 0; i < 32; ++i)
-    for (int j = 0; j < 32; ++j)
-      s.AddCell(5, i, j, 0, grey);
-  for (int i = 12; i < 16; ++i)
-    for (int j = 12; j < 16; ++j)
-      for (int k = 6; k < 8; ++k)
-        s.AddCell(5, i, j, k, grey);
+  const Scene s = FloorAndBlock(grey);
   engine->Build(s.View(), UnitCubeOptions(5));
   const int w = 64, h = 64;
   const double eye[3] = { 0.5, -0.5, 1.2 }, target[3] = { 0.5, 0.5, 0 };

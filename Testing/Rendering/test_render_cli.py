@@ -92,11 +92,7 @@ def test_clipping_planes_past_the_engines_say_so_once():
     them: with eight planes and a cropping box, one warning over frames,
     naming how many are ignored; the clipping planes clip."""
     import vtk
-    mapper = octoray.vtkCPUOctreeVolumeMapper()
-    mapper.SetInputData(random_cloud(1000))
-    window, said = offscreen_view(mapper, (48, 48))
-    window.Render()
-    whole = window_pixels(window)
+    mapper, window, said, whole = drawn_cloud()
     for _ in range(8):
         plane = vtk.vtkPlane()
         plane.SetOrigin(0.5, 0.5, 0.5)
@@ -116,11 +112,7 @@ def test_clipping_planes_past_the_engines_say_so_once():
 def test_cropping_regions_other_than_the_sub_volume_say_so_once():
     """VTK's fence, cross and inverted cropping regions are not convex: the
     engine does not crop to them, says so once, and draws the volume whole."""
-    mapper = octoray.vtkCPUOctreeVolumeMapper()
-    mapper.SetInputData(random_cloud(1000))
-    window, said = offscreen_view(mapper, (48, 48))
-    window.Render()
-    whole = window_pixels(window)
+    mapper, window, said, whole = drawn_cloud()
     mapper.SetCropping(1)
     mapper.SetCroppingRegionFlagsToCross()
     mapper.SetCroppingRegionPlanes(0.2, 0.8, 0.2, 0.8, 0.2, 0.8)
@@ -129,6 +121,16 @@ def test_cropping_regions_other_than_the_sub_volume_say_so_once():
     assert len(said) == 1 and "crops to the sub-volume only (SetCroppingRegionFlagsToSubVolume); with " \
         "CroppingRegionFlags 0x417410 the volume is drawn uncropped." in said[0], said
     assert (window_pixels(window) == whole).all()
+
+
+def drawn_cloud():
+    """A CPU mapper drawing 1000 points in a 48x48 window, drawn once:
+    (mapper, window, the messages it said, the pixels)."""
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    window, said = offscreen_view(mapper, (48, 48))
+    window.Render()
+    return mapper, window, said, window_pixels(window)
 
 
 def window_pixels(window):
