@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -263,6 +264,27 @@ std::string ShortArray(const vtkOctreeInputHelper::Request& r)
 }
 
 //------------------------------------------------------------------------------
+// An array name the user set (`property`, not the default) that names no
+// point array: what the frame goes without, with the arrays there are, so a
+// misspelt name is seen. "" where it names one, or is the default.
+std::string MissingNamedArray(
+  vtkPointData* pd, const char* property, const char* name, const char* defaultName, const char* effect)
+{
+  if (!name || std::strcmp(name, defaultName) == 0 || pd->GetArray(name))
+  {
+    return "";
+  }
+  std::string arrays;
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  {
+    const char* other = pd->GetArrayName(i);
+    arrays += (i ? ", " : "") + std::string(other ? other : "(unnamed)");
+  }
+  return std::string(property) + " '" + name + "' names no point array of the input (its arrays: " +
+    (arrays.empty() ? "none" : arrays) + "); " + effect + ".";
+}
+
+//------------------------------------------------------------------------------
 // RootBounds that are set (min <= max) must be finite, have a size and hold
 // the input's bounds; "" where they do or are not set.
 std::string RootBoundsProblem(const vtkOctreeInputHelper::Request& r)
@@ -322,6 +344,11 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
     const char* refraction = mapper->GetRefractionArrayName();
     r.Reflectivity = reflectivity ? pd->GetArray(reflectivity) : nullptr;
     r.Refraction = refraction ? pd->GetArray(refraction) : nullptr;
+    const std::string missing[2] = {
+      MissingNamedArray(pd, "ReflectivityArrayName", reflectivity, DefaultReflectivityArrayName, "nothing reflects"),
+      MissingNamedArray(pd, "RefractionArrayName", refraction, DefaultRefractionArrayName, "nothing refracts")
+    };
+    r.Notice = missing[0] + (missing[0].empty() || missing[1].empty() ? "" : " ") + missing[1];
     r.Normals = pd->GetNormals();
     if (r.Normals && r.Normals->GetNumberOfComponents() != 3)
     {

@@ -37,6 +37,14 @@ class vtkVolumeProperty;
 class vtkOctreeInputHelper
 {
 public:
+  /**
+   * The point arrays read for reflectivity and refraction unless the mapper
+   * names others: as vtkParticleTextReader names them. Most inputs have
+   * neither, so these two missing are nothing to say.
+   */
+  static constexpr const char* DefaultReflectivityArrayName = "Reflectivity";
+  static constexpr const char* DefaultRefractionArrayName = "Refraction";
+
   enum class Change
   {
     None,      // the octree is up to date
@@ -68,6 +76,9 @@ public:
     // fewer tuples than points, which the engine would read past); "" where
     // it can.
     std::string Problem;
+    // What the frame goes on without, said once for an input (an array the
+    // mapper names that the input lacks); "" where nothing.
+    std::string Notice;
   };
 
   /**

@@ -42,8 +42,8 @@ vtkOctreeVolumeMapper::vtkOctreeVolumeMapper()
 {
   // Point clouds are surfaces more often than clouds of density: first hit.
   this->BlendMode = SURFACE_BLEND;
-  this->SetReflectivityArrayName("Reflectivity");
-  this->SetRefractionArrayName("Refraction");
+  this->SetReflectivityArrayName(vtkOctreeInputHelper::DefaultReflectivityArrayName);
+  this->SetRefractionArrayName(vtkOctreeInputHelper::DefaultRefractionArrayName);
 }
 
 //------------------------------------------------------------------------------

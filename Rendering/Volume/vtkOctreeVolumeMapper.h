@@ -298,7 +298,9 @@ public:
    * weight of the mirror ray; values outside are clamped, and each is kept
    * to 1/65532) and index of refraction (0 = opaque).
    * Defaults: "Reflectivity" and "Refraction", as vtkParticleTextReader
-   * names them.
+   * names them; an input without them neither reflects nor refracts. Any
+   * other name that names no point array of the input is said once for
+   * the input, with the arrays it has.
    */
   vtkSetStringMacro(ReflectivityArrayName);
   vtkGetStringMacro(ReflectivityArrayName);

@@ -120,6 +120,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
     this->CellScalarsWarned = true;
     vtkWarningWithObjectMacro(this->Self, "Cell scalars are not supported; the points are drawn without them.");
   }
+  if (!request.Notice.empty())
+  {
+    this->WarnOncePerInput(input, request.Notice);
+  }
   if (!request.Problem.empty())
   {
     this->WarnOncePerInput(input, request.Problem);
@@ -161,14 +165,17 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::U
 }
 
 //------------------------------------------------------------------------------
-// A warning about the input that stops the frame, said once for an input:
-// every frame tries the input again.
+// A warning about the input, said once for an input (as it is, by its
+// MTime): every frame looks at the input again.
 void vtkOctreeVolumeMapper::vtkInternals::WarnOncePerInput(vtkDataSet* input, const std::string& message)
 {
-  if (message != this->InputWarning || input->GetMTime() != this->InputWarningMTime)
+  if (input->GetMTime() != this->InputWarningMTime)
   {
-    this->InputWarning = message;
+    this->InputWarnings.clear();
     this->InputWarningMTime = input->GetMTime();
+  }
+  if (this->InputWarnings.insert(message).second)
+  {
     vtkWarningWithObjectMacro(this->Self, << message);
   }
 }

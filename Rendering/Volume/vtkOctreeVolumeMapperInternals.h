@@ -24,6 +24,7 @@
 #include <octoray/RootCube.h>
 
 #include <cstdint>
+#include <set>
 #include <string>
 
 class vtkOpenGLRenderWindow;
@@ -86,9 +87,9 @@ public:
   bool LightsWarned = false;
   bool ClipPlanesWarned = false;
   bool CroppingWarned = false;
-  // The last warning that stopped a frame and the input it was for
-  // (WarnOncePerInput): said once for an input, not at every frame.
-  std::string InputWarning;
+  // The warnings said about the input as it is, by its MTime
+  // (WarnOncePerInput): each once for an input, not at every frame.
+  std::set<std::string> InputWarnings;
   vtkMTimeType InputWarningMTime = 0;
   bool InteropUnusable = false; // said once; the host path from then on
 

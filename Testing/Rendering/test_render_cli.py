@@ -144,6 +144,30 @@ def window_pixels(window):
     return vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars()).reshape(-1, 3).copy()
 
 
+def test_a_named_array_the_input_lacks_is_said_once():
+    """ReflectivityArrayName set to a name the input has no array of (a
+    misspelling): one warning over frames, naming the property, the name
+    and the arrays there are. The default names missing say nothing: most
+    inputs have no reflectivity."""
+    import vtk
+    cloud = random_cloud(1000)
+    intensity = vtk.vtkFloatArray()
+    intensity.SetName("Intensity")
+    intensity.SetNumberOfTuples(1000)
+    intensity.Fill(1.0)
+    cloud.GetPointData().AddArray(intensity)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper)
+    window.Render()
+    assert said == []
+    mapper.SetReflectivityArrayName("reflectivity")
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "ReflectivityArrayName 'reflectivity' names no point array of the input " \
+        "(its arrays: Intensity); nothing reflects." in said[0], said
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any
