@@ -458,6 +458,72 @@ TEST_P(SceneTest, ClippedBlockCastsNoShadow)
   EXPECT_GT(floor, 5000);
 }
 
+// Where a clipping plane cuts a solid block, the cut is a flat face lit by
+// the plane's normal: every pixel that sees the cut inside the block (whose
+// voxels' occupancy gradient vanishes) has ambient + diffuse n.l of the
+// grey, with shadows on: the part of the block the plane takes away casts
+// none.
+TEST_P(SceneTest, CutFaceIsLitByTheClippingPlane)
+{
+  Scene s;
+  const float grey[3] = { 0.6f, 0.6f, 0.6f };
+  for (int i = 8; i < 24; ++i)
+    for (int j = 8; j < 24; ++j)
+      for (int k = 8; k < 24; ++k)
+        s.AddCell(5, i, j, k, grey);
+  engine->Build(s.View(), UnitCubeOptions(5));
+  HostOctree t;
+  engine->CopyToHost(t);
+  double kept[3] = { -0.6, 0.5, -0.62 }, toSun[3] = { 0.8, -0.4, 0.62 };
+  Normalize3(kept);
+  Normalize3(toSun);
+  ClipPlane cut;
+  cut.origin[0] = cut.origin[1] = cut.origin[2] = 0.5;
+  std::copy(kept, kept + 3, cut.normal);
+  const double target[3] = { 0.5, 0.5, 0.5 };
+  const double eye[3] = { 0.5 - 2 * kept[0], 0.5 - 2 * kept[1] + 0.3, 0.5 - 2 * kept[2] };
+  const int w = 96, h = 96;
+  const Matrix vp = ViewProjection(eye, target, kZUp, 40, 1.0, 0.1, 5);
+  RenderSettings settings = Settings(vp, w, h);
+  settings.clipPlanes = { cut };
+  settings.shade = ShadeMode::Phong;
+  settings.ambient = 0.2f;
+  settings.diffuse = 0.7f;
+  settings.specular = 0.0f;
+  settings.shadows = true;
+  Light sun;
+  std::copy(toSun, toSun + 3, sun.position);
+  sun.position[3] = 0;
+  settings.lights.push_back(sun);
+  const Image image = RenderChecked(*engine, settings);
+  // The cut faces the viewer: its normal is -kept.
+  const double nl = -(kept[0] * toSun[0] + kept[1] * toSun[1] + kept[2] * toSun[2]);
+  ASSERT_GT(nl, 0.2);
+  const float litValue = float((0.2 + 0.7 * nl) * 0.6);
+  const float lit[3] = { litValue, litValue, litValue };
+  int cutPixels = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+    {
+      const WorldRay r = PixelRay(vp, w, h, x, y);
+      double kept0 = 0, kept1 = 1;
+      const BruteHit b = BruteForceFirstHit(t, vp, w, h, x, y, settings.clipPlanes);
+      if (!b.hit || !KeptSpan(r, settings.clipPlanes, kept0, kept1) || b.t != kept0)
+        continue; // not on the cut
+      double lo[3], hi[3];
+      NodeBox(t, b.node, t.depth, lo, hi);
+      bool inside = true;
+      for (int a = 0; a < 3; ++a)
+        inside = inside && lo[a] * 32 > 8.5 && lo[a] * 32 < 22.5;
+      if (!inside)
+        continue; // the block's rim, whose gradient normal tilts outwards
+      ++cutPixels;
+      const float* pixel = &image.rgba[4 * Pixel(image, x, y)];
+      EXPECT_TRUE(SameRgb(pixel, lit, 1e-5f)) << "pixel " << x << "," << y << ": " << pixel[0] << ", lit " << litValue;
+    }
+  EXPECT_GT(cutPixels, 1000);
+}
+
 // ---------------------------------------------------------------- volume blend modes
 
 namespace

@@ -47,7 +47,7 @@ void TraceShadowPackets(const FrameConstants& f, const OctreeView& tree, const C
   {
     if (((valid >> lane) & 1u) && hits[lane].found)
     {
-      shadows[lane].surface = SurfaceAt(tree, pixels[lane].ray, hits[lane].hit);
+      shadows[lane].surface = SurfaceAt(f, tree, pixels[lane].ray, hits[lane].hit);
       lods[lane] = pixels[lane].lod;
       hit |= 1u << lane;
     }

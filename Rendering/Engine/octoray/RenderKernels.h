@@ -274,13 +274,34 @@ OCTORAY_HD Rgba NodeColor(const FrameConstants& f, const OctreeView& tree, std::
   return StoredColor(tree, node);
 }
 
+// The normal of the cut where a clipping plane cuts the hit voxel and the
+// ray starts there: the plane nearest the start, if one passes within the
+// voxel's size of it. False where none does.
+OCTORAY_HD bool CutNormal(const FrameConstants& f, const Ray& ray, const NodeHit& hit, Vec3f& n)
+{
+  const Vec3f start = ray.origin + ray.tMin * ray.direction;
+  float nearest = hit.size;
+  for (int i = 0; i < f.clipPlaneCount; ++i)
+  {
+    const double* c = f.clipPlanes[i];
+    const float distance = static_cast<float>(fabs(c[0] * start.x + c[1] * start.y + c[2] * start.z + c[3]));
+    if (distance < nearest)
+    {
+      nearest = distance;
+      n = Vec3f{ static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]) };
+    }
+  }
+  return nearest < hit.size;
+}
+
 // Surface normal at a hit, facing the viewer. Averaged point normals where
 // the data has them and they do not cancel (a mean shorter than half a
 // length step, 1/510, is stored as zero: OctahedralNormal.h); otherwise the
 // occupancy gradient of the six neighbours at the hit's level (it follows
-// the shape, not the voxel's blocky faces); the entry face where the
-// gradient vanishes (e.g. inside a solid block).
-OCTORAY_HD Vec3f SurfaceNormal(const OctreeView& tree, const Ray& ray, const NodeHit& hit)
+// the shape, not the voxel's blocky faces); where the gradient vanishes
+// (e.g. inside a solid block), the clipping plane's where one cuts the
+// voxel the ray starts in, else the entry face.
+OCTORAY_HD Vec3f SurfaceNormal(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit)
 {
   Vec3f n = tree.normal ? DecodeNormal(tree.normal[hit.node]) : Vec3f{ 0.0f, 0.0f, 0.0f };
   if (Dot(n, n) < 1e-6f)
@@ -297,7 +318,8 @@ OCTORAY_HD Vec3f SurfaceNormal(const OctreeView& tree, const Ray& ray, const Nod
       n[a] = below - above;
     }
   }
-  if (Dot(n, n) < 1e-6f)
+  const bool startsInside = hit.tEnter < ray.tMin;
+  if (Dot(n, n) < 1e-6f && !(startsInside && CutNormal(f, ray, hit, n)))
   {
     n = Vec3f{ 0.0f, 0.0f, 0.0f };
     const int axis = hit.axis >= 0 ? hit.axis : 2;
@@ -337,9 +359,9 @@ struct SurfacePoint
   Vec3f point, normal, view;
 };
 
-OCTORAY_HD SurfacePoint SurfaceAt(const OctreeView& tree, const Ray& ray, const NodeHit& hit)
+OCTORAY_HD SurfacePoint SurfaceAt(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit)
 {
-  return SurfacePoint{ EntryPoint(ray, hit), SurfaceNormal(tree, ray, hit), -ray.direction };
+  return SurfacePoint{ EntryPoint(ray, hit), SurfaceNormal(f, tree, ray, hit), -ray.direction };
 }
 
 OCTORAY_HD int LightsOf(const FrameConstants& f)
@@ -426,7 +448,7 @@ OCTORAY_HD Vec3f ShadeSurface(const FrameConstants& f, const OctreeView& tree, c
   {
     return albedo;
   }
-  const SurfacePoint s = traced ? traced->surface : SurfaceAt(tree, ray, hit);
+  const SurfacePoint s = traced ? traced->surface : SurfaceAt(f, tree, ray, hit);
   Vec3f lit = f.ambient * albedo;
   for (int i = 0; i < LightsOf(f); ++i)
   {
@@ -751,7 +773,7 @@ OCTORAY_HD void SpawnRays(const FrameConstants& f, const OctreeView& tree, const
   float tHit, float reflectivity, float ior, PendingRay pending[kMaxPendingRays], int& top,
   std::size_t& secondaryRays)
 {
-  const Vec3f n = SurfaceNormal(tree, path.ray, hit);
+  const Vec3f n = SurfaceNormal(f, tree, path.ray, hit);
   if (reflectivity > 0.0f && top < kMaxPendingRays)
   {
     PendingRay mirror;
