@@ -158,8 +158,9 @@ TILED_SUMMARY = "summary-tiled.txt"  # its call's closing table
 # rounds of "wholebounds" (calls 2 and 3, 42ed685 with the patch that
 # a74e097 keeps, on one machine), the forty-first's of "main" (calls 3
 # and 4, at 68179e4, beside a variant not kept), the forty-second's
-# (calls 1, 3 and 4, at fd87b4a and 42b586b, the benchmark alone) and the
-# forty-third's (call 1, at 73c5ff4, on a host that copied slowly)
+# (calls 1, 3 and 4, at fd87b4a and 42b586b, the benchmark alone), the
+# forty-third's (call 1, at 73c5ff4, on a host that copied slowly) and the
+# forty-fourth's (call 3, at 0cb9b19, the report's run before this one)
 # (COMMAND.md).
 ROUNDS_ENGINE = "a74e097"
 ROUNDS = (
@@ -167,6 +168,7 @@ ROUNDS = (
     ("forty-first", "variants-hugepages.txt", ("main-3", "main-4")),
     ("forty-second", "bench-build-rounds.txt", ("main", "main-3")),
     ("forty-third", "bench-build-rounds.txt", ("main-4",)),
+    ("forty-fourth", "bench-build-rounds.txt", ("main-5",)),
 )
 
 
