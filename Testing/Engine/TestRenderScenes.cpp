@@ -340,10 +340,14 @@ struct SunlitFloorAndBlock
     vp = ViewProjection(eye, target, kZUp, kFovy, 1.0, 0.1, 5);
   }
 
-  static Scene Points()
+  // The scene built at depth 5 on the unit cube, as the host sees it.
+  static HostOctree BuildOn(Engine& engine)
   {
     const float green[3] = { 0.2f, 0.8f, 0.2f };
-    return FloorAndBlock(green);
+    engine.Build(FloorAndBlock(green).View(), UnitCubeOptions(5));
+    HostOctree t;
+    engine.CopyToHost(t);
+    return t;
   }
 
   RenderSettings Sunlit() const
@@ -380,9 +384,7 @@ struct SunlitFloorAndBlock
 TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
 {
   const SunlitFloorAndBlock scene;
-  engine->Build(SunlitFloorAndBlock::Points().View(), UnitCubeOptions(5));
-  HostOctree t;
-  engine->CopyToHost(t);
+  const HostOctree t = scene.BuildOn(*engine);
   const int w = SunlitFloorAndBlock::kSize, h = SunlitFloorAndBlock::kSize;
   const Matrix& vp = scene.vp;
   const double* l = scene.toSun;
@@ -431,9 +433,7 @@ TEST_P(SceneTest, BlockCastsItsShadowOnTheFloor)
 TEST_P(SceneTest, ClippedBlockCastsNoShadow)
 {
   const SunlitFloorAndBlock scene;
-  engine->Build(SunlitFloorAndBlock::Points().View(), UnitCubeOptions(5));
-  HostOctree t;
-  engine->CopyToHost(t);
+  const HostOctree t = scene.BuildOn(*engine);
   const int w = SunlitFloorAndBlock::kSize, h = SunlitFloorAndBlock::kSize;
   RenderSettings settings = scene.Sunlit();
   ClipPlane below;
