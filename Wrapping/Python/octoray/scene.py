@@ -50,13 +50,19 @@ class ProgressBar:
         self.shown = -1
         self.stream = stream or sys.stderr
         self.live = self.stream.isatty()
+        self.failed = False
 
     def __call__(self, algorithm, event):
         self.show(algorithm.GetProgress())
 
+    def fail(self, *_):
+        """The algorithm failed: the bar stays where it was (VTK's pipeline
+        still reports 100 % after a failed request)."""
+        self.failed = True
+
     def show(self, fraction):
         percent = int(100 * fraction)
-        if self.shown >= 100:
+        if self.shown >= 100 or self.failed:
             return  # one bar: the pipeline may report a step again
         if percent != self.shown and (self.live or percent >= 100):
             self.shown = percent
@@ -119,11 +125,11 @@ def read(path, file_range=(0, 0), progress_label="reading", stream=None, configu
     nothing was read, the caller says reader.GetErrorMessage(), which names
     the file and the line or slice. Warnings are printed as they come."""
     reader = make_reader(path, file_range)
+    bar = ProgressBar(progress_label, stream) if progress_label else None
     for source in (reader, reader.GetExecutive()):
-        source.AddObserver("ErrorEvent", lambda caller, event: None)
+        source.AddObserver("ErrorEvent", bar.fail if bar else lambda caller, event: None)
     if configure:
         configure(reader)
-    bar = ProgressBar(progress_label, stream) if progress_label else None
     if bar:
         reader.AddObserver("ProgressEvent", bar)
     with Timer() as t:
