@@ -1,6 +1,7 @@
 #include "vtkOctreeInputHelper.h"
 
 #include "vtkAbstractMapper.h"
+#include "vtkColorTransferFunction.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -56,6 +57,82 @@ const float* FloatComponents(vtkDataArray* array, int components, std::vector<fl
   return storage.data();
 }
 
+// The value the transfer functions read from a tuple of `comps` values: one
+// component, or the tuple's length (Request::ScalarComponent).
+double ScalarValue(const double* tuple, int comps, int component)
+{
+  if (component != vtkOctreeInputHelper::kMagnitude)
+  {
+    return tuple[component];
+  }
+  double sum = 0.0;
+  for (int c = 0; c < comps; ++c)
+  {
+    sum += tuple[c] * tuple[c];
+  }
+  return std::sqrt(sum);
+}
+
+// One float a point for the transfer functions: the array's own memory
+// where it is one float component, else each tuple's ScalarValue.
+const float* ScalarValues(vtkDataArray* array, int component, std::vector<float>& storage)
+{
+  if (component == 0)
+  {
+    return FloatComponents(array, 1, storage);
+  }
+  const int comps = array->GetNumberOfComponents();
+  storage.resize(static_cast<std::size_t>(array->GetNumberOfTuples()));
+  vtkSMPTools::For(0, array->GetNumberOfTuples(), [&](vtkIdType begin, vtkIdType end) {
+    std::vector<double> tuple(comps);
+    for (vtkIdType i = begin; i < end; ++i)
+    {
+      array->GetTuple(i, tuple.data());
+      storage[i] = static_cast<float>(ScalarValue(tuple.data(), comps, component));
+    }
+  });
+  return storage.data();
+}
+
+std::string ComponentName(int component)
+{
+  return component == vtkOctreeInputHelper::kMagnitude ? "magnitude" : "component " + std::to_string(component);
+}
+
+// Which value of multi-component scalars the transfer functions read, as
+// vtkScalarsToColors maps vectors and ParaView's colour map offers them
+// (Magnitude, X, Y, Z): the colour function's VectorMode and
+// VectorComponent; component 0 under a grey function, which has neither.
+// What VTK's mappers would draw otherwise goes to `notices`.
+int ScalarComponentOf(vtkVolumeProperty* property, vtkDataArray* scalars, std::vector<std::string>& notices)
+{
+  const int comps = scalars->GetNumberOfComponents();
+  if (comps < 2 || property->GetColorChannels(0) != 3)
+  {
+    return 0;
+  }
+  const std::string name = std::string("'") + (scalars->GetName() ? scalars->GetName() : "(unnamed)") + "'";
+  vtkColorTransferFunction* colour = property->GetRGBTransferFunction(0);
+  int component = vtkOctreeInputHelper::kMagnitude;
+  if (colour->GetVectorMode() != vtkScalarsToColors::MAGNITUDE)
+  {
+    component = std::clamp(colour->GetVectorComponent(), 0, comps - 1);
+    if (component != colour->GetVectorComponent())
+    {
+      notices.push_back("The colour function's VectorComponent " + std::to_string(colour->GetVectorComponent()) +
+        " is not one of the " + std::to_string(comps) + " components of the scalars " + name + "; " +
+        ComponentName(component) + " is drawn.");
+    }
+  }
+  if (!property->GetIndependentComponents())
+  {
+    notices.push_back("The scalars " + name + " have " + std::to_string(comps) +
+      " dependent components (IndependentComponents off), which the octree draws only as 3 or 4 (colours); it "
+      "draws their " + ComponentName(component) + " through the transfer functions.");
+  }
+  return component;
+}
+
 // Positions as the engine takes them: float or double without a copy, any
 // other type converted to double in `storage`.
 void PositionArrays(vtkDataArray* xyz, const float*& f, const double*& d, std::vector<double>& storage)
@@ -82,9 +159,9 @@ void PositionArrays(vtkDataArray* xyz, const float*& f, const double*& d, std::v
 }
 
 // The points of an image: every sample of `axes` (the voxels and, with
-// filling, the planes between slices; octorayLattice.h) whose value (the
-// largest component) is above the background, with its component 0 as
-// scalar or its components as RGBA colour. Two passes over the planes
+// filling, the planes between slices; octorayLattice.h) whose value is
+// above the background: the value the transfer functions read
+// (ScalarValue), or with colours the largest component, which become RGBA. Two passes over the planes
 // (count, then fill at each plane's offset), each in parallel.
 struct ImageOutput
 {
@@ -153,20 +230,23 @@ void GradientNormal(const T* data, int comps, const long long dims[3], const oct
 
 template <typename T>
 void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
-  const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, bool scalar,
+  const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, int component,
   ImageOutput out, const std::function<void(double)>& progress, const double* spacing = nullptr,
   const double* direction = nullptr)
 {
   // Gradient normals: one-component scalars, and the caller asked for them.
-  const bool normals = out.Normal && data && scalar && !colours && comps == 1 && spacing && direction;
+  const bool normals = out.Normal && data && !colours && comps == 1 && spacing && direction;
   const vtkIdType planes = static_cast<vtkIdType>(axes[2].Samples());
   auto above = [&](const double* v) {
-    double value = comps > 0 ? v[0] : 1.0; // no scalars: the whole grid
-    for (int c = 1; c < comps; ++c)
+    if (comps == 0)
     {
-      value = std::max(value, v[c]);
+      return 1.0 > background; // no scalars: the whole grid
     }
-    return value > background;
+    if (!colours)
+    {
+      return ScalarValue(v, comps, component) > background;
+    }
+    return *std::max_element(v, v + comps) > background;
   };
   // Planes in blocks, so that progress is reported from this thread.
   const vtkIdType block = std::max<vtkIdType>(1, planes / 20);
@@ -195,7 +275,7 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
   {
     (bytes ? out.Color8.resize(4 * total) : out.ColorFloat.resize(4 * total));
   }
-  else if (scalar)
+  else if (comps > 0)
   {
     out.Scalar.resize(total);
   }
@@ -230,9 +310,9 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
               }
             }
           }
-          else if (scalar)
+          else if (comps > 0)
           {
-            out.Scalar[n] = static_cast<float>(v[0]);
+            out.Scalar[n] = static_cast<float>(ScalarValue(v, comps, component));
           }
           if (normals)
           {
@@ -326,7 +406,7 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   r.Input = input;
   // The active scalars as the volume property reads them: colours when they
   // have 3 or 4 components and the components are not independent, else
-  // component 0 through the transfer functions.
+  // one value a point through the transfer functions (ScalarComponentOf).
   int cellFlag = 0;
   r.Scalars = vtkAbstractMapper::GetScalars(input, mapper->GetScalarMode(), mapper->GetArrayAccessMode(),
     mapper->GetArrayId(), mapper->GetArrayName(), cellFlag);
@@ -337,6 +417,10 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   }
   const int components = r.Scalars ? r.Scalars->GetNumberOfComponents() : 0;
   r.Colours = r.Scalars && !property->GetIndependentComponents() && (components == 3 || components == 4);
+  if (r.Scalars && !r.Colours)
+  {
+    r.ScalarComponent = ScalarComponentOf(property, r.Scalars, r.Notices);
+  }
   if (vtkPointSet::SafeDownCast(input))
   {
     vtkPointData* pd = input->GetPointData();
@@ -348,7 +432,13 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
       MissingNamedArray(pd, "ReflectivityArrayName", reflectivity, DefaultReflectivityArrayName, "nothing reflects"),
       MissingNamedArray(pd, "RefractionArrayName", refraction, DefaultRefractionArrayName, "nothing refracts")
     };
-    r.Notice = missing[0] + (missing[0].empty() || missing[1].empty() ? "" : " ") + missing[1];
+    for (const std::string& notice : missing)
+    {
+      if (!notice.empty())
+      {
+        r.Notices.push_back(notice);
+      }
+    }
     r.Normals = pd->GetNormals();
     if (r.Normals && r.Normals->GetNumberOfComponents() != 3)
     {
@@ -384,7 +474,8 @@ vtkOctreeInputHelper::Signature vtkOctreeInputHelper::Sign(const Request& r)
   Signature s;
   s.Input = r.Input;
   s.Count = r.Input->GetNumberOfPoints();
-  s.Layout = std::string(r.Colours ? "colours" : (r.Scalars ? "scalars" : "plain")) +
+  const std::string scalars = r.Scalars ? "scalars:" + ComponentName(r.ScalarComponent) : "plain";
+  s.Layout = (r.Colours ? "colours" : scalars) +
     (r.Reflectivity ? "+reflectivity" : "") + (r.Refraction ? "+refraction" : "") + (r.Normals ? "+normals" : "");
   auto* pointSet = vtkPointSet::SafeDownCast(r.Input);
   if (!pointSet)
@@ -505,7 +596,7 @@ void vtkOctreeInputHelper::PointSetView(const Request& r, octoray::PointCloudVie
   }
   else if (r.Scalars)
   {
-    view.scalar = FloatComponents(r.Scalars, 1, this->Scalar); // component 0
+    view.scalar = ScalarValues(r.Scalars, r.ScalarComponent, this->Scalar);
   }
   view.reflectivity = r.Reflectivity ? FloatComponents(r.Reflectivity, 1, this->Reflectivity) : nullptr;
   view.refraction = r.Refraction ? FloatComponents(r.Refraction, 1, this->Refraction) : nullptr;
@@ -588,14 +679,14 @@ void vtkOctreeInputHelper::ImageView(
   if (!scalars)
   {
     const double* none = nullptr;
-    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, false, out, progress);
+    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, 0, out, progress);
   }
   else if (scalars->HasStandardMemoryLayout())
   {
     switch (scalars->GetDataType())
     {
       vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
-        lattice, r.ImageBackground, r.Colours, bytes, true, out, progress, spacing, direction));
+        lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent, out, progress, spacing, direction));
     }
   }
   else
@@ -606,7 +697,8 @@ void vtkOctreeInputHelper::ImageView(
     {
       scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
     }
-    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, true, out, progress,
+    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent, out,
+      progress,
       spacing, direction);
   }
   view.count = this->Xyz.size() / 3;

@@ -61,6 +61,9 @@ public:
     vtkDataSet* Input = nullptr;
     vtkDataArray* Scalars = nullptr; // active scalars (point data only)
     bool Colours = false;            // Scalars are RGB(A) colours, not through the transfer function
+    // Which value of multi-component Scalars the transfer functions read:
+    // a component, or kMagnitude (ScalarComponentOf).
+    int ScalarComponent = 0;
     vtkDataArray* Reflectivity = nullptr;
     vtkDataArray* Refraction = nullptr;
     vtkDataArray* Normals = nullptr;
@@ -76,10 +79,16 @@ public:
     // fewer tuples than points, which the engine would read past); "" where
     // it can.
     std::string Problem;
-    // What the frame goes on without, said once for an input (an array the
-    // mapper names that the input lacks); "" where nothing.
-    std::string Notice;
+    // What the frame goes on without or draws otherwise than VTK's mappers
+    // would, each said once for an input (an array the mapper names that
+    // the input lacks, scalar components the octree does not draw).
+    std::vector<std::string> Notices;
   };
+
+  /**
+   * Request::ScalarComponent for the length of each tuple.
+   */
+  static constexpr int kMagnitude = -1;
 
   /**
    * The request for `input` as `mapper` and `property` select its arrays.

@@ -27,8 +27,9 @@ void vtkOctreeRenderSettings::SetCamera(
 }
 
 //------------------------------------------------------------------------------
-octoray::BlendMode vtkOctreeRenderSettings::Blend(int vtkBlendMode)
+octoray::BlendMode vtkOctreeRenderSettings::Blend(int vtkBlendMode, std::string& approximation)
 {
+  approximation.clear();
   switch (vtkBlendMode)
   {
     case vtkVolumeMapper::COMPOSITE_BLEND:
@@ -41,7 +42,19 @@ octoray::BlendMode vtkOctreeRenderSettings::Blend(int vtkBlendMode)
       return octoray::BlendMode::Average;
     case vtkVolumeMapper::ADDITIVE_BLEND:
       return octoray::BlendMode::Additive;
-    default: // SURFACE_BLEND, and ISOSURFACE_BLEND as the nearest to it
+    case vtkOctreeVolumeMapper::SURFACE_BLEND:
+      return octoray::BlendMode::Surface;
+    case vtkVolumeMapper::ISOSURFACE_BLEND:
+      approximation = "BlendMode ISOSURFACE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, not the "
+                      "volume property's iso-values.";
+      return octoray::BlendMode::Surface;
+    case vtkVolumeMapper::SLICE_BLEND:
+      approximation = "BlendMode SLICE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, not the "
+                      "volume property's slice function.";
+      return octoray::BlendMode::Surface;
+    default:
+      approximation = "BlendMode " + std::to_string(vtkBlendMode) +
+        " is not one of VTK's; it is drawn as SURFACE_BLEND, the first voxel a ray meets.";
       return octoray::BlendMode::Surface;
   }
 }

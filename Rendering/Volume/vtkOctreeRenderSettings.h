@@ -17,6 +17,7 @@
 #include <octoray/Render.h> // for octoray::RenderSettings
 
 #include <cstdint> // for std::uint64_t
+#include <string>  // for std::string
 #include <vector>  // for std::vector
 
 class vtkCamera;
@@ -38,10 +39,12 @@ public:
     vtkCamera* camera, double aspect, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings);
 
   /**
-   * VTK's blend mode as the engine's: SURFACE_BLEND, and ISOSURFACE_BLEND as
-   * its nearest, are first hits.
+   * VTK's blend mode as the engine's. Where the engine has none of its own
+   * (ISOSURFACE_BLEND, SLICE_BLEND, a value VTK does not know), the nearest,
+   * the first hit (SURFACE_BLEND), with what is drawn instead in
+   * `approximation`; "" otherwise.
    */
-  static octoray::BlendMode Blend(int vtkBlendMode);
+  static octoray::BlendMode Blend(int vtkBlendMode, std::string& approximation);
 
   /**
    * Shade mode and Phong coefficients of component 0 of `property`: Phong

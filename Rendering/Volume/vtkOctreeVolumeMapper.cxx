@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace
 {
@@ -126,6 +127,45 @@ void vtkOctreeVolumeMapper::SetInputData(vtkImageData* input)
 void vtkOctreeVolumeMapper::SetInputData(vtkRectilinearGrid* input)
 {
   this->SetInputData(static_cast<vtkDataSet*>(input));
+}
+
+//------------------------------------------------------------------------------
+// vtkSetClampMacro lets a NaN through (no comparison holds for it), and
+// frames would trace with it: a NaN is refused by name, the value kept.
+void vtkOctreeVolumeMapper::SetNumber(const char* name, double value, double low, double high, double& member)
+{
+  if (std::isnan(value))
+  {
+    vtkErrorMacro(<< name << " must be a number, not NaN; it stays " << member << ".");
+    return;
+  }
+  value = std::clamp(value, low, high);
+  if (member != value)
+  {
+    member = value;
+    this->Modified();
+  }
+}
+
+void vtkOctreeVolumeMapper::SetLODPixelThreshold(double pixels)
+{
+  this->SetNumber("LODPixelThreshold", pixels, 0.0, VTK_DOUBLE_MAX, this->LODPixelThreshold);
+}
+
+void vtkOctreeVolumeMapper::SetDepthCue(double fraction)
+{
+  this->SetNumber("DepthCue", fraction, 0.0, 1.0, this->DepthCue);
+}
+
+void vtkOctreeVolumeMapper::SetImageSampleDistance(double pixels)
+{
+  this->SetNumber("ImageSampleDistance", pixels, 1.0, 32.0, this->ImageSampleDistance);
+}
+
+void vtkOctreeVolumeMapper::SetImageBackground(double value)
+{
+  const double infinity = std::numeric_limits<double>::infinity();
+  this->SetNumber("ImageBackground", value, -infinity, infinity, this->ImageBackground);
 }
 
 //------------------------------------------------------------------------------

@@ -20,10 +20,17 @@
  *   gl_FragDepth, so the octree hides and is hidden by other actors;
  * - vtkVolumeProperty: shade on/off, ambient, diffuse, specular, specular
  *   power, the colour transfer function and scalar opacity on the active
- *   scalars; with IndependentComponents off, 3- or 4-component active
- *   scalars are colours;
+ *   scalars; of several components, on the value the colour function's
+ *   VectorMode and VectorComponent choose (the magnitude or one component),
+ *   as vtkScalarsToColors maps vectors and ParaView's colour map offers
+ *   them; with IndependentComponents off, 3- or 4-component active scalars
+ *   are colours (other dependent components are said once);
  * - blend modes: composite, maximum, minimum, average, additive, and
- *   SURFACE_BLEND (first hit; also used for ISOSURFACE_BLEND), the default;
+ *   SURFACE_BLEND (first hit), the default; ISOSURFACE_BLEND, SLICE_BLEND
+ *   and values VTK does not know draw as SURFACE_BLEND and say so once;
+ * - settings no frame can be drawn with (a NaN from the volume property,
+ *   which VTK's clamped setters let through) are an error said once, and
+ *   nothing is drawn until they change; the octree is kept;
  * - renderer lights (headlight, camera and scene lights, positional or
  *   directional, colour and intensity) become engine lights;
  * - clipping planes (AddClippingPlane, in world coordinates) and cropping
@@ -211,8 +218,9 @@ public:
    * (a see-through, speckled picture of a dense cloud), are drawn by their
    * ancestor of about a pixel, and the trace does not pay for descending
    * below what the screen shows. 0 always descends to the leaves.
+   * Clamped to 0 and above; NaN is an error and leaves the value.
    */
-  vtkSetClampMacro(LODPixelThreshold, double, 0.0, VTK_DOUBLE_MAX);
+  virtual void SetLODPixelThreshold(double pixels);
   vtkGetMacro(LODPixelThreshold, double);
   ///@}
 
@@ -237,8 +245,9 @@ public:
   /**
    * Depth cue for unshaded surface rendering: the fraction of brightness
    * lost at the far side of the octree. 0 (the default) turns it off.
+   * Clamped to 0..1; NaN is an error and leaves the value.
    */
-  vtkSetClampMacro(DepthCue, double, 0.0, 1.0);
+  virtual void SetDepthCue(double fraction);
   vtkGetMacro(DepthCue, double);
   ///@}
 
@@ -246,18 +255,22 @@ public:
   /**
    * Trace one ray per ImageSampleDistance x ImageSampleDistance pixels and
    * stretch the picture over the viewport. 1 (the default) traces every
-   * pixel.
+   * pixel. Clamped to 1..32 and rounded to whole pixels when traced; NaN
+   * is an error and leaves the value.
    */
-  vtkSetClampMacro(ImageSampleDistance, double, 1.0, 32.0);
+  virtual void SetImageSampleDistance(double pixels);
   vtkGetMacro(ImageSampleDistance, double);
   ///@}
 
   ///@{
   /**
-   * vtkImageData input: voxels whose value (the largest component) is at or
-   * below this become no point. Default 0.
+   * vtkImageData input: voxels whose value is at or below this become no
+   * point: the value the transfer functions read (with several components,
+   * the one the colour function's VectorMode and VectorComponent choose), or
+   * with colours the largest component. Default 0. NaN is an error and
+   * leaves the value.
    */
-  vtkSetMacro(ImageBackground, double);
+  virtual void SetImageBackground(double value);
   vtkGetMacro(ImageBackground, double);
   ///@}
 
@@ -436,6 +449,7 @@ private:
   void operator=(const vtkOctreeVolumeMapper&) = delete;
 
   vtkDataSet* UpdatedInput();
+  void SetNumber(const char* name, double value, double low, double high, double& member);
 
   // The engine, the input helper, the frame and the compositor; it does the
   // work of Render() (vtkOctreeVolumeMapper.cxx).

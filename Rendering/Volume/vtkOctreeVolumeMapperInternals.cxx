@@ -115,14 +115,13 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::P
 {
   const vtkOctreeInputHelper::Request request =
     vtkOctreeInputHelper::MakeRequest(input, this->Self, property, this->Backend.Generation());
-  if (request.CellScalars && !this->CellScalarsWarned)
+  if (request.CellScalars)
   {
-    this->CellScalarsWarned = true;
-    vtkWarningWithObjectMacro(this->Self, "Cell scalars are not supported; the points are drawn without them.");
+    this->WarnOnce("Cell scalars are not supported; the points are drawn without them.");
   }
-  if (!request.Notice.empty())
+  for (const std::string& notice : request.Notices)
   {
-    this->WarnOncePerInput(input, request.Notice);
+    this->WarnOncePerInput(input, notice);
   }
   if (!request.Problem.empty())
   {
@@ -162,6 +161,17 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::U
     this->Self->LastBuildSeconds = Now() - start;
   }
   return step;
+}
+
+//------------------------------------------------------------------------------
+// A warning about the settings or the renderer, once for the mapper, each
+// different text: frames come many a second, and repeat what rarely changes.
+void vtkOctreeVolumeMapper::vtkInternals::WarnOnce(const std::string& message)
+{
+  if (this->SettingsWarnings.insert(message).second)
+  {
+    vtkWarningWithObjectMacro(this->Self, << message);
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -286,17 +296,21 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
   s.width = (width + step - 1) / step;
   s.height = (height + step - 1) / step;
   vtkOctreeRenderSettings::SetCamera(ren->GetActiveCamera(), ren->GetTiledAspectRatio(), vol->GetMatrix(), s);
-  s.blend = vtkOctreeRenderSettings::Blend(self->BlendMode);
+  std::string blendApproximation;
+  s.blend = vtkOctreeRenderSettings::Blend(self->BlendMode, blendApproximation);
+  if (!blendApproximation.empty())
+  {
+    this->WarnOnce(blendApproximation);
+  }
   vtkOctreeRenderSettings::SetShading(property, self->DepthCue, s);
   s.shadows = self->Shadows;
   s.maxBounces = self->MaximumBounces;
   s.lodPixels = static_cast<float>(self->LODPixelThreshold);
   const int ignoredLights = vtkOctreeRenderSettings::SetLights(ren->GetLights(), vol->GetMatrix(), s);
-  if (ignoredLights > 0 && !this->LightsWarned)
+  if (ignoredLights > 0)
   {
-    this->LightsWarned = true; // once: the renderer's lights rarely change, and frames come many a second
-    vtkWarningWithObjectMacro(self, "The octree engine takes at most " << octoray::kMaxLights << " lights; "
-        << ignoredLights << " more are ignored.");
+    this->WarnOnce("The octree engine takes at most " + std::to_string(octoray::kMaxLights) + " lights; " +
+      std::to_string(ignoredLights) + " more are ignored.");
   }
   this->SetClipPlanes(vol, s);
   // Transfer function on the scalars (unless the points carry colours).
@@ -315,11 +329,10 @@ void vtkOctreeVolumeMapper::vtkInternals::SetClipPlanes(vtkVolume* vol, octoray:
   vtkOctreeVolumeMapper* self = this->Self;
   const int ignored =
     vtkOctreeRenderSettings::SetClipPlanes(self->GetClippingPlanes(), vol->GetMatrix(), this->CroppingBox(), s);
-  if (ignored > 0 && !this->ClipPlanesWarned)
+  if (ignored > 0)
   {
-    this->ClipPlanesWarned = true;
-    vtkWarningWithObjectMacro(self, "The octree engine takes at most " << octoray::kMaxClipPlanes
-        << " clipping planes, a cropping box's six faces among them; " << ignored << " more are ignored.");
+    this->WarnOnce("The octree engine takes at most " + std::to_string(octoray::kMaxClipPlanes) +
+      " clipping planes, a cropping box's six faces among them; " + std::to_string(ignored) + " more are ignored.");
   }
 }
 
@@ -338,15 +351,10 @@ const double* vtkOctreeVolumeMapper::vtkInternals::CroppingBox()
   {
     return self->GetCroppingRegionPlanes();
   }
-  if (!this->CroppingWarned)
-  {
-    this->CroppingWarned = true;
-    std::ostringstream flags; // VTK's warning stream takes no manipulators
-    flags << "0x" << std::hex << self->GetCroppingRegionFlags();
-    vtkWarningWithObjectMacro(self, "The octree engine crops to the sub-volume only "
-                                    "(SetCroppingRegionFlagsToSubVolume); with CroppingRegionFlags "
-        << flags.str() << " the volume is drawn uncropped.");
-  }
+  std::ostringstream flags;
+  flags << "0x" << std::hex << self->GetCroppingRegionFlags();
+  this->WarnOnce("The octree engine crops to the sub-volume only (SetCroppingRegionFlagsToSubVolume); with "
+                 "CroppingRegionFlags " + flags.str() + " the volume is drawn uncropped.");
   return nullptr;
 }
 
@@ -398,6 +406,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
       return step;
     }
   }
+  if (!this->Drawable(s))
+  {
+    return Step::Stop;
+  }
   const vtkOctreeRenderSettings::TraceKey key = vtkOctreeRenderSettings::TraceKey::Of(
     s, self->GetMTime(), vol->GetProperty()->GetMTime(), this->OctreeVersion, depthSignature);
   if (key == this->LastTrace && this->Compositor.HasPicture())
@@ -411,6 +423,30 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
     this->LastTrace = key;
   }
   return traced;
+}
+
+//------------------------------------------------------------------------------
+// Settings no frame can be drawn with (octoray::CheckSettings: a NaN in the
+// volume property, which VTK's clamped setters let through): an error said
+// once while they last, and no trace. Checked here, not left to the trace,
+// whose failure would drop the octree (vtkInternals::Report).
+bool vtkOctreeVolumeMapper::vtkInternals::Drawable(const octoray::RenderSettings& s)
+{
+  try
+  {
+    octoray::CheckSettings(s);
+    this->SettingsProblem.clear();
+    return true;
+  }
+  catch (const std::exception& e)
+  {
+    if (this->SettingsProblem != e.what())
+    {
+      this->SettingsProblem = e.what();
+      vtkErrorWithObjectMacro(this->Self, << e.what());
+    }
+    return false;
+  }
 }
 
 //------------------------------------------------------------------------------

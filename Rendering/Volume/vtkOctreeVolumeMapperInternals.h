@@ -67,6 +67,8 @@ public:
   Step Run(const char* what, Call&& call);
   Step Report(vtkOctreeBackend::Status status);
   void WarnOncePerInput(vtkDataSet* input, const std::string& message);
+  void WarnOnce(const std::string& message);
+  bool Drawable(const octoray::RenderSettings& settings);
   // Whether the octree held is `input`'s (the getters describe no other).
   bool OctreeOf(vtkDataSet* input) const { return this->Input.HasOctree() && this->BuiltFor == input; }
   void WarnNothingToDraw(const vtkOctreeInputHelper::Request& request);
@@ -83,10 +85,10 @@ public:
   vtkDataSet* BuiltFor = nullptr;
   vtkMTimeType BuiltMTime = 0;
   bool BuiltWithPoints = false; // KeepPointsForUpdates at the last build: Update can run
-  bool CellScalarsWarned = false;
-  bool LightsWarned = false;
-  bool ClipPlanesWarned = false;
-  bool CroppingWarned = false;
+  // The warnings said about the mapper's settings and the renderer's
+  // (WarnOnce): each once, not at every frame.
+  std::set<std::string> SettingsWarnings;
+  std::string SettingsProblem; // the error of the last frame's settings, said once; "" where none
   // The warnings said about the input as it is, by its MTime
   // (WarnOncePerInput): each once for an input, not at every frame.
   std::set<std::string> InputWarnings;

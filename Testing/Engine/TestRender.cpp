@@ -7,6 +7,10 @@
 #include <octoray/PacketTraversal.h>
 #include <octoray/ReferenceTraversal.h>
 
+#include <limits>
+#include <string>
+#include <utility>
+
 using namespace octoray;
 using namespace octoray::test;
 
@@ -431,6 +435,28 @@ TEST_P(RenderTest, BadSettingsAreErrors)
     EXPECT_STREQ(e.what(), "octoray: clipping plane 1 needs a finite origin and a non-zero normal, got (1.000000, "
                            "2.000000, 3.000000) and (0.000000, 0.000000, 0.000000)");
   }
+  s.clipPlanes.clear();
+  const std::pair<float RenderSettings::*, const char*> numbers[] = { { &RenderSettings::ambient,
+                                                                        "ambient coefficient" },
+    { &RenderSettings::diffuse, "diffuse coefficient" }, { &RenderSettings::specular, "specular coefficient" },
+    { &RenderSettings::specularPower, "specular power" }, { &RenderSettings::depthCue, "depth cue" },
+    { &RenderSettings::lodPixels, "level-of-detail pixel size" },
+    { &RenderSettings::opacityUnitDistance, "opacity unit distance" } };
+  for (const auto& number : numbers)
+  {
+    RenderSettings bad = s;
+    bad.*number.first = std::numeric_limits<float>::quiet_NaN();
+    try
+    {
+      engine->Render(bad, image);
+      FAIL() << "no error for a NaN " << number.second;
+    }
+    catch (const Error& e)
+    {
+      EXPECT_EQ(e.what(), "octoray: the " + std::string(number.second) + " must be a finite number, got nan");
+    }
+  }
+  engine->Render(s, image); // the same settings without a NaN draw
 }
 
 TEST_P(RenderTest, EightBitOutputIsTheRoundedFloatPicture)

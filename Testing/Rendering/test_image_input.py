@@ -216,3 +216,35 @@ def test_a_small_change_of_the_background_rebuilds():
     assert mapper.GetNumberOfBuilds() == 2
     assert mapper.GetNumberOfOctreePoints() == int((values > 5e-8).sum()) < low
 
+
+
+def test_vector_voxels_go_by_the_value_the_colour_function_reads():
+    """A 3-component image through the transfer functions in Magnitude
+    mode: a voxel is a point where its magnitude is above ImageBackground,
+    and the picture equals that of a 1-component image of the magnitudes
+    (float). Before, the largest component was compared and component 0
+    drawn."""
+    vectors = np.random.default_rng(7).normal(size=(12, 12, 12, 3)).astype(np.float32)
+    magnitude = np.linalg.norm(vectors.astype(float), axis=3)
+    vector_image = image(magnitude, (1.0, 1.0, 1.0))
+    components = numpy_to_vtk(vectors.reshape(-1, 3), deep=1)
+    components.SetName("Velocity")
+    vector_image.GetPointData().SetScalars(components)
+
+    def draw(data):
+        def lights(ren, prop):
+            ramp = vtk.vtkColorTransferFunction()
+            ramp.AddRGBPoint(0.0, 0, 0, 1)
+            ramp.AddRGBPoint(3.0, 1, 0, 0)
+            ramp.SetVectorModeToMagnitude()
+            prop.SetColor(ramp)
+        mapper, window = render(data, configure=lambda m: m.SetImageBackground(1.5), lights=lights)
+        grab = vtk.vtkWindowToImageFilter()
+        grab.SetInput(window)
+        grab.Update()
+        return mapper, vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars()).copy()
+    mapper, drawn = draw(vector_image)
+    expected_mapper, expected = draw(image(magnitude, (1.0, 1.0, 1.0)))
+    assert mapper.GetNumberOfOctreePoints() == int((magnitude.astype(np.float32) > 1.5).sum())
+    assert expected_mapper.GetNumberOfOctreePoints() == mapper.GetNumberOfOctreePoints()
+    assert (drawn == expected).all(), (drawn != expected).any(axis=1).sum()

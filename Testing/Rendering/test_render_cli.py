@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 import octoray
 from mapper_views import offscreen_view
 from octoray.png import read_png
@@ -266,6 +267,124 @@ def test_non_finite_scalars_leave_the_transfer_function_its_range():
         reddish = ((rgb[:, 0] > 2 * rgb[:, 2]) & (rgb[:, 0] > 60)).mean()
         bluish = ((rgb[:, 2] > 2 * rgb[:, 0]) & (rgb[:, 2] > 60)).mean()
         assert said == [] and reddish > 0.02 and bluish > 0.02, (bad, said, reddish, bluish)
+
+
+@pytest.mark.parametrize("setter, kept", [
+    ("DepthCue", 0.0), ("ImageSampleDistance", 1.0), ("LODPixelThreshold", 1.0), ("ImageBackground", 0.0)])
+def test_a_nan_setting_is_refused_by_name(setter, kept):
+    """vtkSetClampMacro lets a NaN through; these setters refuse it with an
+    error naming the property, and keep the value."""
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    said = []
+
+    def observe(caller, event, text):
+        said.append(text)
+    import vtk
+    observe.CallDataType = vtk.VTK_STRING
+    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
+    getattr(mapper, "Set" + setter)(float("nan"))
+    assert getattr(mapper, "Get" + setter)() == kept
+    assert len(said) == 1 and f"{setter} must be a number, not NaN; it stays {kept:g}." in said[0], said
+
+
+def test_a_nan_shading_number_is_said_once_and_keeps_the_octree():
+    """A NaN ambient (vtkVolumeProperty lets one through; it drew every pixel
+    black): one error over frames naming it, nothing drawn, the octree kept;
+    once it is a number again the cloud is drawn as before."""
+    mapper, window, said, whole = drawn_cloud()
+    prop = window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty()
+    ambient = prop.GetAmbient()
+    prop.SetAmbient(float("nan"))
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and "the ambient coefficient must be a finite number, got nan" in said[0], said
+    assert not window_pixels(window).any()
+    prop.SetAmbient(ambient)
+    window.Render()
+    assert (window_pixels(window) == whole).all() and mapper.GetNumberOfBuilds() == 1 and len(said) == 1
+
+
+@pytest.mark.parametrize("mode, expected", [
+    ("ISOSURFACE_BLEND", "BlendMode ISOSURFACE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, "
+        "not the volume property's iso-values."),
+    ("SLICE_BLEND", "BlendMode SLICE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, not the volume "
+        "property's slice function."),
+    (77, "BlendMode 77 is not one of VTK's; it is drawn as SURFACE_BLEND, the first voxel a ray meets."),
+])
+def test_a_blend_mode_the_engine_has_not_is_said_once(mode, expected):
+    """Blend modes the engine has none of its own for draw the first hit,
+    as SURFACE_BLEND does, and say so once over frames."""
+    mapper, window, said, whole = drawn_cloud()
+    mapper.SetBlendMode(getattr(mapper, mode) if isinstance(mode, str) else mode)
+    for _ in range(3):
+        window.Render()
+    assert len(said) == 1 and expected in said[0], said
+    assert (window_pixels(window) == whole).all()
+
+
+def coloured_by(cloud, configure):
+    """The RGB pixels of `cloud` drawn by a CPU mapper in a 64x64 window,
+    with a blue-to-red ramp whose colour function `configure` is given,
+    and what the mapper said."""
+    import vtk
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper, (64, 64))
+    ramp = vtk.vtkColorTransferFunction()
+    ramp.AddRGBPoint(0.0, 0, 0, 1)
+    ramp.AddRGBPoint(3.0, 1, 0, 0)
+    configure(ramp)
+    window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty().SetColor(ramp)
+    window.Render()
+    return window_pixels(window), said, mapper, ramp, window
+
+
+def test_vector_scalars_are_drawn_as_the_colour_function_maps_vectors():
+    """3-component scalars go through the transfer functions as the colour
+    function's VectorMode and VectorComponent say (ParaView's colour map:
+    Magnitude, X, Y, Z): each picture equals the one of a 1-component array
+    holding that value, in float. Changing the mode rebuilds the octree."""
+    from vtk.util.numpy_support import numpy_to_vtk
+    vectors = np.random.default_rng(4).normal(size=(3000, 3))
+    picks = {"magnitude": (lambda r: r.SetVectorModeToMagnitude(), np.linalg.norm(vectors, axis=1)),
+             "component 2": (lambda r: (r.SetVectorModeToComponent(), r.SetVectorComponent(2)), vectors[:, 2])}
+    for name, (configure, values) in picks.items():
+        cloud = random_cloud(3000, seed=5)
+        cloud.GetPointData().SetScalars(numpy_to_vtk(vectors, deep=1))
+        drawn, said, mapper, ramp, window = coloured_by(cloud, configure)
+        reference = random_cloud(3000, seed=5)
+        reference.GetPointData().SetScalars(numpy_to_vtk(values.astype(np.float32), deep=1))
+        expected = coloured_by(reference, lambda r: None)[0]
+        assert said == [] and (drawn == expected).all(), (name, said, (drawn != expected).any(axis=1).sum())
+    ramp.SetVectorModeToMagnitude()
+    window.Render()
+    assert mapper.GetNumberOfBuilds() == 2 and (window_pixels(window) != drawn).any()
+
+
+@pytest.mark.parametrize("components, independent, configure, expected", [
+    (3, True, lambda r: r.SetVectorComponent(3),
+     "The colour function's VectorComponent 3 is not one of the 3 components of the scalars 'Velocity'; "
+     "component 2 is drawn."),
+    (2, False, lambda r: None,
+     "The scalars 'Velocity' have 2 dependent components (IndependentComponents off), which the octree draws "
+     "only as 3 or 4 (colours); it draws their component 0 through the transfer functions."),
+])
+def test_scalar_components_drawn_otherwise_are_said_once(components, independent, configure, expected):
+    """A VectorComponent past the scalars' components is clamped, as
+    vtkScalarsToColors clamps it; dependent components other than colours
+    (VTK draws 2 as a value and its opacity) go through the transfer
+    functions. Each is said once over frames."""
+    from vtk.util.numpy_support import numpy_to_vtk
+    cloud = random_cloud(1000)
+    scalars = numpy_to_vtk(np.random.default_rng(6).random((1000, components)), deep=1)
+    scalars.SetName("Velocity")
+    cloud.GetPointData().SetScalars(scalars)
+    drawn, said, mapper, ramp, window = coloured_by(cloud, configure)
+    window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty() \
+        .SetIndependentComponents(independent)
+    for _ in range(3):
+        window.Render()
+    assert said == [expected] or (len(said) == 1 and expected in said[0]), said
 
 
 def test_render_particles(tmp_path):

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace octoray
 {
@@ -105,8 +106,8 @@ void CheckClipPlanes(const std::vector<ClipPlane>& planes)
     }
   }
 }
+}
 
-// Settings no frame can be drawn with: an error naming what is wrong.
 void CheckSettings(const RenderSettings& s)
 {
   if (s.width <= 0 || s.height <= 0)
@@ -124,12 +125,28 @@ void CheckSettings(const RenderSettings& s)
     throw Error("octoray: at most " + std::to_string(kMaxLights) + " lights, got " + std::to_string(s.lights.size()));
   }
   CheckClipPlanes(s.clipPlanes);
+  // A NaN here (VTK's clamped setters let one through) would turn every
+  // pixel it touches NaN, drawn black.
+  const std::pair<const char*, float> numbers[] = { { "ambient coefficient", s.ambient },
+    { "diffuse coefficient", s.diffuse }, { "specular coefficient", s.specular },
+    { "specular power", s.specularPower }, { "depth cue", s.depthCue }, { "level-of-detail pixel size", s.lodPixels },
+    { "opacity unit distance", s.opacityUnitDistance } };
+  for (const auto& number : numbers)
+  {
+    if (!std::isfinite(number.second))
+    {
+      throw Error(std::string("octoray: the ") + number.first + " must be a finite number, got " +
+        std::to_string(number.second));
+    }
+  }
   if (!s.transfer.table.empty() && !(s.transfer.range[1] > s.transfer.range[0]))
   {
     throw Error("octoray: the transfer function's scalar range is empty");
   }
 }
 
+namespace
+{
 // The camera between normalised device coordinates and the octree's unit
 // cube: unit <- world is u = (p - origin) / size, world <- unit its inverse.
 void SetCamera(const RenderSettings& s, const RootCube& cube, FrameConstants& f)

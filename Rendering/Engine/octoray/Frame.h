@@ -9,8 +9,8 @@
 
 namespace octoray
 {
-// Throws Error for settings that cannot make a picture (empty viewport, a
-// singular camera matrix, a depth buffer of the wrong size, too many lights).
+// Throws Error for settings that cannot make a picture (CheckSettings, and a
+// singular camera matrix).
 // Table and depth-buffer pointers are the host vectors of `settings`; a
 // device backend replaces them with device copies.
 // A tree whose nodes neither reflect nor refract gets a frame that casts no

@@ -94,6 +94,13 @@ struct RenderSettings
   bool rgba8 = false;
 };
 
+// Throws Error naming what no frame can be drawn with: an empty viewport, a
+// depth buffer of the wrong size, more than kMaxLights lights or
+// kMaxClipPlanes planes, a plane without a normal, a shading number that is
+// not finite, an empty transfer range. Every Render checks; a caller may
+// check first (the VTK mapper, which then keeps its octree).
+void CheckSettings(const RenderSettings& settings);
+
 // Premultiplied RGBA and window depth (1 where nothing was hit), rows from
 // the bottom, as OpenGL reads them back.
 struct Image

@@ -12,6 +12,9 @@
 #include "vtkPlaneCollection.h"
 #include "vtkTransform.h"
 
+#include <string>
+#include <utility>
+
 using namespace octoray_test;
 
 namespace
@@ -66,13 +69,33 @@ void TestCamera()
 
 void TestModes()
 {
-  CHECK(vtkOctreeRenderSettings::Blend(vtkOctreeVolumeMapper::SURFACE_BLEND) == octoray::BlendMode::Surface);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::ISOSURFACE_BLEND) == octoray::BlendMode::Surface);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::COMPOSITE_BLEND) == octoray::BlendMode::Composite);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND) == octoray::BlendMode::Maximum);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::MINIMUM_INTENSITY_BLEND) == octoray::BlendMode::Minimum);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::AVERAGE_INTENSITY_BLEND) == octoray::BlendMode::Average);
-  CHECK(vtkOctreeRenderSettings::Blend(vtkVolumeMapper::ADDITIVE_BLEND) == octoray::BlendMode::Additive);
+  // The engine's own modes, said nothing of; the others drawn as the first
+  // hit, said as such.
+  const std::pair<int, octoray::BlendMode> exact[] = { { vtkOctreeVolumeMapper::SURFACE_BLEND,
+                                                         octoray::BlendMode::Surface },
+    { vtkVolumeMapper::COMPOSITE_BLEND, octoray::BlendMode::Composite },
+    { vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND, octoray::BlendMode::Maximum },
+    { vtkVolumeMapper::MINIMUM_INTENSITY_BLEND, octoray::BlendMode::Minimum },
+    { vtkVolumeMapper::AVERAGE_INTENSITY_BLEND, octoray::BlendMode::Average },
+    { vtkVolumeMapper::ADDITIVE_BLEND, octoray::BlendMode::Additive } };
+  std::string approximation = "left from before";
+  for (const auto& mode : exact)
+  {
+    CHECK(vtkOctreeRenderSettings::Blend(mode.first, approximation) == mode.second);
+    CHECK(approximation.empty());
+  }
+  const std::pair<int, const char*> nearest[] = { { vtkVolumeMapper::ISOSURFACE_BLEND,
+                                                    "BlendMode ISOSURFACE_BLEND is drawn as SURFACE_BLEND: the first "
+                                                    "voxel a ray meets, not the volume property's iso-values." },
+    { vtkVolumeMapper::SLICE_BLEND,
+      "BlendMode SLICE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, not the volume property's "
+      "slice function." },
+    { 77, "BlendMode 77 is not one of VTK's; it is drawn as SURFACE_BLEND, the first voxel a ray meets." } };
+  for (const auto& mode : nearest)
+  {
+    CHECK(vtkOctreeRenderSettings::Blend(mode.first, approximation) == octoray::BlendMode::Surface);
+    CHECK(approximation == mode.second);
+  }
 
   vtkNew<vtkVolumeProperty> property;
   property->SetAmbient(0.25);
