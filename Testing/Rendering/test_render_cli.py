@@ -413,6 +413,38 @@ def test_render_modes_differ(tmp_path):
     assert (pictures[0] != pictures[1]).any()
 
 
+def test_clip_and_crop_reach_the_mapper(tmp_path):
+    """--clip's plane keeps the side its normal points to: below every point
+    it keeps the picture as it was, above every point it leaves nothing;
+    --crop to the low half in x leaves part of the cloud."""
+    def drawn(*cut):
+        out = tmp_path / ("cut%d.png" % len(list(tmp_path.iterdir())))
+        r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "96x96", *cut)
+        assert r.returncode == 0, r.stderr
+        return read_pixels(str(out))[2][:, :3], r.stdout
+    whole, _ = drawn()
+    kept, said = drawn("--clip", "0", "0", "-1000000000", "0", "0", "1")
+    assert (kept == whole).all() and "cut: 1 clipping plane" in said, said
+    nothing, _ = drawn("--clip", "0", "0", "1e9", "0", "0", "1")
+    assert not nothing.any()
+    half, said = drawn("--crop", "0", "0.5", "0", "1", "0", "1")
+    covered = [(p.max(axis=1) > 0).sum() for p in (whole, half)]
+    assert 0.2 * covered[0] < covered[1] < 0.8 * covered[0], covered
+    assert "cut: 0 clipping planes, cropped to a box" in said, said
+
+
+@pytest.mark.parametrize("cut, expected", [
+    (("--clip", "0", "0", "0", "0", "0", "0"), "--clip needs a finite origin and a non-zero normal, got 0 0 0 0 0 0"),
+    (("--clip", "nan", "0", "0", "0", "0", "1"), "--clip needs a finite origin and a non-zero normal, got nan 0 0 0 0 1"),
+    (("--crop", "0.5", "0.2", "0", "1", "0", "1"),
+     "--crop needs fractions 0 <= low < high <= 1 on each axis, got 0.5 0.2 0 1 0 1"),
+])
+def test_bad_cuts_are_errors_naming_the_option(tmp_path, cut, expected):
+    r = run(PARTICLES, "-o", str(tmp_path / "x.png"), *cut)
+    assert r.returncode == 2 and expected in r.stderr, r.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_render_dicom_folder(tmp_path):
     out = tmp_path / "ct.png"
     r = run(os.path.join(DATA, "DICOM", "CT_small"), "-o", str(out), "--backend", "cpu", "--size", "96x96",

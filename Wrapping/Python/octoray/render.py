@@ -6,6 +6,7 @@
         [--color-by auto|colors|intensity|z|none|ARRAY] [--normals auto|pcl|none]
         [--azimuth DEG] [--elevation DEG] [--zoom F] [--parallel] [--depth N]
         [--background LO HI] [--particles] [--no-fill]
+        [--clip OX OY OZ NX NY NZ]... [--crop X0 X1 Y0 Y1 Z0 Z1]
 
 INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
 cloud (.pcd: ascii, binary or binary_compressed), a folder of image slices or
@@ -29,6 +30,7 @@ key light above-left of the camera casts the shadows (--shadows) and a
 headlight fills them.
 """
 import argparse
+import math
 import os
 import sys
 
@@ -95,7 +97,43 @@ def parser():
                    help="slice stacks: draw the reader's particles instead of its volume")
     p.add_argument("--no-fill", action="store_true",
                    help="slice stacks: no points between slices (leaves as large as the slice spacing)")
+    p.add_argument("--clip", type=float, nargs=6, action="append", default=[],
+                   metavar=("OX", "OY", "OZ", "NX", "NY", "NZ"),
+                   help="a clipping plane through (OX, OY, OZ) in the data's coordinates, keeping the side "
+                        "its normal points to (the mapper's AddClippingPlane); repeatable")
+    p.add_argument("--crop", type=float, nargs=6, default=None, metavar=("X0", "X1", "Y0", "Y1", "Z0", "Z1"),
+                   help="keep the box between these fractions (0..1) of the drawn bounds along x, y and z "
+                        "(the mapper's cropping to the sub-volume), e.g. 0 1 0.5 1 0 1 for the far half in y")
     return p
+
+
+def check_cuts(p, args):
+    """--clip needs a finite plane with a normal, --crop fractions that
+    leave a box: an error naming the option otherwise."""
+    for plane in args.clip:
+        if not all(map(math.isfinite, plane)) or not any(plane[3:]):
+            p.error("--clip needs a finite origin and a non-zero normal, got %s" % " ".join("%g" % v for v in plane))
+    if args.crop is not None:
+        box = args.crop
+        if not all(0.0 <= box[2 * a] < box[2 * a + 1] <= 1.0 for a in range(3)):
+            p.error("--crop needs fractions 0 <= low < high <= 1 on each axis, got %s"
+                    % " ".join("%g" % v for v in box))
+
+
+def add_cuts(mapper, args, bounds):
+    """The clipping planes and the cropping box of --clip and --crop; the
+    box in fractions of `bounds`, what the camera frames."""
+    for plane in args.clip:
+        cut = vtk.vtkPlane()
+        cut.SetOrigin(*plane[:3])
+        cut.SetNormal(*plane[3:])
+        mapper.AddClippingPlane(cut)
+    if args.crop is not None:
+        box = [bounds[2 * a] + f * (bounds[2 * a + 1] - bounds[2 * a])
+               for a in range(3) for f in args.crop[2 * a:2 * a + 2]]
+        mapper.SetCropping(1)
+        mapper.SetCroppingRegionFlagsToSubVolume()
+        mapper.SetCroppingRegionPlanes(*box)
 
 
 def main(argv=None):
@@ -109,6 +147,7 @@ def main(argv=None):
                 % (args.preset, octoray.vtkOctreeVolumePresets.GetNamesAsString()))
     if not 0 <= args.depth <= 21:
         p.error("--depth must be 0 (automatic) or 1..21, got %d" % args.depth)
+    check_cuts(p, args)
     blend, shade = MODES[args.mode]
 
     # ---- Load.
@@ -223,6 +262,7 @@ def main(argv=None):
     else:
         mapper.GetVoxelBounds(bounds)
     scene.look_at(ren, bounds, front, up, args.azimuth, args.elevation, args.zoom)
+    add_cuts(mapper, args, bounds)
     ren.GetActiveCamera().SetParallelProjection(args.parallel)
 
     # ---- Build and render: the first render builds the octree.
@@ -251,6 +291,9 @@ def main(argv=None):
     print("leaf: %.6g" % mapper.GetLeafSize())
     if colouring:
         print("colour: %s" % colouring)
+    if args.clip or args.crop:
+        print("cut: %d clipping plane%s%s" % (len(args.clip), "" if len(args.clip) == 1 else "s",
+                                             ", cropped to a box" if args.crop else ""))
     print("load: %.3f s" % load)
     if normals_seconds is not None:
         print("normals: %.3f s (PCL, 16 neighbours)" % normals_seconds)

@@ -324,7 +324,7 @@ def visible_bounds(image, threshold):
         return image.GetBounds()
     values = vtk_to_numpy(scalars)
     if values.ndim > 1:
-        values = values.max(axis=1)  # as the mapper: the largest component
+        values = values.max(axis=1)  # the largest component, as the mapper compares colours
     nx, ny, nz = image.GetDimensions()
     above = (values > threshold).reshape(nz, ny, nx)
     if not above.any():
