@@ -207,6 +207,7 @@ def bench_slices(workdir, slices, size, repeats):
         r = octoray.vtkSliceStackReader()
         r.SetFilePattern(pattern)
         r.SetFileNameRange(0, slices - 1)
+        r.GradientNormalsOff()  # as the peers: points and values, no normals
         r.Update()
         return r.GetOutput().GetNumberOfPoints()
 

@@ -110,6 +110,16 @@ struct Samples
   int Comps;
   const Axis* Axes;
   const long long* Dims;
+  const double* Spacing;
+  const double* Direction; // row-major 3x3
+
+  // The normal of the grey field at sample r (GradientNormal).
+  void Normal(long long r0, long long r1, long long r2, float normal[3]) const
+  {
+    const long long r[3] = { r0, r1, r2 };
+    octoray::lattice::GradientNormal(this->Data, this->Comps, this->Dims, this->Axes, this->Spacing,
+      this->Direction, r, normal);
+  }
 
   vtkIdType Planes() const { return static_cast<vtkIdType>(this->Axes[2].Samples()); }
   template <typename Visit>
@@ -127,8 +137,9 @@ struct ParticleArrays
   vtkSmartPointer<vtkFloatArray> Points = vtkSmartPointer<vtkFloatArray>::New();
   vtkSmartPointer<vtkFloatArray> Scalars = vtkSmartPointer<vtkFloatArray>::New();
   vtkSmartPointer<vtkUnsignedCharArray> Colors; // colour images only
+  vtkSmartPointer<vtkFloatArray> Normals;        // grey images with GradientNormals only
 
-  ParticleArrays(vtkIdType n, bool colour)
+  ParticleArrays(vtkIdType n, bool colour, bool normals)
   {
     this->Points->SetNumberOfComponents(3);
     this->Points->SetNumberOfTuples(n);
@@ -140,6 +151,13 @@ struct ParticleArrays
       this->Colors->SetName("Colors");
       this->Colors->SetNumberOfComponents(3);
       this->Colors->SetNumberOfTuples(n);
+    }
+    if (normals)
+    {
+      this->Normals = vtkSmartPointer<vtkFloatArray>::New();
+      this->Normals->SetName("Normals");
+      this->Normals->SetNumberOfComponents(3);
+      this->Normals->SetNumberOfTuples(n);
     }
   }
 
@@ -156,6 +174,10 @@ struct ParticleArrays
     else
     {
       output->GetPointData()->SetScalars(this->Scalars);
+    }
+    if (this->Normals)
+    {
+      output->GetPointData()->SetNormals(this->Normals);
     }
   }
 };
@@ -190,6 +212,7 @@ void WriteParticles(const Samples<T>& samples, const Background& bg,
   float* p = arrays.Points->GetPointer(0);
   float* sc = arrays.Scalars->GetPointer(0);
   unsigned char* co = arrays.Colors ? arrays.Colors->GetPointer(0) : nullptr;
+  float* nm = arrays.Normals ? arrays.Normals->GetPointer(0) : nullptr;
   vtkSMPTools::For(0, samples.Planes(), [&](vtkIdType b, vtkIdType e) {
     for (vtkIdType s = b; s < e; ++s)
     {
@@ -213,6 +236,10 @@ void WriteParticles(const Samples<T>& samples, const Background& bg,
             co[3 * n + c] = InterpolatedToByte<T>(px[c]);
           }
         }
+        if (nm)
+        {
+          samples.Normal(r0, r1, s, &nm[3 * n]);
+        }
         ++n;
       });
     }
@@ -221,14 +248,14 @@ void WriteParticles(const Samples<T>& samples, const Background& bg,
 
 template <typename T>
 void Extract(const Samples<T>& samples, const Background& bg,
-  const octoray::lattice::Lattice& lattice, bool vertices, vtkPolyData* output)
+  const octoray::lattice::Lattice& lattice, const ParticleOptions& options, vtkPolyData* output)
 {
   const std::vector<vtkIdType> offsets = PlaneOffsets(samples, bg);
   const vtkIdType total = offsets.back();
-  const ParticleArrays arrays(total, samples.Comps >= 3);
+  const ParticleArrays arrays(total, samples.Comps >= 3, options.GradientNormals && samples.Comps == 1);
   WriteParticles(samples, bg, lattice, offsets, arrays);
   arrays.AttachTo(output);
-  if (vertices)
+  if (options.GenerateVertices)
   {
     output->SetVerts(octoray::VertexCells(total));
   }
@@ -313,12 +340,12 @@ void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyD
   const long long size[3] = { dims[0], dims[1], dims[2] };
   const int comps = image->GetNumberOfScalarComponents();
   const Background bg{ comps, options.BackgroundRange };
+  const double* direction = image->GetDirectionMatrix()->GetData();
   switch (image->GetScalarType())
   {
-    vtkTemplateMacro(
-      Extract(Samples<VTK_TT>{ static_cast<const VTK_TT*>(image->GetScalarPointer()), comps, axes,
-                size },
-        bg, lattice, options.GenerateVertices, output));
+    vtkTemplateMacro(Extract(Samples<VTK_TT>{ static_cast<const VTK_TT*>(image->GetScalarPointer()), comps,
+                               axes, size, spacing, direction },
+      bg, lattice, options, output));
   }
   // The lattice of the particles, for the octree mapper's leaf grid.
   auto field = vtkSmartPointer<vtkDoubleArray>::New();

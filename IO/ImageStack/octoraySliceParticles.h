@@ -24,6 +24,7 @@ struct ParticleOptions
   bool FillBetweenSlices = true;
   double BackgroundRange[2] = { 0, 0 };
   bool GenerateVertices = true;
+  bool GradientNormals = true;
 };
 
 // What is wrong with `options` for a stack of dims[0] x dims[1] pixels and
@@ -33,7 +34,8 @@ struct ParticleOptions
 std::string ParticleOptionsProblem(const int dims[3], const ParticleOptions& options);
 
 // Points (float), `Scalars` (intensity: grey, or the mean of R, G, B), for
-// colour images `Colors` (RGB bytes), vertex cells, PointLattice; no points
+// colour images `Colors` (RGB bytes), for grey ones with GradientNormals
+// `Normals` (octorayLattice.h's GradientNormal), vertex cells, PointLattice; no points
 // when the region of interest is empty (options as ParticleOptionsProblem
 // passes them).
 void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyData* output);

@@ -210,6 +210,7 @@ bool vtkSliceStackReader::MakeParticles(vtkImageData* image, vtkPolyData* partic
   options.FillBetweenSlices = this->FillBetweenSlices;
   std::copy_n(this->BackgroundRange, 2, options.BackgroundRange);
   options.GenerateVertices = this->GenerateVertices;
+  options.GradientNormals = this->GradientNormals;
   const std::string problem = octoray::slices::ParticleOptionsProblem(image->GetDimensions(), options);
   if (!problem.empty())
   {
@@ -358,5 +359,6 @@ void vtkSliceStackReader::PrintSelf(ostream& os, vtkIndent indent)
      << this->Stride[2] << "\n";
   os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
   os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
+  os << indent << "GradientNormals: " << this->GradientNormals << "\n";
   os << indent << "IsDICOM: " << this->IsDICOM << "\n";
 }

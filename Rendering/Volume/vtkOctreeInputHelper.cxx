@@ -172,62 +172,6 @@ struct ImageOutput
   std::vector<float>* Normal; // gradient normals (ImageGradientNormals), or null
 };
 
-// The normal of a one-component field at sample (r0, r1, r2) of the
-// (filled) lattice: the gradient by central differences (one-sided at the
-// border) at the source voxels around it, interpolated with the sample's
-// weights, through the direction matrix (row-major), negated and made unit
-// length: it points out of the denser material. (0, 0, 0) where flat.
-template <typename T>
-void GradientNormal(const T* data, int comps, const long long dims[3], const octoray::lattice::Axis axes[3],
-  const double spacing[3], const double* direction, const long long r[3], float normal[3])
-{
-  long long below[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    axes[a].Source(r[a], below[a], t[a]);
-  }
-  const long long stride[3] = { comps, comps * dims[0], comps * dims[0] * dims[1] };
-  double g[3] = { 0.0, 0.0, 0.0 };
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    double weight = 1.0;
-    long long at[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      const bool up = (corner >> a) & 1;
-      weight *= up ? t[a] : 1.0 - t[a];
-      at[a] = std::min(below[a] + (up ? 1 : 0), dims[a] - 1);
-    }
-    if (weight <= 0.0)
-    {
-      continue;
-    }
-    const long long id = at[0] * stride[0] + at[1] * stride[1] + at[2] * stride[2];
-    for (int a = 0; a < 3; ++a)
-    {
-      if (dims[a] < 2 || spacing[a] == 0.0)
-      {
-        continue;
-      }
-      const long long lo = at[a] > 0 ? id - stride[a] : id;
-      const long long hi = at[a] + 1 < dims[a] ? id + stride[a] : id;
-      const double steps = (at[a] > 0 && at[a] + 1 < dims[a]) ? 2.0 : 1.0;
-      g[a] += weight * (static_cast<double>(data[hi]) - static_cast<double>(data[lo])) / (steps * spacing[a]);
-    }
-  }
-  double world[3];
-  for (int row = 0; row < 3; ++row)
-  {
-    world[row] = direction[3 * row] * g[0] + direction[3 * row + 1] * g[1] + direction[3 * row + 2] * g[2];
-  }
-  const double length = std::sqrt(world[0] * world[0] + world[1] * world[1] + world[2] * world[2]);
-  for (int a = 0; a < 3; ++a)
-  {
-    normal[a] = length > 0.0 ? static_cast<float>(-world[a] / length) : 0.0f;
-  }
-}
-
 template <typename T>
 void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3], const long long dims[3],
   const octoray::lattice::Lattice& lattice, double background, bool colours, bool bytes, int component,
@@ -317,7 +261,7 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
           if (normals)
           {
             const long long r[3] = { r0, r1, static_cast<long long>(k) };
-            GradientNormal(data, comps, dims, axes, spacing, direction, r, &(*out.Normal)[3 * n]);
+            octoray::lattice::GradientNormal(data, comps, dims, axes, spacing, direction, r, &(*out.Normal)[3 * n]);
           }
           ++n;
         });

@@ -352,6 +352,38 @@ def test_fill_interpolates_between_neighbouring_slices(tmp_path):
     assert r.GetOutput().GetNumberOfPoints() == 3 * 4 * 5
 
 
+def test_gradient_normals_point_out_of_a_ball(tmp_path):
+    """A ball whose intensity falls linearly from its centre, slices two
+    pixel spacings apart: every particle's Normals (on by default) point away
+    from the centre (the negated gradient), the filled planes' too; off, and
+    for a colour stack, there are none."""
+    k, j, i = np.mgrid[:12, :24, :24]
+    radius = np.sqrt((i - 11.5) ** 2 + (j - 11.5) ** 2 + (2 * (k - 5.5)) ** 2)
+    vol = np.clip(1000 * (1 - radius / 11), 0, None).astype(np.uint16)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "ball%02d.png", vol)
+    r, out, msgs = reader_for(Files=files, Spacing=(1.0, 1.0, 2.0))
+    assert not msgs.errors and r.GetGradientNormals()
+    p = points(out)
+    normals = array(out, "Normals")
+    assert out.GetPointData().GetNormals() is not None and normals.shape == p.shape
+    centre = p.mean(axis=0)
+    np.testing.assert_allclose(centre, (11.5, 11.5, 11.0), atol=0.05)
+    outward = p - centre
+    distance = np.linalg.norm(outward, axis=1)
+    far = distance > 2.0  # the peak's neighbours see a kink in the cone
+    cosine = (normals[far] * outward[far]).sum(axis=1) / distance[far]
+    between = np.abs(np.round(p[far, 2], 6) % 2.0) > 0  # the filled planes
+    assert between.any() and cosine.min() > 0.97, cosine.min()
+    np.testing.assert_allclose(np.linalg.norm(normals[far], axis=1), 1.0, atol=1e-5)
+    r.SetGradientNormals(False)
+    r.Update()
+    assert r.GetOutput().GetPointData().GetNormals() is None
+    colour = np.zeros((2, 4, 4, 3), np.uint8)
+    colour[:, 1:3, 1:3] = (200, 100, 50)
+    files = write_slices(vtk.vtkPNGWriter, str(tmp_path / "colour"), "c%d.png", colour)
+    assert reader_for(Files=files)[1].GetPointData().GetNormals() is None
+
+
 def test_fill_colours(tmp_path):
     vol = np.zeros((2, 2, 2, 3), np.uint8)
     vol[0] = (10, 20, 30)

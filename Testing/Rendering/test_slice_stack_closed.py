@@ -113,13 +113,13 @@ def morph(mask, r):
     return np.logical_and.reduce(shifted) if r > 0 else np.logical_or.reduce(shifted)
 
 
-def draw(data, view, path, image=False, fill=True):
+def draw(data, view, path, image=False, fill=True, shade=False):
     mapper = octoray.vtkCPUOctreeVolumeMapper()
     mapper.SetInputData(data)
     if not fill:
         mapper.SetFillBetweenSlices(False)
     prop = vtk.vtkVolumeProperty()
-    prop.ShadeOff()
+    prop.SetShade(shade)
     ctf = vtk.vtkColorTransferFunction()
     ctf.AddRGBPoint(0, 0.9, 0.8, 0.4)
     ctf.AddRGBPoint(1000, 0.9, 0.8, 0.4)
@@ -191,6 +191,24 @@ def test_particles_close_the_gaps(block, tmp_path, name):
     assert mapper2.GetNumberOfOctreePoints() == out.GetNumberOfPoints()
     assert mapper2.GetLeafSize() == leaf
     assert np.array_equal(rgb2, rgb)
+
+
+def test_shaded_particles_draw_as_the_shaded_image(block, tmp_path):
+    """Shaded (Phong, the headlight), the particles with their gradient
+    normals (vtkSliceStackReader's GradientNormals) draw as the stack's
+    volume with the mapper's gradient normals (ImageGradientNormals): the
+    same normals, the same picture. Without them the particles' faces were
+    lit by the octree's occupancy."""
+    folder, vol = block
+    r = read(folder)
+    view = VIEWS["grazing"]
+    rgb, z, mapper = draw(r.GetOutput(), view, str(tmp_path / "particles-shaded.png"), shade=True)
+    rgb2, z2, mapper2 = draw(r.GetImageOutput(), view, str(tmp_path / "image-shaded.png"), image=True, shade=True)
+    assert np.array_equal(rgb2, rgb)
+    r.SetGradientNormals(False)
+    r.Update()
+    rgb3, z3, mapper3 = draw(r.GetOutput(), view, str(tmp_path / "particles-occupancy-normals.png"), shade=True)
+    assert not np.array_equal(rgb3, rgb)
 
 
 def test_unfilled_particles_are_closed_with_larger_leaves(block, tmp_path):

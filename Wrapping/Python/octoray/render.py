@@ -23,7 +23,8 @@ stdout.
 Defaults: --preset applies a CT transfer function (Hounsfield units) and its
 threshold; points without RGB colours are coloured by their Intensity array,
 else by elevation z, through viridis over the 1st to 99th percentile;
---mode phong estimates normals with PCL where the points have none; the
+--mode phong estimates normals with PCL where the points have none (a
+slice stack's particles carry the reader's gradient normals); the
 camera faces a DICOM head from the front (patient anterior, head up) and a
 PCD scan from its sensor, --azimuth and --elevation turn it from there; a
 key light above-left of the camera casts the shadows (--shadows) and a
