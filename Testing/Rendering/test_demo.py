@@ -29,7 +29,8 @@ def test_demo_quarter_size(tmp_path):
     out = r.stdout
     for line in ("[1/3] head CT", "108 slices, 256 x 256 x 108 voxels", "-1024..2986 HU",
                  "ct-bone  threshold 306 HU", "ct-skin  threshold -750 HU", "depth 8, leaf 0.957",
-                 "vtkSmartVolumeMapper", "[2/3] laser scan", "460,400 points", "PCL NormalEstimationOMP",
+                 "vtkSmartVolumeMapper", "cut      CT-Bone cropped to the back 55 % of the head", "1 build:",
+                 "[2/3] laser scan", "460,400 points", "PCL NormalEstimationOMP",
                  "Intensity through viridis over 0..52 (percentiles 1..99 of 0..246)",
                  "[3/3] thesis LiDAR", "1,065 points", "colours: the points' own RGB", "backend CPU",
                  "demo                               total"):
@@ -38,6 +39,7 @@ def test_demo_quarter_size(tmp_path):
     for label in ("reading", "normals", "building"):
         assert label in r.stderr
     expected = {"ct-bone.png": (240, 240), "ct-skin.png": (240, 240), "ct-compare.png": (400, 200),
+                "ct-bone-cut.png": (240, 240),
                 "scan.png": (300, 225), "lidar.png": (300, 225)}
     for name, size in expected.items():
         path = tmp_path / name
