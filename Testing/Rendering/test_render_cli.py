@@ -622,6 +622,36 @@ def test_color_by(tmp_path):
     assert r.returncode == 1 and "no RGB colours" in r.stderr
 
 
+def test_color_by_a_vector_array_is_by_its_magnitude():
+    """scene.color_by (octoray.render's --color-by) colours an array of
+    several components by its magnitude, as ParaView colours vectors: the
+    range is the magnitudes' and the picture that of a 1-component array of
+    the magnitudes (it was component 0's)."""
+    import vtk
+    from octoray import scene
+    from vtk.util.numpy_support import numpy_to_vtk
+    velocity = np.random.default_rng(8).normal(size=(3000, 3))
+    magnitude = np.linalg.norm(velocity, axis=1)
+    pictures, sentences = [], []
+    for values in (velocity, magnitude):
+        cloud = random_cloud(3000, seed=9)
+        array = numpy_to_vtk(values, deep=1)
+        array.SetName("Velocity")
+        cloud.GetPointData().AddArray(array)
+        mapper = octoray.vtkCPUOctreeVolumeMapper()
+        window, said = offscreen_view(mapper, (64, 64))
+        prop = window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty()
+        data, sentence = scene.color_by(cloud, mapper, prop, "Velocity")
+        mapper.SetInputData(data)
+        window.Render()
+        pictures.append(window_pixels(window))
+        sentences.append(sentence)
+        assert said == [], said
+    lo, hi = np.percentile(magnitude, (1, 99))
+    assert sentences[0].startswith("Velocity (magnitude) through viridis over %g..%g" % (lo, hi)), sentences[0]
+    assert (pictures[0] == pictures[1]).all(), (pictures[0] != pictures[1]).any(axis=1).sum()
+
+
 def test_normals(tmp_path):
     """--mode phong estimates PCL normals for points without them (auto);
     --normals none does not; flat modes do not need them."""

@@ -79,8 +79,8 @@ def parser():
     p.add_argument("--threshold", type=float, default=None, metavar="V",
                    help="slice stacks: voxels at or below V are empty (default: the preset's, else 0)")
     p.add_argument("--color-by", default="auto", metavar="WHAT",
-                   help="points: colors, intensity, z, none or an array name (auto: colors when the "
-                        "points have them, else Intensity, else z)")
+                   help="points: colors, intensity, z, none or an array name, by its magnitude where it has "
+                        "several components (auto: colors when the points have them, else Intensity, else z)")
     p.add_argument("--normals", choices=["auto", "pcl", "none"], default="auto",
                    help="auto: PCL normals for phong when the points have none")
     p.add_argument("--azimuth", type=float, default=0.0)

@@ -226,7 +226,9 @@ def choose_color_by(data, requested="auto"):
 def color_by(data, mapper, prop, what, percentiles=(1.0, 99.0)):
     """Sets up `mapper` and `prop` to colour `data` by `what` (see
     choose_color_by). Returns (data to draw, a sentence on what was done).
-    Arrays and z are mapped through viridis over their percentile range."""
+    Arrays and z are mapped through viridis over their percentile range;
+    an array of several components by its magnitude, as ParaView colours
+    vectors (the colour function's VectorMode, which the mapper follows)."""
     if what == "colors":
         if not has_colours(data):
             raise ValueError("the points carry no RGB colours (arrays: %s)" % array_names(data))
@@ -247,18 +249,22 @@ def color_by(data, mapper, prop, what, percentiles=(1.0, 99.0)):
         if arr is None:
             raise ValueError("no point array %r (arrays: %s)" % (what, array_names(data)))
         name, values = arr.GetName(), vtk_to_numpy(arr)
-        if values.ndim > 1:
-            values = values[:, 0]
+    ramp_name = name
+    if values.ndim > 1:
+        values = np.linalg.norm(values.astype(float), axis=1)
+        ramp_name = "%s (magnitude)" % name
     lo, hi = percentile_range(values, *percentiles)
     mapper.SetScalarModeToUsePointFieldData()
     mapper.SelectScalarArray(name)
-    prop.SetColor(colormap(lo, hi))
+    ramp = colormap(lo, hi)
+    ramp.SetVectorModeToMagnitude()
+    prop.SetColor(ramp)
     opacity = vtk.vtkPiecewiseFunction()
     opacity.AddPoint(lo, 1.0)
     opacity.AddPoint(hi, 1.0)
     prop.SetScalarOpacity(opacity)
     return data, "%s through viridis over %g..%g (percentiles %g..%g of %g..%g)" % (
-        name, lo, hi, percentiles[0], percentiles[1], float(np.min(values)), float(np.max(values)))
+        ramp_name, lo, hi, percentiles[0], percentiles[1], float(np.min(values)), float(np.max(values)))
 
 
 def array_names(data):
