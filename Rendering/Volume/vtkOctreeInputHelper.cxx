@@ -161,8 +161,9 @@ void PositionArrays(vtkDataArray* xyz, const float*& f, const double*& d, std::v
 // The points of an image: every sample of `axes` (the voxels and, with
 // filling, the planes between slices; octorayLattice.h) whose value is
 // above the background: the value the transfer functions read
-// (ScalarValue), or with colours the largest component, which become RGBA. Two passes over the planes
-// (count, then fill at each plane's offset), each in parallel.
+// (ScalarValue), or with colours, which become RGBA, the largest
+// component. Two passes over the planes (count, then fill at each plane's
+// offset), each in parallel.
 struct ImageOutput
 {
   std::vector<double>& Xyz;
