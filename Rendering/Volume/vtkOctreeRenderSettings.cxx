@@ -75,6 +75,23 @@ void vtkOctreeRenderSettings::SetShading(
 }
 
 //------------------------------------------------------------------------------
+std::string vtkOctreeRenderSettings::UnappliedProperty(vtkVolumeProperty* property)
+{
+  if (property->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
+  {
+    return "The volume property's 2D transfer function (TransferFunctionMode TF_2D) is not applied; the octree is "
+           "drawn through its colour function and scalar opacity.";
+  }
+  // As VTK's GPU ray caster decides whether to apply it.
+  if (property->HasGradientOpacity(0) && !property->GetDisableGradientOpacity(0))
+  {
+    return "The volume property's gradient opacity is not applied; the octree's opacity is the scalar opacity's "
+           "alone (DisableGradientOpacityOn turns it off, and this warning with it).";
+  }
+  return "";
+}
+
+//------------------------------------------------------------------------------
 int vtkOctreeRenderSettings::SetLights(
   vtkLightCollection* lights, vtkMatrix4x4* volumeMatrix, octoray::RenderSettings& settings)
 {

@@ -53,6 +53,13 @@ public:
   static void SetShading(vtkVolumeProperty* property, double depthCue, octoray::RenderSettings& settings);
 
   /**
+   * What of `property` the engine does not apply, as sentences to say once
+   * (a gradient opacity that VTK's mappers would apply, 2D transfer
+   * functions); "" where nothing.
+   */
+  static std::string UnappliedProperty(vtkVolumeProperty* property);
+
+  /**
    * The switched-on lights in data coordinates (camera lights and the
    * headlight carry the camera's transform). Every light off: one dark
    * light, as VTK then leaves ambient light only. Returns how many lights

@@ -24,7 +24,8 @@
  *   VectorMode and VectorComponent choose (the magnitude or one component),
  *   as vtkScalarsToColors maps vectors and ParaView's colour map offers
  *   them; with IndependentComponents off, 3- or 4-component active scalars
- *   are colours (other dependent components are said once);
+ *   are colours (other dependent components are said once); a gradient
+ *   opacity and 2D transfer functions are not applied, and said once;
  * - blend modes: composite, maximum, minimum, average, additive, and
  *   SURFACE_BLEND (first hit), the default; ISOSURFACE_BLEND, SLICE_BLEND
  *   and values VTK does not know draw as SURFACE_BLEND and say so once;

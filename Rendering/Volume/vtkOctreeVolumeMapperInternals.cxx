@@ -166,9 +166,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::U
 //------------------------------------------------------------------------------
 // A warning about the settings or the renderer, once for the mapper, each
 // different text: frames come many a second, and repeat what rarely changes.
+// "" says nothing.
 void vtkOctreeVolumeMapper::vtkInternals::WarnOnce(const std::string& message)
 {
-  if (this->SettingsWarnings.insert(message).second)
+  if (!message.empty() && this->SettingsWarnings.insert(message).second)
   {
     vtkWarningWithObjectMacro(this->Self, << message);
   }
@@ -298,11 +299,9 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
   vtkOctreeRenderSettings::SetCamera(ren->GetActiveCamera(), ren->GetTiledAspectRatio(), vol->GetMatrix(), s);
   std::string blendApproximation;
   s.blend = vtkOctreeRenderSettings::Blend(self->BlendMode, blendApproximation);
-  if (!blendApproximation.empty())
-  {
-    this->WarnOnce(blendApproximation);
-  }
+  this->WarnOnce(blendApproximation);
   vtkOctreeRenderSettings::SetShading(property, self->DepthCue, s);
+  this->WarnOnce(vtkOctreeRenderSettings::UnappliedProperty(property));
   s.shadows = self->Shadows;
   s.maxBounces = self->MaximumBounces;
   s.lodPixels = static_cast<float>(self->LODPixelThreshold);

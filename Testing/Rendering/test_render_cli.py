@@ -322,6 +322,36 @@ def test_a_blend_mode_the_engine_has_not_is_said_once(mode, expected):
     assert (window_pixels(window) == whole).all()
 
 
+@pytest.mark.parametrize("configure, expected", [
+    (lambda p: p.SetGradientOpacity(ramp_up()),
+     "The volume property's gradient opacity is not applied; the octree's opacity is the scalar opacity's alone"),
+    (lambda p: p.SetTransferFunctionModeTo2D(),
+     "The volume property's 2D transfer function (TransferFunctionMode TF_2D) is not applied"),
+    (lambda p: (p.SetGradientOpacity(ramp_up()), p.DisableGradientOpacityOn()), None),
+])
+def test_volume_property_parts_the_engine_does_not_apply_are_said_once(configure, expected):
+    """A gradient opacity (VTK's CT examples set one) or a 2D transfer
+    function: one warning over frames, the picture as without; a gradient
+    opacity switched off says nothing."""
+    mapper, window, said, whole = drawn_cloud()
+    configure(window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty())
+    for _ in range(3):
+        window.Render()
+    if expected is None:
+        assert said == [], said
+    else:
+        assert len(said) == 1 and expected in said[0], said
+    assert (window_pixels(window) == whole).all()
+
+
+def ramp_up():
+    import vtk
+    ramp = vtk.vtkPiecewiseFunction()
+    ramp.AddPoint(0, 0.0)
+    ramp.AddPoint(100, 1.0)
+    return ramp
+
+
 def coloured_by(cloud, configure):
     """The RGB pixels of `cloud` drawn by a CPU mapper in a 64x64 window,
     with a blue-to-red ramp whose colour function `configure` is given,
