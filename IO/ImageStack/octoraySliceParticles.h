@@ -24,7 +24,7 @@ struct ParticleOptions
   bool FillBetweenSlices = true;
   double BackgroundRange[2] = { 0, 0 };
   bool GenerateVertices = true;
-  bool GradientNormals = true;
+  bool GradientNormals = false;
 };
 
 // What is wrong with `options` for a stack of dims[0] x dims[1] pixels and

@@ -22,8 +22,8 @@
  * Output 0 (vtkPolyData): one particle per pixel that is not background,
  * at origin + direction * (i*sx, j*sy, k*sz), with a vertex cell each,
  * `Scalars` (the pixel intensity: the grey value, or the mean of R, G, B),
- * for colour images `Colors` (unsigned char RGB), and for grey ones
- * `Normals`, the intensities' gradient (GradientNormals). A pixel is background when
+ * for colour images `Colors` (unsigned char RGB), and for grey ones with
+ * GradientNormals on `Normals`, the intensities' gradient. A pixel is background when
  * its intensity lies in BackgroundRange (default [0, 0]) or its alpha is 0.
  * A region of interest (in pixel indices of the stack) and a stride pick the
  * pixels that are looked at.
@@ -151,12 +151,15 @@ public:
   ///@}
 
   ///@{
-  /// Particles of a grey stack carry `Normals` (default on): the negated
+  /// Particles of a grey stack carry `Normals` (default off): the negated
   /// gradient of the intensities by central differences, interpolated
   /// between slices like the values (octorayLattice.h's GradientNormal), the
   /// normals vtkOctreeVolumeMapper gives image input (ImageGradientNormals)
   /// and VTK's volume mappers shade by. Shaded, the particles then draw as
   /// the tissue's surface, not as the voxels' faces. Colour stacks have none.
+  /// Off by default: the particles are made at every update, also where
+  /// only the image output is drawn, and the normals cost a gradient a
+  /// particle.
   vtkSetMacro(GradientNormals, bool);
   vtkGetMacro(GradientNormals, bool);
   vtkBooleanMacro(GradientNormals, bool);
@@ -208,7 +211,7 @@ protected:
   int Stride[3] = { 1, 1, 1 };
   bool GenerateVertices = true;
   bool FillBetweenSlices = true;
-  bool GradientNormals = true;
+  bool GradientNormals = false;
   bool IsDICOM = false;
   std::string ErrorMessage;
   std::vector<std::string> SliceFiles;

@@ -354,15 +354,16 @@ def test_fill_interpolates_between_neighbouring_slices(tmp_path):
 
 def test_gradient_normals_point_out_of_a_ball(tmp_path):
     """A ball whose intensity falls linearly from its centre, slices two
-    pixel spacings apart: every particle's Normals (on by default) point away
-    from the centre (the negated gradient), the filled planes' too; off, and
-    for a colour stack, there are none."""
+    pixel spacings apart: with GradientNormals (off by default) every
+    particle's Normals point away from the centre (the negated gradient), the
+    filled planes' too; off, and for a colour stack, there are none."""
     k, j, i = np.mgrid[:12, :24, :24]
     radius = np.sqrt((i - 11.5) ** 2 + (j - 11.5) ** 2 + (2 * (k - 5.5)) ** 2)
     vol = np.clip(1000 * (1 - radius / 11), 0, None).astype(np.uint16)
     files = write_slices(vtk.vtkPNGWriter, str(tmp_path), "ball%02d.png", vol)
-    r, out, msgs = reader_for(Files=files, Spacing=(1.0, 1.0, 2.0))
-    assert not msgs.errors and r.GetGradientNormals()
+    assert octoray.vtkSliceStackReader().GetGradientNormals() is False
+    r, out, msgs = reader_for(Files=files, Spacing=(1.0, 1.0, 2.0), GradientNormals=True)
+    assert not msgs.errors
     p = points(out)
     normals = array(out, "Normals")
     assert out.GetPointData().GetNormals() is not None and normals.shape == p.shape
@@ -381,7 +382,7 @@ def test_gradient_normals_point_out_of_a_ball(tmp_path):
     colour = np.zeros((2, 4, 4, 3), np.uint8)
     colour[:, 1:3, 1:3] = (200, 100, 50)
     files = write_slices(vtk.vtkPNGWriter, str(tmp_path / "colour"), "c%d.png", colour)
-    assert reader_for(Files=files)[1].GetPointData().GetNormals() is None
+    assert reader_for(Files=files, GradientNormals=True)[1].GetPointData().GetNormals() is None
 
 
 def test_fill_colours(tmp_path):

@@ -484,6 +484,22 @@ def test_render_dicom_folder(tmp_path):
     assert read_pixels(str(out))[2][:, :3].max() > 0
 
 
+def test_slice_stack_particles_shade_by_the_gradient(tmp_path):
+    """--particles --mode phong: the reader's gradient normals (the image
+    output's, which python.slice_stack_closed compares), not PCL's, which
+    striped a CT along its lattice's rows; --normals none draws without
+    them, by the octree's occupancy."""
+    pictures = {}
+    for normals in ("auto", "none"):
+        out = tmp_path / ("ct-%s.png" % normals)
+        r = run(os.path.join(DATA, "DICOM", "CT_small"), "-o", str(out), "--backend", "cpu", "--size", "96x96",
+                "--mode", "phong", "--preset", "ct-bone", "--particles", "--normals", normals)
+        assert r.returncode == 0, r.stderr
+        assert "normals:" not in r.stdout, r.stdout
+        pictures[normals] = read_pixels(str(out))[2]
+    assert pictures["auto"][:, :3].max() > 0 and (pictures["auto"] != pictures["none"]).any()
+
+
 def test_render_slice_stack_closed(tmp_path):
     """A CT series (slices 2.5 mm apart, pixels 0.488 mm): filled between
     slices, leaves of the pixel size; the same points from the stack's

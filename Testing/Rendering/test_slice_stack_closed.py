@@ -201,6 +201,8 @@ def test_shaded_particles_draw_as_the_shaded_image(block, tmp_path):
     lit by the octree's occupancy."""
     folder, vol = block
     r = read(folder)
+    r.SetGradientNormals(True)
+    r.Update()
     view = VIEWS["grazing"]
     rgb, z, mapper = draw(r.GetOutput(), view, str(tmp_path / "particles-shaded.png"), shade=True)
     rgb2, z2, mapper2 = draw(r.GetImageOutput(), view, str(tmp_path / "image-shaded.png"), image=True, shade=True)
