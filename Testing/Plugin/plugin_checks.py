@@ -17,3 +17,28 @@ def finish():
         print("%d check(s) failed" % len(failures))
         sys.exit(1)
     print("OK")
+
+
+def front_view(view, focus=(1.25, 0.5, 0.0), size=(300, 200)):
+    """`view` black, without axes, `size` pixels, looking down -z at `focus`
+    (the two squares of points side by side that the colour tests draw,
+    x 0..2.5, y 0..1) and fitted to what it shows."""
+    view.ViewSize = list(size)
+    view.OrientationAxesVisibility = 0
+    view.UseColorPaletteForBackground = 0
+    view.Background = [0, 0, 0]
+    view.CameraPosition = [focus[0], focus[1], focus[2] + 6]
+    view.CameraFocalPoint = list(focus)
+    view.CameraViewUp = [0, 1, 0]
+    view.ResetCamera()
+
+
+def screenshot_rgb(path):
+    """A PNG's colours as a (height, width, 3) array of ints."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    png = vtkPNGReader()
+    png.SetFileName(path)
+    png.Update()
+    w, h, _ = png.GetOutput().GetDimensions()
+    return vtk_to_numpy(png.GetOutput().GetPointData().GetScalars())[:, :3].astype(int).reshape(h, w, 3)

@@ -15,7 +15,9 @@ green.
 import os
 import sys
 
+import numpy as np
 from paraview.simple import *  # noqa: F401,F403
+from plugin_checks import front_view, screenshot_rgb
 from vtkmodules.vtkCommonCore import vtkPoints, vtkUnsignedCharArray
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkIOPLY import vtkPLYWriter
@@ -59,31 +61,17 @@ info = r.GetDataInformation()
 check("points", info.GetNumberOfPoints(), 3200)
 check("RGB array", "RGB" in r.PointData.keys(), True)
 view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = [300, 200]
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = [0, 0, 0]
 d = Show(r, view)
 d.SetRepresentationType("Octree Volume")
 ColorBy(d, ("POINTS", "RGB"))
 d.MapScalars = 0
 d.LeafDepth = 6
-view.CameraPosition = [1.25, 0.5, 6]
-view.CameraFocalPoint = [1.25, 0.5, 0]
-view.CameraViewUp = [0, 1, 0]
-view.ResetCamera()
+front_view(view)
 out = os.path.join(work, "two_slabs.png")
 SaveScreenshot(out, view, ImageResolution=[300, 200])
 
-from vtkmodules.vtkIOImage import vtkPNGReader  # noqa: E402
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
-import numpy as np  # noqa: E402
-
-png = vtkPNGReader()
-png.SetFileName(out)
-png.Update()
-w, h, _ = png.GetOutput().GetDimensions()
-rgb = vtk_to_numpy(png.GetOutput().GetPointData().GetScalars())[:, :3].astype(int).reshape(h, w, 3)
+rgb = screenshot_rgb(out)
+h, w, _ = rgb.shape
 red = (rgb[:, :, 0] > 2 * rgb[:, :, 1]) & (rgb[:, :, 0] > 2 * rgb[:, :, 2]) & (rgb[:, :, 0] > 60)
 green = (rgb[:, :, 1] > 2 * rgb[:, :, 0]) & (rgb[:, :, 1] > 2 * rgb[:, :, 2]) & (rgb[:, :, 1] > 60)
 print(f"reddish {100 * red.mean():.1f} %, greenish {100 * green.mean():.1f} % of the picture")

@@ -21,11 +21,10 @@ import sys
 
 import numpy as np
 from paraview.simple import *  # noqa: F401,F403
+from plugin_checks import front_view, screenshot_rgb
 from vtkmodules.numpy_interface import dataset_adapter as dsa
-from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkPolyData
-from vtkmodules.vtkIOImage import vtkPNGReader
 
 plugin, work = sys.argv[1:3]
 os.makedirs(work, exist_ok=True)
@@ -54,28 +53,18 @@ def check(what, got, expected):
 source = TrivialProducer()
 source.GetClientSideObject().SetOutput(cloud)
 view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = [300, 200]
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = [0, 0, 0]
 d = Show(source, view)
 d.SetRepresentationType("Octree Volume")
 d.LeafDepth = 6
-view.CameraPosition = [1.25, 0.5, 6]
-view.CameraFocalPoint = [1.25, 0.5, 0]
-view.CameraViewUp = [0, 1, 0]
-view.ResetCamera()
+front_view(view)
 
 for colouring, red_side in (("Magnitude", "right"), ("X", "left"), ("Y", "right")):
     ColorBy(d, ("POINTS", "Velocity", colouring))
     d.RescaleTransferFunctionToDataRange(False, True)
     out = os.path.join(work, f"velocity_{colouring}.png")
     SaveScreenshot(out, view, ImageResolution=[300, 200])
-    png = vtkPNGReader()
-    png.SetFileName(out)
-    png.Update()
-    w, h, _ = png.GetOutput().GetDimensions()
-    rgb = vtk_to_numpy(png.GetOutput().GetPointData().GetScalars())[:, :3].astype(int).reshape(h, w, 3)
+    rgb = screenshot_rgb(out)
+    h, w, _ = rgb.shape
     red = (rgb[:, :, 0] > 2 * rgb[:, :, 2]) & (rgb[:, :, 0] > 60)
     blue = (rgb[:, :, 2] > 2 * rgb[:, :, 0]) & (rgb[:, :, 2] > 60)
     print(f"by {colouring}: reddish {100 * red.mean():.1f} %, bluish {100 * blue.mean():.1f} % of the picture")

@@ -3,16 +3,23 @@ drawing a mapper's volume, with the mapper's messages gathered."""
 import vtk
 
 
-def offscreen_view(mapper, size=(32, 32)):
-    """A window drawing `mapper`'s volume, with the mapper's warnings and
-    errors gathered: (window, [texts])."""
+def gathered(obj, events=(vtk.vtkCommand.WarningEvent, vtk.vtkCommand.ErrorEvent)):
+    """The texts of `obj`'s warnings and errors from now on, in a list that
+    grows as they come."""
     said = []
 
     def observe(caller, event, text):
         said.append(text)
     observe.CallDataType = vtk.VTK_STRING
-    mapper.AddObserver(vtk.vtkCommand.WarningEvent, observe)
-    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
+    for event in events:
+        obj.AddObserver(event, observe)
+    return said
+
+
+def offscreen_view(mapper, size=(32, 32)):
+    """A window drawing `mapper`'s volume, with the mapper's warnings and
+    errors gathered: (window, [texts])."""
+    said = gathered(mapper)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(vtk.vtkVolumeProperty())

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 import octoray
-from mapper_views import offscreen_view
+from mapper_views import gathered, offscreen_view
 from octoray.png import read_png
 
 DATA = os.environ.get("OCTORAY_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "Data"))
@@ -176,12 +176,7 @@ def test_a_rectilinear_grid_is_refused_by_name():
     every frame)."""
     import vtk
     mapper = octoray.vtkCPUOctreeVolumeMapper()
-    said = []
-
-    def observe(caller, event, text):
-        said.append(text)
-    observe.CallDataType = vtk.VTK_STRING
-    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
+    said = gathered(mapper)
     mapper.SetInputData(vtk.vtkRectilinearGrid())
     assert len(said) == 1 and "not a vtkRectilinearGrid" in said[0], said
     assert mapper.GetInput() is None
@@ -275,13 +270,7 @@ def test_a_nan_setting_is_refused_by_name(setter, kept):
     """vtkSetClampMacro lets a NaN through; these setters refuse it with an
     error naming the property, and keep the value."""
     mapper = octoray.vtkCPUOctreeVolumeMapper()
-    said = []
-
-    def observe(caller, event, text):
-        said.append(text)
-    import vtk
-    observe.CallDataType = vtk.VTK_STRING
-    mapper.AddObserver(vtk.vtkCommand.ErrorEvent, observe)
+    said = gathered(mapper)
     getattr(mapper, "Set" + setter)(float("nan"))
     assert getattr(mapper, "Get" + setter)() == kept
     assert len(said) == 1 and f"{setter} must be a number, not NaN; it stays {kept:g}." in said[0], said
