@@ -35,9 +35,9 @@ std::string ParticleOptionsProblem(const int dims[3], const ParticleOptions& opt
 
 // Points (float), `Scalars` (intensity: grey, or the mean of R, G, B), for
 // colour images `Colors` (RGB bytes), for grey ones with GradientNormals
-// `Normals` (octorayLattice.h's GradientNormal), vertex cells, PointLattice; no points
-// when the region of interest is empty (options as ParticleOptionsProblem
-// passes them).
+// `Normals` (octorayLattice.h's GradientNormal), vertex cells, PointLattice;
+// no points when the region of interest is empty (options as
+// ParticleOptionsProblem passes them).
 void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyData* output);
 } // namespace slices
 } // namespace octoray

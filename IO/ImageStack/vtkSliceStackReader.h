@@ -23,8 +23,9 @@
  * at origin + direction * (i*sx, j*sy, k*sz), with a vertex cell each,
  * `Scalars` (the pixel intensity: the grey value, or the mean of R, G, B),
  * for colour images `Colors` (unsigned char RGB), and for grey ones with
- * GradientNormals on `Normals`, the intensities' gradient. A pixel is background when
- * its intensity lies in BackgroundRange (default [0, 0]) or its alpha is 0.
+ * GradientNormals on `Normals`, the intensities' gradient. A pixel is
+ * background when its intensity lies in BackgroundRange (default [0, 0]) or
+ * its alpha is 0.
  * A region of interest (in pixel indices of the stack) and a stride pick the
  * pixels that are looked at.
  *

@@ -454,7 +454,8 @@ def test_clip_and_crop_reach_the_mapper(tmp_path):
 
 @pytest.mark.parametrize("cut, expected", [
     (("--clip", "0", "0", "0", "0", "0", "0"), "--clip needs a finite origin and a non-zero normal, got 0 0 0 0 0 0"),
-    (("--clip", "nan", "0", "0", "0", "0", "1"), "--clip needs a finite origin and a non-zero normal, got nan 0 0 0 0 1"),
+    (("--clip", "nan", "0", "0", "0", "0", "1"),
+     "--clip needs a finite origin and a non-zero normal, got nan 0 0 0 0 1"),
     (("--crop", "0.5", "0.2", "0", "1", "0", "1"),
      "--crop needs fractions 0 <= low < high <= 1 on each axis, got 0.5 0.2 0 1 0 1"),
 ])

@@ -104,7 +104,7 @@ def parser():
                         "its normal points to (the mapper's AddClippingPlane); repeatable")
     p.add_argument("--crop", type=float, nargs=6, default=None, metavar=("X0", "X1", "Y0", "Y1", "Z0", "Z1"),
                    help="keep the box between these fractions (0..1) of the drawn bounds along x, y and z "
-                        "(the mapper's cropping to the sub-volume), e.g. 0 1 0.5 1 0 1 for the far half in y")
+                        "(the mapper's cropping to the sub-volume), e.g. 0 1 0.5 1 0 1 for the half of larger y")
     return p
 
 
