@@ -19,6 +19,7 @@
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
 #include "vtkPolyData.h"
+#include "vtkPoints.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
@@ -200,10 +201,16 @@ bool vtkSliceStackReader::ReadStack(
 }
 
 //------------------------------------------------------------------------------
-// The particles of the image read, as the reader's options select them;
-// false after Fail() for options that do not fit the stack.
+// The particles of the image read, as the reader's options select them
+// (none without GenerateParticles); false after Fail() for options that do
+// not fit the stack.
 bool vtkSliceStackReader::MakeParticles(vtkImageData* image, vtkPolyData* particles)
 {
+  if (!this->GenerateParticles)
+  {
+    particles->SetPoints(vtkSmartPointer<vtkPoints>::New());
+    return true;
+  }
   octoray::slices::ParticleOptions options;
   std::copy_n(this->RegionOfInterest, 6, options.RegionOfInterest);
   std::copy_n(this->Stride, 3, options.Stride);
@@ -360,5 +367,6 @@ void vtkSliceStackReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GenerateVertices: " << this->GenerateVertices << "\n";
   os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
   os << indent << "GradientNormals: " << this->GradientNormals << "\n";
+  os << indent << "GenerateParticles: " << this->GenerateParticles << "\n";
   os << indent << "IsDICOM: " << this->IsDICOM << "\n";
 }

@@ -152,6 +152,17 @@ public:
   ///@}
 
   ///@{
+  /// Make output 0's particles (default on). Off, output 0 has no points and
+  /// only the stack's volume (output 1) is made, for a view or script that
+  /// draws the volume alone: the particles' time and memory are saved (the
+  /// head CT's 14 M particles above the default background are most of its
+  /// read), and the particle options are not looked at.
+  vtkSetMacro(GenerateParticles, bool);
+  vtkGetMacro(GenerateParticles, bool);
+  vtkBooleanMacro(GenerateParticles, bool);
+  ///@}
+
+  ///@{
   /// Particles of a grey stack carry `Normals` (default off): the negated
   /// gradient of the intensities by central differences, interpolated
   /// between slices like the values (octorayLattice.h's GradientNormal), the
@@ -213,6 +224,7 @@ protected:
   bool GenerateVertices = true;
   bool FillBetweenSlices = true;
   bool GradientNormals = false;
+  bool GenerateParticles = true;
   bool IsDICOM = false;
   std::string ErrorMessage;
   std::vector<std::string> SliceFiles;

@@ -385,6 +385,19 @@ def test_gradient_normals_point_out_of_a_ball(tmp_path):
     assert reader_for(Files=files, GradientNormals=True)[1].GetPointData().GetNormals() is None
 
 
+def test_image_output_alone(tmp_path):
+    """GenerateParticles off (on by default): output 0 has no points, and
+    the stack's volume is the same; options that only the particles use
+    are not looked at."""
+    folder, vol = block_stack(tmp_path)
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert r.GetGenerateParticles() and out.GetNumberOfPoints() > 0
+    r2, out2, msgs2 = reader_for(DirectoryName=folder, GenerateParticles=False, Stride=(0, 1, 1))
+    assert not msgs2.errors, msgs2.errors
+    assert out2.GetNumberOfPoints() == 0
+    np.testing.assert_array_equal(stack_of(r2), stack_of(r))
+
+
 def test_fill_colours(tmp_path):
     vol = np.zeros((2, 2, 2, 3), np.uint8)
     vol[0] = (10, 20, 30)

@@ -167,6 +167,7 @@ def main(argv=None):
         if kind != "slices":
             return
         reader.SetFillBetweenSlices(not args.no_fill)
+        reader.SetGenerateParticles(args.particles)  # else the image output alone is drawn
         reader.SetGradientNormals(args.particles and shade and args.normals == "auto")
         if args.particles and args.background is not None:
             reader.SetBackgroundRange(*args.background)
