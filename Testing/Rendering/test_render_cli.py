@@ -239,26 +239,15 @@ def test_non_finite_scalars_leave_the_transfer_function_its_range():
     """A NaN or an infinity among the scalars: the transfer function spans
     the finite values (a NaN first failed the frame, an infinity turned the
     cloud one colour)."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtk.util.numpy_support import numpy_to_vtk
     rng = np.random.default_rng(2)
     for bad in (float("nan"), float("inf")):
         cloud = random_cloud(2000, seed=3)
         scalars = numpy_to_vtk(rng.random(2000).astype(np.float32), deep=1)
         scalars.SetValue(0, bad)
         cloud.GetPointData().SetScalars(scalars)
-        mapper = octoray.vtkCPUOctreeVolumeMapper()
-        mapper.SetInputData(cloud)
-        window, said = offscreen_view(mapper, (64, 64))
-        ramp = vtk.vtkColorTransferFunction()
-        ramp.AddRGBPoint(0.0, 1, 0, 0)
-        ramp.AddRGBPoint(1.0, 0, 0, 1)
-        window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty().SetColor(ramp)
-        window.Render()
-        grab = vtk.vtkWindowToImageFilter()
-        grab.SetInput(window)
-        grab.Update()
-        rgb = vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
+        rgb, said = coloured_by(cloud, ramp=((0.0, (1, 0, 0)), (1.0, (0, 0, 1))))[:2]
+        rgb = rgb.astype(int)
         reddish = ((rgb[:, 0] > 2 * rgb[:, 2]) & (rgb[:, 0] > 60)).mean()
         bluish = ((rgb[:, 2] > 2 * rgb[:, 0]) & (rgb[:, 2] > 60)).mean()
         assert said == [] and reddish > 0.02 and bluish > 0.02, (bad, said, reddish, bluish)
@@ -341,21 +330,22 @@ def ramp_up():
     return ramp
 
 
-def coloured_by(cloud, configure):
-    """The RGB pixels of `cloud` drawn by a CPU mapper in a 64x64 window,
-    with a blue-to-red ramp whose colour function `configure` is given,
-    and what the mapper said."""
+def coloured_by(cloud, configure=lambda ramp: None, ramp=((0.0, (0, 0, 1)), (3.0, (1, 0, 0)))):
+    """(the RGB pixels, what the mapper said, the mapper, its colour
+    function, the window) of `cloud` drawn by a CPU mapper in a 64x64
+    window through `ramp`'s colours (blue to red by default), the colour
+    function then given to `configure`."""
     import vtk
     mapper = octoray.vtkCPUOctreeVolumeMapper()
     mapper.SetInputData(cloud)
     window, said = offscreen_view(mapper, (64, 64))
-    ramp = vtk.vtkColorTransferFunction()
-    ramp.AddRGBPoint(0.0, 0, 0, 1)
-    ramp.AddRGBPoint(3.0, 1, 0, 0)
-    configure(ramp)
-    window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty().SetColor(ramp)
+    function = vtk.vtkColorTransferFunction()
+    for value, rgb in ramp:
+        function.AddRGBPoint(value, *rgb)
+    configure(function)
+    window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty().SetColor(function)
     window.Render()
-    return window_pixels(window), said, mapper, ramp, window
+    return window_pixels(window), said, mapper, function, window
 
 
 def test_vector_scalars_are_drawn_as_the_colour_function_maps_vectors():
