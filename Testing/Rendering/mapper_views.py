@@ -31,3 +31,11 @@ def offscreen_view(mapper, size=(32, 32)):
     window.AddRenderer(ren)
     ren.ResetCamera()
     return window, said
+
+
+def assert_said_once(window, said, text, frames=3):
+    """Draws `window` `frames` times; the mapper said exactly one message
+    over them, holding `text` (a warning is said once, not every frame)."""
+    for _ in range(frames):
+        window.Render()
+    assert len(said) == 1 and text in said[0], said
