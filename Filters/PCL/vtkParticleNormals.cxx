@@ -38,14 +38,27 @@ int vtkParticleNormals::RequestData(
     return 0;
   }
 
+  // PCL takes float coordinates. Far from the origin (a LiDAR tile in UTM
+  // metres: eastings near 6e5, northings up to 1e7) a float rounds to steps
+  // of 6 cm to 1 m, coarser than a scan's spacing, and the neighbourhoods'
+  // covariances turn to noise; so the points go to PCL relative to the
+  // centre of their bounds, subtracted in double. A translation does not
+  // change the normals.
+  double bounds[6];
+  input->GetBounds(bounds);
+  const double centre[3] = { 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),
+    0.5 * (bounds[4] + bounds[5]) };
+  const auto relative = [&centre](const double p[3]) {
+    return pcl::PointXYZ(static_cast<float>(p[0] - centre[0]),
+      static_cast<float>(p[1] - centre[1]), static_cast<float>(p[2] - centre[2]));
+  };
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   cloud->resize(static_cast<size_t>(n));
   double x[3];
   for (vtkIdType i = 0; i < n; ++i)
   {
     input->GetPoint(i, x);
-    (*cloud)[i] = pcl::PointXYZ(static_cast<float>(x[0]), static_cast<float>(x[1]),
-      static_cast<float>(x[2]));
+    (*cloud)[i] = relative(x);
   }
   this->UpdateProgress(0.1);
 
@@ -62,8 +75,8 @@ int vtkParticleNormals::RequestData(
   {
     estimator.setKSearch(std::min<int>(this->NumberOfNeighbors, static_cast<int>(n)));
   }
-  estimator.setViewPoint(static_cast<float>(this->ViewPoint[0]),
-    static_cast<float>(this->ViewPoint[1]), static_cast<float>(this->ViewPoint[2]));
+  const pcl::PointXYZ viewPoint = relative(this->ViewPoint);
+  estimator.setViewPoint(viewPoint.x, viewPoint.y, viewPoint.z);
   pcl::PointCloud<pcl::Normal> normals;
   estimator.compute(normals);
   this->UpdateProgress(0.9);

@@ -9,7 +9,10 @@
  * flipNormalTowardsViewpoint does. Output: the input with a `Normals` array
  * (float, set as the active normals) and `Curvature` (PCL's surface
  * variation). Points with too few neighbours for a normal get (0, 0, 0) and
- * are counted (GetNumberOfInvalidNormals, and a warning).
+ * are counted (GetNumberOfInvalidNormals, and a warning). PCL works in
+ * float; the points are handed to it relative to the centre of their
+ * bounds, so that clouds far from the origin (UTM coordinates) keep their
+ * precision.
  *
  * PCL's io and visualization components (which link VTK) are not used.
  */
