@@ -34,7 +34,8 @@ def front_view(view, focus=(1.25, 0.5, 0.0), size=(300, 200)):
 
 
 def screenshot_rgb(path):
-    """A PNG's colours as a (height, width, 3) array of ints."""
+    """A PNG's colours as a (height, width, 3) array of ints, the bottom row
+    first (VTK's order)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkIOImage import vtkPNGReader
     png = vtkPNGReader()
@@ -42,3 +43,19 @@ def screenshot_rgb(path):
     png.Update()
     w, h, _ = png.GetOutput().GetDimensions()
     return vtk_to_numpy(png.GetOutput().GetPointData().GetScalars())[:, :3].astype(int).reshape(h, w, 3)
+
+
+def write_rgb(rgb, path):
+    """A (height, width, 3) array in screenshot_rgb's order as a PNG."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+    h, w, _ = rgb.shape
+    image = vtkImageData()
+    image.SetDimensions(w, h, 1)
+    image.GetPointData().SetScalars(numpy_to_vtk(rgb.reshape(-1, 3).astype(np.uint8), deep=True))
+    png = vtkPNGWriter()
+    png.SetFileName(path)
+    png.SetInputData(image)
+    png.Write()
