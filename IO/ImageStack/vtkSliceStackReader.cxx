@@ -14,6 +14,7 @@
 #include "octoraySliceParticles.h"
 #include "octoraySlicePictures.h"
 
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -25,6 +26,7 @@
 #include "vtkStringArray.h"
 
 #include <algorithm>
+#include <cstdio>
 
 vtkStandardNewMacro(vtkSliceStackReader);
 
@@ -161,9 +163,8 @@ int vtkSliceStackReader::RequestInformation(
 }
 
 //------------------------------------------------------------------------------
-// The slices into image and its particles into particles; false after Fail().
-bool vtkSliceStackReader::ReadStack(
-  const std::vector<std::string>& files, vtkImageData* image, vtkPolyData* particles)
+// The slices into image; false after Fail().
+bool vtkSliceStackReader::ReadStack(const std::vector<std::string>& files, vtkImageData* image)
 {
   octoray::slices::SliceRead read;
   read.Progress = [this](double progress) { this->UpdateProgress(progress); };
@@ -174,20 +175,16 @@ bool vtkSliceStackReader::ReadStack(
     ok = this->IsDICOM
       ? octoray::slices::ReadDicomStack(files, this->Spacing[2], this->UseMetadata, image, read)
       : octoray::slices::ReadPictureStack(files, image, read);
-    if (ok)
-    {
-      // The spacing and origin the user set, unless the DICOM series' own
-      // are used.
-      if (!this->IsDICOM || !this->UseMetadata)
-      {
-        image->SetSpacing(this->Spacing);
-        image->SetOrigin(this->Origin);
-      }
-      ok = this->MakeParticles(image, particles);
-    }
-    else
+    if (!ok)
     {
       this->Fail(read.Error);
+    }
+    // The spacing and origin the user set, unless the DICOM series' own
+    // are used.
+    else if (!this->IsDICOM || !this->UseMetadata)
+    {
+      image->SetSpacing(this->Spacing);
+      image->SetOrigin(this->Origin);
     }
   }
   catch (const std::exception& e)
@@ -198,6 +195,35 @@ bool vtkSliceStackReader::ReadStack(
   }
   this->SliceFiles = read.SliceFiles;
   return ok;
+}
+
+//------------------------------------------------------------------------------
+// What the image read from `files` depends on: the files as they are on
+// disk and the geometry properties. Particle options are not part of it.
+std::string vtkSliceStackReader::ImageSignature(const std::vector<std::string>& files) const
+{
+  char geometry[256];
+  std::snprintf(geometry, sizeof(geometry), "%a %a %a %a %a %a %d", this->Spacing[0],
+    this->Spacing[1], this->Spacing[2], this->Origin[0], this->Origin[1], this->Origin[2],
+    this->UseMetadata ? 1 : 0);
+  return octoray::slices::FilesSignature(nullptr, files, {}) + geometry;
+}
+
+//------------------------------------------------------------------------------
+// The stack's volume for this update: the last one read where nothing it
+// depends on has changed (its ImageSignature: only a particle option did,
+// or the particles are asked for after the volume alone), else read now;
+// null after Fail().
+vtkSmartPointer<vtkImageData> vtkSliceStackReader::CurrentImage(
+  const std::vector<std::string>& files, const std::string& signature)
+{
+  if (this->LastImage && signature == this->LastImageSignature)
+  {
+    this->SliceFiles = this->LastSliceFiles;
+    return this->LastImage;
+  }
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  return this->ReadStack(files, image) ? image : nullptr;
 }
 
 //------------------------------------------------------------------------------
@@ -255,19 +281,26 @@ static std::string GeometryProblem(const double spacing[3], const double origin[
 //------------------------------------------------------------------------------
 // A failed update puts back the outputs of the last successful one (or
 // leaves them empty): the pipeline has already emptied them, and a failure
-// half-way must not leave a half-read stack.
+// half-way must not leave a half-read stack. Particles not asked for
+// (output == null) stay as they are.
 int vtkSliceStackReader::KeepLastOutputs(vtkPolyData* output, vtkImageData* image)
 {
-  if (this->LastOutput)
+  if (output && this->LastOutput)
   {
     output->ShallowCopy(this->LastOutput);
+  }
+  else if (output)
+  {
+    output->Initialize();
+  }
+  if (this->LastImage)
+  {
     image->ShallowCopy(this->LastImage);
     this->SliceFiles = this->LastSliceFiles;
     this->IsDICOM = this->LastIsDICOM;
   }
   else
   {
-    output->Initialize();
     image->Initialize();
     this->SliceFiles.clear();
     this->IsDICOM = false;
@@ -276,15 +309,43 @@ int vtkSliceStackReader::KeepLastOutputs(vtkPolyData* output, vtkImageData* imag
 }
 
 //------------------------------------------------------------------------------
+vtkTypeBool vtkSliceStackReader::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The particles are made only where output 0 is asked for (or no port in
+  // particular is): a pipeline that draws the volume alone does not pay for
+  // them. The executive then keeps output 0 as it was and re-executes when
+  // it is asked for, and the volume is not read again for it
+  // (CurrentImage).
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_NOT_GENERATED()))
+  {
+    const bool volumeAlone = request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
+      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1;
+    if (volumeAlone)
+    {
+      outputVector->GetInformationObject(0)->Set(vtkDemandDrivenPipeline::DATA_NOT_GENERATED(), 1);
+    }
+    return 1;
+  }
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
 int vtkSliceStackReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkInformation* particlesInfo = outputVector->GetInformationObject(0);
+  vtkPolyData* output = particlesInfo->Get(vtkDemandDrivenPipeline::DATA_NOT_GENERATED())
+    ? nullptr
+    : vtkPolyData::GetData(particlesInfo);
   vtkImageData* image = vtkImageData::GetData(outputVector, 1);
   this->ErrorMessage.clear();
   this->SliceFiles.clear();
   this->IsDICOM = false;
-  output->Initialize();
+  if (output)
+  {
+    output->Initialize();
+  }
   image->Initialize();
 
   const std::string geometry = GeometryProblem(this->Spacing, this->Origin);
@@ -306,16 +367,23 @@ int vtkSliceStackReader::RequestData(
   }
   this->IsDICOM = dicom > 0;
   this->UpdateProgress(0.0);
-  auto freshImage = vtkSmartPointer<vtkImageData>::New();
-  auto fresh = vtkSmartPointer<vtkPolyData>::New();
-  if (!this->ReadStack(files, freshImage, fresh))
+  const std::string signature = this->ImageSignature(files);
+  vtkSmartPointer<vtkImageData> volume = this->CurrentImage(files, signature);
+  auto particles = vtkSmartPointer<vtkPolyData>::New();
+  if (!volume || (output && !this->MakeParticles(volume, particles)))
   {
     return this->KeepLastOutputs(output, image);
   }
-  output->ShallowCopy(fresh);
-  image->ShallowCopy(freshImage);
-  this->LastOutput = fresh;
-  this->LastImage = freshImage;
+  image->ShallowCopy(volume);
+  this->LastImage = volume;
+  this->LastImageSignature = signature;
+  // Particles not asked for: output 0 keeps those of an earlier update,
+  // which the executive re-executes for when it is asked for.
+  if (output)
+  {
+    output->ShallowCopy(particles);
+    this->LastOutput = particles;
+  }
   this->LastSliceFiles = this->SliceFiles;
   this->LastIsDICOM = this->IsDICOM;
   // The slices just read are part of the signature from now on; that is not

@@ -512,6 +512,69 @@ def test_error_settings_no_stack_can_have(tmp_path, options, message):
     assert out.GetNumberOfPoints() == 0 and r.GetImageOutput().GetNumberOfPoints() == 0
 
 
+def scalars_address(reader):
+    """Where the image output's values live: the same after an update that
+    did not read the volume again."""
+    return reader.GetImageOutput().GetPointData().GetScalars().GetVoidPointer(0)
+
+
+def particle_positions(out):
+    return vtk_to_numpy(out.GetPoints().GetData()) if out.GetPoints() else np.zeros((0, 3))
+
+
+def test_particles_only_where_asked_for(tmp_path):
+    """An update of output 1 alone makes no particles (and does not look at
+    their options); output 0 asked for afterwards gets them from the same
+    volume, not read again, equal to a fresh reader's."""
+    folder, vol = block_stack(tmp_path)
+    r = octoray.vtkSliceStackReader()
+    msgs = Messages(r)
+    r.SetDirectoryName(folder)
+    r.SetStride(0, 1, 1)
+    r.Update(1)
+    assert not msgs.errors, msgs.errors
+    assert r.GetOutput().GetNumberOfPoints() == 0
+    np.testing.assert_array_equal(stack_of(r), vol)
+    volume = scalars_address(r)
+    r.Update(0)
+    assert msgs.errors and "Stride" in msgs.errors[-1], msgs.errors
+    del msgs.errors[:]
+    r.SetStride(1, 1, 1)
+    r.Update(0)
+    assert not msgs.errors, msgs.errors
+    assert scalars_address(r) == volume
+    fresh = reader_for(DirectoryName=folder)[1]
+    assert r.GetOutput().GetNumberOfPoints() == fresh.GetNumberOfPoints() > 0
+    np.testing.assert_array_equal(particle_positions(r.GetOutput()), particle_positions(fresh))
+
+
+def test_volume_read_again_only_when_it_changes(tmp_path):
+    """A particle option's change makes the particles again from the volume
+    already read; Spacing and a slice changed on disk read it again."""
+    folder, vol = block_stack(tmp_path)
+    r, out, msgs = reader_for(DirectoryName=folder)
+    volume = scalars_address(r)
+    r.SetBackgroundRange(0, 999)  # the block's 1000 is not background
+    r.Update()
+    assert scalars_address(r) == volume
+    assert out.GetNumberOfPoints() == reader_for(DirectoryName=folder, BackgroundRange=(0, 999))[1].GetNumberOfPoints()
+    r.SetBackgroundRange(0, 1000)
+    r.Update()
+    assert out.GetNumberOfPoints() == 0 and scalars_address(r) == volume
+    r.SetSpacing(1.0, 1.0, 2.0)
+    r.Update()
+    assert scalars_address(r) != volume
+    np.testing.assert_array_equal(stack_of(r), vol)
+    volume = scalars_address(r)
+    changed = vol.copy()
+    changed[2, 4, 5] = 7
+    write_slices(vtk.vtkPNGWriter, folder, "b%02d.png", changed)
+    r.Update()
+    assert scalars_address(r) != volume
+    np.testing.assert_array_equal(stack_of(r), changed)
+    assert not msgs.errors, msgs.errors
+
+
 def test_error_nothing_given():
     r, out, msgs = reader_for()
     assert r.GetErrorMessage() == "no slices given: set file names, a directory or a file pattern"

@@ -102,9 +102,8 @@ def automatic_depth(data, backend):
 def head_ct(args, timings, pictures):
     folder = os.path.join(args.data, "External", "HeadCT", "DICOM")
     log("[1/3] head CT: %s (DICOM series) through vtkSliceStackReader" % folder)
-    # The image output is drawn, not the particles.
-    reader, image, seconds = scene.read(folder, progress_label="  reading",
-                                        configure=lambda r: r.SetGenerateParticles(False))
+    # The image output is drawn, not the particles: they are not made.
+    reader, image, seconds = scene.read(folder, progress_label="  reading")
     if image is None or image.GetNumberOfPoints() == 0:
         raise RuntimeError("no CT read from %s: %s" % (folder, reader.GetErrorMessage()))
     dims, spacing = image.GetDimensions(), image.GetSpacing()

@@ -167,16 +167,13 @@ def main(argv=None):
         if kind != "slices":
             return
         reader.SetFillBetweenSlices(not args.no_fill)
-        reader.SetGenerateParticles(args.particles)  # else the image output alone is drawn
         reader.SetGradientNormals(args.particles and shade and args.normals == "auto")
         if args.particles and args.background is not None:
             reader.SetBackgroundRange(*args.background)
         elif args.particles and threshold is not None:
             reader.SetBackgroundRange(-1e300, threshold)
 
-    reader, data, load = scene.read(args.input, args.range, configure=configure)
-    if args.particles:
-        data = reader.GetOutput()
+    reader, data, load = scene.read(args.input, args.range, configure=configure, particles=args.particles)
     if data is None or data.GetNumberOfPoints() == 0:
         why = reader.GetErrorMessage() if hasattr(reader, "GetErrorMessage") else ""
         print("error: %s" % (why or "nothing read from %s" % args.input), file=sys.stderr)

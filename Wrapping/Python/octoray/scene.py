@@ -117,10 +117,13 @@ def make_reader(path, file_range=(0, 0)):
     return reader
 
 
-def read(path, file_range=(0, 0), progress_label="reading", stream=None, configure=None):
+def read(path, file_range=(0, 0), progress_label="reading", stream=None, configure=None,
+         particles=False):
     """Reads `path` with a progress line; returns (reader, data, seconds).
-    Slice stacks give the reader's image output (vtkImageData), the others
-    the points (vtkPolyData). `configure(reader)` is called before reading.
+    Slice stacks give the reader's image output (vtkImageData), or with
+    `particles` its particles, and only that output is made; the others
+    give the points (vtkPolyData). `configure(reader)` is called before
+    reading.
     A failed read prints nothing (not VTK's pipeline report either): where
     nothing was read, the caller says reader.GetErrorMessage(), which names
     the file and the line or slice. Warnings are printed as they come."""
@@ -132,12 +135,12 @@ def read(path, file_range=(0, 0), progress_label="reading", stream=None, configu
         configure(reader)
     if bar:
         reader.AddObserver("ProgressEvent", bar)
+    port = 1 if isinstance(reader, octoray.vtkSliceStackReader) and not particles else 0
     with Timer() as t:
-        reader.Update()
+        reader.Update(port)
     if bar:
         bar.finish()
-    data = reader.GetImageOutput() if isinstance(reader, octoray.vtkSliceStackReader) else reader.GetOutput()
-    return reader, data, t.seconds
+    return reader, reader.GetOutputDataObject(port), t.seconds
 
 
 def has_colours(data):
