@@ -310,16 +310,20 @@ struct Lattice
 };
 
 /**
- * The lattice of the samples of `axes` over an image: origin, spacing per
- * index axis and direction matrix (row-major; index axis a runs along column
- * a), as vtkImageData has them.
+ * The lattice of the samples of `axes` over an image: where its first
+ * sample lies, its spacing per index axis and its direction matrix
+ * (row-major; index axis a runs along column a), as vtkImageData has them.
+ * The first sample is the data array's first value: for a vtkImageData its
+ * extent's first index (TransformIndexToPhysicalPoint), which lies at its
+ * Origin only where the extent starts at 0 (not for the Wavelet source's
+ * -10..10, nor for the pieces of an image split over ranks).
  */
-inline Lattice LatticeOf(const Axis axes[3], const double origin[3], const double spacing[3], const double direction[9])
+inline Lattice LatticeOf(const Axis axes[3], const double first[3], const double spacing[3], const double direction[9])
 {
   Lattice l;
   for (int w = 0; w < 3; ++w)
   {
-    l.Origin[w] = origin[w];
+    l.Origin[w] = first[w];
     for (int a = 0; a < 3; ++a)
     {
       l.Origin[w] += direction[3 * w + a] * (static_cast<double>(axes[a].First) * spacing[a]);

@@ -335,8 +335,11 @@ void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyD
     output->SetPoints(vtkSmartPointer<vtkPoints>::New());
     return;
   }
-  const octoray::lattice::Lattice lattice = octoray::lattice::LatticeOf(
-    axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
+  const int* extent = image->GetExtent();
+  double first[3];
+  image->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], first);
+  const octoray::lattice::Lattice lattice =
+    octoray::lattice::LatticeOf(axes, first, spacing, image->GetDirectionMatrix()->GetData());
   const long long size[3] = { dims[0], dims[1], dims[2] };
   const int comps = image->GetNumberOfScalarComponents();
   const Background bg{ comps, options.BackgroundRange };

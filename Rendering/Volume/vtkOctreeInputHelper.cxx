@@ -613,8 +613,11 @@ void vtkOctreeInputHelper::ImageView(
       axes[a].Fill = fill[a];
     }
   }
+  const int* extent = image->GetExtent();
+  double first[3];
+  image->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], first);
   const octoray::lattice::Lattice lattice =
-    octoray::lattice::LatticeOf(axes, image->GetOrigin(), spacing, image->GetDirectionMatrix()->GetData());
+    octoray::lattice::LatticeOf(axes, first, spacing, image->GetDirectionMatrix()->GetData());
   const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
   const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
   this->Normal.clear();

@@ -2,7 +2,8 @@
 python, vtk; run under a display by ctest):
 
 - LeafDepth 0 chooses the depth from the spacing: the leaf is the finest
-  spacing, and the voxel centres are leaf centres;
+  spacing, and the voxel centres are leaf centres, also where the extent
+  does not start at 0;
 - with slices farther apart than the pixels the octree has no empty layers
   between slices (FillBetweenSlices), and values are interpolated linearly
   between slices;
@@ -75,6 +76,29 @@ def test_depth_from_the_spacing_and_leaves_on_the_voxels():
     grid = (centres - np.array([3.0, -2.0, 100.0])) / 0.5
     assert np.abs(grid - np.round(grid)).max() < 1e-3
     assert grid.min() > -1e-3 and grid.max() < 9 + 1e-3
+
+
+def test_leaves_at_the_voxels_of_an_extent_not_starting_at_0():
+    # Voxel (i, j, k) of an extent lies at Origin + (i, j, k) * spacing
+    # whatever the extent's first index (the Wavelet source's -10..10, the
+    # pieces of an image split over ranks); before, the octree was drawn as
+    # if the extent began at 0, 5 spacings off here. The leaves' centres
+    # are the voxels' positions, and the octree's bounds the image's.
+    im = image(np.ones((4, 4, 4)), (0.5, 0.5, 0.5), origin=(1.0, 2.0, 3.0))
+    im.SetExtent(-5, -2, 3, 6, 10, 13)
+    mapper, _ = render(im)
+    centres, _ = leaves(mapper)
+    expected = np.array([[1.0 + 0.5 * i, 2.0 + 0.5 * j, 3.0 + 0.5 * k]
+                         for k in range(10, 14) for j in range(3, 7) for i in range(-5, -1)])
+    order = lambda p: p[np.lexsort((p[:, 0], p[:, 1], p[:, 2]))]
+    assert len(centres) == 64
+    np.testing.assert_allclose(order(centres), order(expected), atol=1e-4)
+    voxel = [0.0] * 6
+    mapper.GetVoxelBounds(voxel)
+    bounds = im.GetBounds()
+    for a in range(3):
+        assert voxel[2 * a] == pytest.approx(bounds[2 * a] - 0.25, abs=1e-4)
+        assert voxel[2 * a + 1] == pytest.approx(bounds[2 * a + 1] + 0.25, abs=1e-4)
 
 
 def test_no_empty_layers_between_slices():
