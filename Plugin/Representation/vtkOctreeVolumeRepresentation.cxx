@@ -34,7 +34,7 @@
 #include "vtkUnstructuredGrid.h"
 #include "vtkVolumeProperty.h"
 
-#include <algorithm> // for std::copy
+#include <algorithm> // for std::copy, std::copy_n
 #include <string>
 
 
@@ -77,6 +77,7 @@ vtkOctreeVolumeRepresentation::vtkOctreeVolumeRepresentation()
   // two thirds of the engine's for a static scene.
   this->Mapper->KeepPointsForUpdatesOff();
   vtkMath::UninitializeBounds(this->DataBounds);
+  vtkMath::UninitializeBounds(this->WholeBounds);
 }
 
 //----------------------------------------------------------------------------
@@ -187,6 +188,7 @@ int vtkOctreeVolumeRepresentation::RequestData(
     ReduceBoundsOverRanks(this->DataBounds, globalBounds);
   }
   this->Mapper->SetRootBounds(globalBounds);
+  std::copy_n(ranks > 1 ? globalBounds : this->DataBounds, 6, this->WholeBounds);
 
   return this->Superclass::RequestData(request, inputVector, outputVector);
 }
@@ -394,6 +396,34 @@ void vtkOctreeVolumeRepresentation::UpdateMapperParameters()
   // multi-component mapping) makes 3/4-component arrays direct colours.
   this->Property->SetIndependentComponents(this->MapScalars && !this->MultiComponentsMapping);
   this->UpdatePreset();
+  this->UpdateCropping();
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::UpdateCropping()
+{
+  const bool crop = this->Cropping && vtkMath::AreBoundsInitialized(this->WholeBounds);
+  this->Mapper->SetCropping(crop);
+  if (crop)
+  {
+    double planes[6];
+    for (int i = 0; i < 6; ++i)
+    {
+      planes[i] = this->CroppingOrigin[i / 2] + this->WholeBounds[i] * this->CroppingScale[i / 2];
+    }
+    this->Mapper->SetCroppingRegionPlanes(planes);
+    this->Mapper->SetCroppingRegionFlagsToSubVolume();
+  }
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::SetCropping(bool on)
+{
+  if (this->Cropping != on)
+  {
+    this->Cropping = on;
+    this->Modified();
+  }
 }
 
 //----------------------------------------------------------------------------
@@ -558,4 +588,7 @@ void vtkOctreeVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Mapper: " << this->Mapper->GetClassName() << "\n";
   os << indent << "Cache: " << (this->Cache ? this->Cache->GetClassName() : "(none)") << "\n";
   os << indent << "Preset: " << (this->Preset.empty() ? "none" : this->Preset) << "\n";
+  os << indent << "Cropping: " << (this->Cropping ? "on" : "off") << ", origin " << this->CroppingOrigin[0]
+     << " " << this->CroppingOrigin[1] << " " << this->CroppingOrigin[2] << ", scale "
+     << this->CroppingScale[0] << " " << this->CroppingScale[1] << " " << this->CroppingScale[2] << "\n";
 }

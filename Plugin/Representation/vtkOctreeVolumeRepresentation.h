@@ -108,6 +108,22 @@ public:
 
   ///@{
   /**
+   * Cropping, as ParaView's Volume representation of images does it (and
+   * its properties UseCropping, CroppingOrigin, CroppingScale and box
+   * widget): on, only what lies inside the box CroppingOrigin + the data's
+   * bounds * CroppingScale, axis by axis, is drawn (the mapper's cropping
+   * region planes, its central region kept). The bounds are every rank's
+   * together, so that all ranks cut at the same planes.
+   */
+  void SetCropping(bool);
+  vtkSetVector3Macro(CroppingOrigin, double);
+  vtkGetVector3Macro(CroppingOrigin, double);
+  vtkSetVector3Macro(CroppingScale, double);
+  vtkGetVector3Macro(CroppingScale, double);
+  ///@}
+
+  ///@{
+  /**
    * A CT transfer-function preset by name (vtkOctreeVolumePresets:
    * "ct-bone", "ct-skin", "ct-muscle"), or "none" (or empty, the default)
    * for ParaView's colour map and opacity function. A preset replaces them
@@ -174,6 +190,12 @@ protected:
   void UpdateMapperParameters();
 
   /**
+   * The mapper's cropping region planes from CroppingOrigin, CroppingScale
+   * and WholeBounds; cropping off where no rank has data.
+   */
+  void UpdateCropping();
+
+  /**
    * True for the blend modes whose picture depends on the order in which
    * pieces are blended (everything but the opaque surface mode).
    */
@@ -203,6 +225,11 @@ protected:
   // mapper!").
   vtkNew<vtkTrivialProducer> EmptyPiece;
   std::string ReportedType;
+  // Every rank's bounds together (this rank's on one), for cropping.
+  double WholeBounds[6];
+  bool Cropping = false;
+  double CroppingOrigin[3] = { 0, 0, 0 };
+  double CroppingScale[3] = { 1, 1, 1 };
   bool BackendReported = false;
   bool OrderWarningIssued = false;
 
