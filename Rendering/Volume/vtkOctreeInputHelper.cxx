@@ -275,14 +275,16 @@ void ImagePoints(const T* data, int comps, const octoray::lattice::Axis axes[3],
 // engine reads one tuple a point, so the input is refused, naming the array.
 std::string ShortArray(const vtkOctreeInputHelper::Request& r)
 {
-  const vtkIdType points = r.Input->GetNumberOfPoints();
   for (vtkDataArray* a : { r.Scalars, r.Reflectivity, r.Refraction, r.Normals })
   {
-    if (a && a->GetNumberOfTuples() < points)
+    const bool cellArray = a == r.Scalars && r.CellCentred;
+    const vtkIdType needed = cellArray ? r.Input->GetNumberOfCells() : r.Input->GetNumberOfPoints();
+    if (a && a->GetNumberOfTuples() < needed)
     {
       const std::string name = a->GetName() ? a->GetName() : "(unnamed)";
-      return "The point array '" + name + "' has " + std::to_string(a->GetNumberOfTuples()) + " tuples for " +
-        std::to_string(points) + " points; nothing to draw.";
+      const std::string what = cellArray ? "cell" : "point";
+      return "The " + what + " array '" + name + "' has " + std::to_string(a->GetNumberOfTuples()) +
+        " tuples for " + std::to_string(needed) + " " + what + "s; nothing to draw.";
     }
   }
   return "";
@@ -355,7 +357,12 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
   int cellFlag = 0;
   r.Scalars = vtkAbstractMapper::GetScalars(input, mapper->GetScalarMode(), mapper->GetArrayAccessMode(),
     mapper->GetArrayId(), mapper->GetArrayName(), cellFlag);
-  if (r.Scalars && cellFlag)
+  if (r.Scalars && cellFlag && vtkImageData::SafeDownCast(input))
+  {
+    // An image's cells are voxels too, as VTK's GPU ray caster draws them.
+    r.CellCentred = true;
+  }
+  else if (r.Scalars && cellFlag)
   {
     r.CellScalars = true;
     r.Scalars = nullptr;
@@ -589,14 +596,30 @@ bool vtkOctreeInputHelper::PointLattice(octoray::lattice::Lattice& lattice, doub
 // Every voxel above the background is a point at the voxel's position, with
 // its value as scalar (or its components as colour); with FillBetweenSlices,
 // so are the samples interpolated between slices (octorayLattice.h: along
-// the coarsest axis, down to the second-coarsest spacing).
+// the coarsest axis, down to the second-coarsest spacing). The voxels are
+// the image's points, or with cell scalars its cells.
 void vtkOctreeInputHelper::ImageView(
   const Request& r, octoray::PointCloudView& view, const std::function<void(double)>& progress)
 {
   auto* image = vtkImageData::SafeDownCast(r.Input);
   vtkDataArray* scalars = r.Scalars;
+  // The samples: the points, or with cell scalars the cells (one fewer
+  // along each axis that has cells, at their centres), first to last.
   int dims[3];
   image->GetDimensions(dims);
+  const int* extent = image->GetExtent();
+  double firstIndex[3] = { static_cast<double>(extent[0]), static_cast<double>(extent[2]),
+    static_cast<double>(extent[4]) };
+  for (int a = 0; a < 3 && r.CellCentred; ++a)
+  {
+    if (dims[a] > 1)
+    {
+      --dims[a];
+      firstIndex[a] += 0.5;
+    }
+  }
+  double first[3];
+  image->TransformContinuousIndexToPhysicalPoint(firstIndex, first);
   const long long size[3] = { dims[0], dims[1], dims[2] };
   octoray::lattice::Axis axes[3];
   for (int a = 0; a < 3; ++a)
@@ -613,9 +636,6 @@ void vtkOctreeInputHelper::ImageView(
       axes[a].Fill = fill[a];
     }
   }
-  const int* extent = image->GetExtent();
-  double first[3];
-  image->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], first);
   const octoray::lattice::Lattice lattice =
     octoray::lattice::LatticeOf(axes, first, spacing, image->GetDirectionMatrix()->GetData());
   const int comps = scalars ? scalars->GetNumberOfComponents() : 0;

@@ -59,7 +59,8 @@ public:
   struct Request
   {
     vtkDataSet* Input = nullptr;
-    vtkDataArray* Scalars = nullptr; // active scalars (point data only)
+    vtkDataArray* Scalars = nullptr; // active scalars: point data, or an image's cell data
+    bool CellCentred = false;        // an image's cell data: each cell a voxel at its centre
     bool Colours = false;            // Scalars are RGB(A) colours, not through the transfer function
     // Which value of multi-component Scalars the transfer functions read:
     // a component, or kMagnitude (ScalarComponentOf).
@@ -67,7 +68,7 @@ public:
     vtkDataArray* Reflectivity = nullptr;
     vtkDataArray* Refraction = nullptr;
     vtkDataArray* Normals = nullptr;
-    bool CellScalars = false; // the selected scalars are cell data, which the octree cannot use
+    bool CellScalars = false; // the selected scalars are a point set's cell data, which the octree cannot use
     double ImageBackground = 0.0;
     bool FillBetweenSlices = true; // image input: fill between slices (octorayLattice.h)
     bool ImageGradientNormals = true; // image input: normals from the scalar gradient

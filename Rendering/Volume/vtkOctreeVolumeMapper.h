@@ -6,7 +6,8 @@
  * optional colours, scalars, reflectivity, refraction and normals) or a
  * vtkImageData (every voxel above ImageBackground becomes a point, and
  * between slices farther apart than the pixels, interpolated points fill
- * the gaps: FillBetweenSlices) by
+ * the gaps: FillBetweenSlices; with cell scalars the voxels are the cells,
+ * at their centres) by
  * building the octree engine's sparse voxel octree of the points and
  * ray-tracing it. It holds the VTK plumbing shared by both backends:
  *

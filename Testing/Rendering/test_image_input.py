@@ -101,6 +101,61 @@ def test_leaves_at_the_voxels_of_an_extent_not_starting_at_0():
         assert voxel[2 * a + 1] == pytest.approx(bounds[2 * a + 1] + 0.25, abs=1e-4)
 
 
+def cell_image(values, spacing, origin, extent_start=(0, 0, 0)):
+    """vtkImageData whose (nz, ny, nx) cells hold `values` as cell scalars
+    (and whose points hold nothing)."""
+    nz, ny, nx = values.shape
+    im = vtk.vtkImageData()
+    lo = extent_start
+    im.SetExtent(lo[0], lo[0] + nx, lo[1], lo[1] + ny, lo[2], lo[2] + (nz if nz > 1 else 0))
+    im.SetSpacing(*spacing)
+    im.SetOrigin(*origin)
+    arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).ravel(), deep=1)
+    arr.SetName("CellValues")
+    im.GetCellData().SetScalars(arr)
+    return im
+
+
+@pytest.mark.parametrize("shape", [(3, 4, 5), (1, 4, 5)], ids=["volume", "one slice"])
+def test_cell_scalars_draw_the_cells_as_voxels(shape):
+    # Cell scalars of an image (ParaView colouring by a CELLS array, VTK's
+    # ScalarModeToUseCellData): each cell is a voxel at its centre, with its
+    # value, as the point image of the cells' centres draws: the same
+    # leaves and values. A flat image's cells lie in its plane. Before, the
+    # voxels were drawn without the values, and a warning said so.
+    values = np.arange(np.prod(shape), dtype=float).reshape(shape) + 1.0
+    spacing, origin = (0.5, 0.5, 0.5), (1.0, 2.0, 3.0)
+    start = (-2, 0, 4)
+    cells = cell_image(values, spacing, origin, extent_start=start)
+    flat = (False, False, shape[0] == 1)  # an axis without cells: its one layer of points
+    centre = [origin[a] + spacing[a] * (start[a] + (0.0 if flat[a] else 0.5)) for a in range(3)]
+    points = image(values, spacing, origin=centre)
+    got = []
+    for data, mode in ((cells, "SetScalarModeToUseCellData"), (points, "SetScalarModeToDefault")):
+        mapper, _ = render(data, configure=lambda m: getattr(m, mode)())
+        centres, pd = leaves(mapper)
+        scalars = vtk_to_numpy(pd.GetPointData().GetArray("Scalars")).astype(float)
+        order = np.lexsort((centres[:, 0], centres[:, 1], centres[:, 2]))
+        got.append((centres[order], scalars[order]))
+    assert len(got[0][0]) == values.size
+    np.testing.assert_allclose(got[0][0], got[1][0], atol=1e-4)
+    np.testing.assert_allclose(got[0][1], got[1][1], rtol=1e-3)
+    np.testing.assert_allclose(np.sort(got[0][1]), np.sort(values.ravel()), rtol=1e-3)
+
+
+def test_a_short_cell_array_is_named():
+    im = cell_image(np.ones((2, 3, 3)), (1.0, 1.0, 1.0), (0.0, 0.0, 0.0))
+    short = numpy_to_vtk(np.ones(5, dtype=np.float32), deep=1)
+    short.SetName("Short")
+    im.GetCellData().SetScalars(short)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(im)
+    mapper.SetScalarModeToUseCellData()
+    window, said = offscreen_view(mapper, (32, 32))
+    window.Render()
+    assert any("The cell array 'Short' has 5 tuples for 18 cells; nothing to draw." in m for m in said), said
+
+
 def test_no_empty_layers_between_slices():
     # 8 x 8 voxels of 1, 4 slices 2.5 apart (z 0 .. 7.5): planes of points
     # are filled in between, the leaf is the pixel (1), and every leaf layer
