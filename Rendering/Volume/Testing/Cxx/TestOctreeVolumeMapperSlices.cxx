@@ -14,11 +14,14 @@
 // spacing, the 2760 voxels), point sets that name their lattice in the
 // field data as vtkSliceStackReader's particles do (the slices' pixels, and
 // the filled planes), and the image in a root cube around larger bounds (as
-// parallel ranks build theirs), and the image turned obliquely. --backend cpu|cuda; the side views in parallel
+// parallel ranks build theirs), the image turned obliquely, the image with
+// an extent that does not start at 0, and the block as the cells of an image
+// coloured by cell scalars. --backend cpu|cuda; the side views in parallel
 // projection are written to the testing temporary folder (-T) to look at.
 #include "octorayMapperTesting.h"
 
 #include "vtkActor.h"
+#include "vtkCellData.h"
 #include "vtkCubeSource.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -51,6 +54,32 @@ vtkSmartPointer<vtkImageData> Block()
     const unsigned char c[3] = { 210, 180, 90 };
     rgb->SetTypedTuple(i, c);
   }
+  return image;
+}
+
+// The same block as an image whose extent starts at `start` (as the
+// Wavelet source's, or an image's pieces over ranks), the origin moved so
+// that its voxels lie where Block()'s do.
+vtkSmartPointer<vtkImageData> BlockFrom(const int start[3])
+{
+  vtkSmartPointer<vtkImageData> image = Block();
+  image->SetExtent(start[0], start[0] + kDims[0] - 1, start[1], start[1] + kDims[1] - 1, start[2],
+    start[2] + kDims[2] - 1);
+  image->SetOrigin(kOrigin[0] - start[0] * kSpacing[0], kOrigin[1] - start[1] * kSpacing[1],
+    kOrigin[2] - start[2] * kSpacing[2]);
+  return image;
+}
+
+// The same block as the cells of an image one point larger along each axis,
+// whose cell centres lie where Block()'s points do, the colours cell data.
+vtkSmartPointer<vtkImageData> BlockCells()
+{
+  vtkSmartPointer<vtkImageData> block = Block();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(kDims[0] + 1, kDims[1] + 1, kDims[2] + 1);
+  image->SetSpacing(kSpacing[0], kSpacing[1], kSpacing[2]);
+  image->SetOrigin(kOrigin[0] - 0.5 * kSpacing[0], kOrigin[1] - 0.5 * kSpacing[1], kOrigin[2] - 0.5 * kSpacing[2]);
+  image->GetCellData()->SetScalars(block->GetPointData()->GetScalars());
   return image;
 }
 
@@ -216,7 +245,9 @@ int TestOctreeVolumeMapperSlices(int argc, char* argv[])
     double Leaf;
     bool RootBounds = false; // in a cube around larger bounds, as parallel ranks share
     bool Oblique = false;
+    bool CellData = false; // the colours are cell scalars
   };
+  const int start[3] = { -4, 7, 2 };
   const vtkIdType filled = kDims[0] * kDims[1] * ((kDims[2] - 1) * 3 + 1);
   const vtkIdType voxels = kDims[0] * kDims[1] * kDims[2];
   const Case cases[] = {
@@ -226,14 +257,18 @@ int TestOctreeVolumeMapperSlices(int argc, char* argv[])
     { "point set of the filled planes with its lattice", BlockPoints(1.0), true, filled, 1.0 },
     { "image, filled, in the caller's root bounds", image, true, filled, 1.0, true },
     { "image turned obliquely, filled", turned, true, filled, std::sqrt(3.0), false, true },
+    { "image whose extent starts at (-4, 7, 2), filled", BlockFrom(start), true, filled, 1.0 },
+    { "image of cells coloured by cell scalars, filled", BlockCells(), true, filled, 1.0, false, false, true },
   };
   const std::string temporary = Argument(argc, argv, "-T", "");
   int caseNumber = 0;
   for (const Case& c : cases)
   {
     ++caseNumber;
+    // The voxel centres' bounds: the input's points', or for cells those of
+    // the block their centres make.
     double block[6];
-    c.Input->GetBounds(block);
+    (c.CellData ? static_cast<vtkDataSet*>(image) : c.Input.Get())->GetBounds(block);
     // The box of the voxel centres in the image's frame, and that frame.
     const double local[6] = { 0, (kDims[0] - 1) * kSpacing[0], 0, (kDims[1] - 1) * kSpacing[1], 0,
       (kDims[2] - 1) * kSpacing[2] };
@@ -249,6 +284,10 @@ int TestOctreeVolumeMapperSlices(int argc, char* argv[])
     vtkSmartPointer<vtkOctreeVolumeMapper> mapper = NewMapper(backend);
     mapper->SetInputData(c.Input);
     mapper->SetFillBetweenSlices(c.Fill);
+    if (c.CellData)
+    {
+      mapper->SetScalarModeToUseCellData();
+    }
     if (c.RootBounds)
     {
       mapper->SetRootBounds(block[0] - 3.7, block[1] + 11.2, block[2] - 0.4, block[3] + 5.5, block[4] - 7.9, block[5] + 1.3);
