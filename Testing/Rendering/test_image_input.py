@@ -25,16 +25,22 @@ import octoray
 from mapper_views import offscreen_view
 
 
-def image(values, spacing, origin=(0.0, 0.0, 0.0)):
-    """vtkImageData from a (nz, ny, nx) array."""
-    nz, ny, nx = values.shape
+def image(values, spacing, origin=(0.0, 0.0, 0.0), cells=False, extent_start=(0, 0, 0)):
+    """vtkImageData holding a (nz, ny, nx) array: its point scalars
+    "Scalars", or with `cells` the cell scalars "CellValues" of an image one
+    point larger along each axis of more than one value (a single slice
+    stays flat, one layer of points)."""
+    counts = values.shape[::-1]
     im = vtk.vtkImageData()
-    im.SetDimensions(nx, ny, nz)
+    extent = []
+    for lo, n in zip(extent_start, counts):
+        extent += [lo, lo + n - 1 + (1 if cells and n > 1 else 0)]
+    im.SetExtent(*extent)
     im.SetSpacing(*spacing)
     im.SetOrigin(*origin)
     arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).ravel(), deep=1)
-    arr.SetName("Scalars")
-    im.GetPointData().SetScalars(arr)
+    arr.SetName("CellValues" if cells else "Scalars")
+    (im.GetCellData() if cells else im.GetPointData()).SetScalars(arr)
     return im
 
 
@@ -101,21 +107,6 @@ def test_leaves_at_the_voxels_of_an_extent_not_starting_at_0():
         assert voxel[2 * a + 1] == pytest.approx(bounds[2 * a + 1] + 0.25, abs=1e-4)
 
 
-def cell_image(values, spacing, origin, extent_start=(0, 0, 0)):
-    """vtkImageData whose (nz, ny, nx) cells hold `values` as cell scalars
-    (and whose points hold nothing)."""
-    nz, ny, nx = values.shape
-    im = vtk.vtkImageData()
-    lo = extent_start
-    im.SetExtent(lo[0], lo[0] + nx, lo[1], lo[1] + ny, lo[2], lo[2] + (nz if nz > 1 else 0))
-    im.SetSpacing(*spacing)
-    im.SetOrigin(*origin)
-    arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).ravel(), deep=1)
-    arr.SetName("CellValues")
-    im.GetCellData().SetScalars(arr)
-    return im
-
-
 @pytest.mark.parametrize("shape", [(3, 4, 5), (1, 4, 5)], ids=["volume", "one slice"])
 def test_cell_scalars_draw_the_cells_as_voxels(shape):
     # Cell scalars of an image (ParaView colouring by a CELLS array, VTK's
@@ -126,7 +117,7 @@ def test_cell_scalars_draw_the_cells_as_voxels(shape):
     values = np.arange(np.prod(shape), dtype=float).reshape(shape) + 1.0
     spacing, origin = (0.5, 0.5, 0.5), (1.0, 2.0, 3.0)
     start = (-2, 0, 4)
-    cells = cell_image(values, spacing, origin, extent_start=start)
+    cells = image(values, spacing, origin, cells=True, extent_start=start)
     flat = (False, False, shape[0] == 1)  # an axis without cells: its one layer of points
     centre = [origin[a] + spacing[a] * (start[a] + (0.0 if flat[a] else 0.5)) for a in range(3)]
     points = image(values, spacing, origin=centre)
@@ -144,7 +135,7 @@ def test_cell_scalars_draw_the_cells_as_voxels(shape):
 
 
 def test_a_short_cell_array_is_named():
-    im = cell_image(np.ones((2, 3, 3)), (1.0, 1.0, 1.0), (0.0, 0.0, 0.0))
+    im = image(np.ones((2, 3, 3)), (1.0, 1.0, 1.0), cells=True)
     short = numpy_to_vtk(np.ones(5, dtype=np.float32), deep=1)
     short.SetName("Short")
     im.GetCellData().SetScalars(short)
