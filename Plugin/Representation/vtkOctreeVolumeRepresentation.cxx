@@ -378,9 +378,9 @@ void vtkOctreeVolumeRepresentation::UpdateMapperParameters()
   this->Mapper->SelectScalarArray(colorArrayName);
   // The octree holds point attributes, and an image's cell scalars as
   // voxels (the mapper warns about a point set's cell scalars); no array
-  // means the voxels' own colours or white. A CT preset
-  // maps the data's values: with no array chosen (Solid Color) it maps the
-  // active point scalars, as choosing the preset asks.
+  // means the voxels' own colours or white. A CT preset maps the data's
+  // values: with no array chosen (Solid Color) it maps the active point
+  // scalars, as choosing the preset asks.
   const bool solidColor = !colorArrayName || !*colorArrayName;
   if (solidColor && !this->Preset.empty())
   {

@@ -593,6 +593,28 @@ bool vtkOctreeInputHelper::PointLattice(octoray::lattice::Lattice& lattice, doub
 }
 
 //------------------------------------------------------------------------------
+// The voxels of an image: its points, or with cell scalars its cells (one
+// fewer along each axis that has cells, at their centres). How many along
+// each axis, and where the first lies: the extent's first index, which is
+// at the Origin only where the extent starts at 0.
+static void ImageSamples(vtkImageData* image, bool cells, int dims[3], double first[3])
+{
+  image->GetDimensions(dims);
+  const int* extent = image->GetExtent();
+  double index[3] = { static_cast<double>(extent[0]), static_cast<double>(extent[2]),
+    static_cast<double>(extent[4]) };
+  for (int a = 0; a < 3 && cells; ++a)
+  {
+    if (dims[a] > 1)
+    {
+      --dims[a];
+      index[a] += 0.5;
+    }
+  }
+  image->TransformContinuousIndexToPhysicalPoint(index, first);
+}
+
+//------------------------------------------------------------------------------
 // Every voxel above the background is a point at the voxel's position, with
 // its value as scalar (or its components as colour); with FillBetweenSlices,
 // so are the samples interpolated between slices (octorayLattice.h: along
@@ -603,23 +625,9 @@ void vtkOctreeInputHelper::ImageView(
 {
   auto* image = vtkImageData::SafeDownCast(r.Input);
   vtkDataArray* scalars = r.Scalars;
-  // The samples: the points, or with cell scalars the cells (one fewer
-  // along each axis that has cells, at their centres), first to last.
   int dims[3];
-  image->GetDimensions(dims);
-  const int* extent = image->GetExtent();
-  double firstIndex[3] = { static_cast<double>(extent[0]), static_cast<double>(extent[2]),
-    static_cast<double>(extent[4]) };
-  for (int a = 0; a < 3 && r.CellCentred; ++a)
-  {
-    if (dims[a] > 1)
-    {
-      --dims[a];
-      firstIndex[a] += 0.5;
-    }
-  }
   double first[3];
-  image->TransformContinuousIndexToPhysicalPoint(firstIndex, first);
+  ImageSamples(image, r.CellCentred, dims, first);
   const long long size[3] = { dims[0], dims[1], dims[2] };
   octoray::lattice::Axis axes[3];
   for (int a = 0; a < 3; ++a)
