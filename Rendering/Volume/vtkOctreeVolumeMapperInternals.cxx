@@ -338,17 +338,32 @@ void vtkOctreeVolumeMapper::vtkInternals::SetClipPlanes(vtkVolume* vol, octoray:
 //------------------------------------------------------------------------------
 // The box to crop to, where the mapper crops to the sub-volume. VTK's other
 // cropping regions (fence, cross and their inverses) are not convex; they
-// are said once, and the volume is drawn uncropped.
+// are said once, and the volume is drawn uncropped. Planes that are not
+// finite are this frame's CroppingProblem (Drawable).
 const double* vtkOctreeVolumeMapper::vtkInternals::CroppingBox()
 {
   vtkOctreeVolumeMapper* self = this->Self;
+  this->CroppingProblem.clear();
   if (!self->GetCropping())
   {
     return nullptr;
   }
+  const double* planes = self->GetCroppingRegionPlanes();
+  if (!std::all_of(planes, planes + 6, [](double v) { return std::isfinite(v); }))
+  {
+    std::ostringstream text;
+    text << "CroppingRegionPlanes (" << planes[0];
+    for (int i = 1; i < 6; ++i)
+    {
+      text << ", " << planes[i];
+    }
+    text << "): each must be finite; nothing is drawn.";
+    this->CroppingProblem = text.str();
+    return nullptr;
+  }
   if (self->GetCroppingRegionFlags() == VTK_CROP_SUBVOLUME)
   {
-    return self->GetCroppingRegionPlanes();
+    return planes;
   }
   std::ostringstream flags;
   flags << "0x" << std::hex << self->GetCroppingRegionFlags();
@@ -426,26 +441,34 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::T
 
 //------------------------------------------------------------------------------
 // Settings no frame can be drawn with (octoray::CheckSettings: a NaN in the
-// volume property, which VTK's clamped setters let through): an error said
-// once while they last, and no trace. Checked here, not left to the trace,
+// volume property, which VTK's clamped setters let through; a cropping box
+// that is not finite): an error said once while they last, and no trace. Checked here, not left to the trace,
 // whose failure would drop the octree (vtkInternals::Report).
 bool vtkOctreeVolumeMapper::vtkInternals::Drawable(const octoray::RenderSettings& s)
 {
+  std::string problem = this->CroppingProblem;
   try
   {
-    octoray::CheckSettings(s);
-    this->SettingsProblem.clear();
-    return true;
+    if (problem.empty())
+    {
+      octoray::CheckSettings(s);
+    }
   }
   catch (const std::exception& e)
   {
-    if (this->SettingsProblem != e.what())
-    {
-      this->SettingsProblem = e.what();
-      vtkErrorWithObjectMacro(this->Self, << e.what());
-    }
-    return false;
+    problem = e.what();
   }
+  if (problem.empty())
+  {
+    this->SettingsProblem.clear();
+    return true;
+  }
+  if (this->SettingsProblem != problem)
+  {
+    this->SettingsProblem = problem;
+    vtkErrorWithObjectMacro(this->Self, << problem);
+  }
+  return false;
 }
 
 //------------------------------------------------------------------------------

@@ -89,6 +89,7 @@ public:
   // (WarnOnce): each once, not at every frame.
   std::set<std::string> SettingsWarnings;
   std::string SettingsProblem; // the error of the last frame's settings, said once; "" where none
+  std::string CroppingProblem; // this frame's cropping box that no frame can be drawn with; "" where none
   // The warnings said about the input as it is, by its MTime
   // (WarnOncePerInput): each once for an input, not at every frame.
   std::set<std::string> InputWarnings;

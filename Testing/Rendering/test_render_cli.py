@@ -266,6 +266,26 @@ def test_a_nan_shading_number_is_said_once_and_keeps_the_octree():
     assert (window_pixels(window) == whole).all() and mapper.GetNumberOfBuilds() == 1 and len(said) == 1
 
 
+def test_a_cropping_box_that_is_not_finite_is_said_once_and_keeps_the_octree():
+    """CroppingRegionPlanes holding a NaN: one error over frames naming
+    them, nothing drawn, the octree kept (before, the engine's error named
+    "clipping plane 0", which the user never set); a finite box again crops
+    as it did."""
+    mapper, window, said, whole = drawn_cloud()
+    mapper.SetCropping(1)
+    mapper.SetCroppingRegionFlagsToSubVolume()
+    mapper.SetCroppingRegionPlanes(-1e9, 1e9, -1e9, 1e9, -1e9, 1e9)
+    window.Render()
+    assert (window_pixels(window) == whole).all()
+    mapper.SetCroppingRegionPlanes(float("nan"), 1e9, -1e9, 1e9, -1e9, 1e9)
+    assert_said_once(window, said, "CroppingRegionPlanes (nan, 1e+09, -1e+09, 1e+09, -1e+09, 1e+09): each must be "
+                     "finite; nothing is drawn.")
+    assert not window_pixels(window).any()
+    mapper.SetCroppingRegionPlanes(-1e9, 1e9, -1e9, 1e9, -1e9, 1e9)
+    window.Render()
+    assert (window_pixels(window) == whole).all() and mapper.GetNumberOfBuilds() == 1 and len(said) == 1
+
+
 @pytest.mark.parametrize("mode, expected", [
     ("ISOSURFACE_BLEND", "BlendMode ISOSURFACE_BLEND is drawn as SURFACE_BLEND: the first voxel a ray meets, "
         "not the volume property's iso-values."),
