@@ -1,10 +1,12 @@
 #include "vtkOctreeVolumeRepresentation.h"
 
 #include "vtkAlgorithmOutput.h"
+#include "vtkAppendDataSets.h"
 #include "vtkBoundingBox.h"
 #include "vtkCellArray.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkCommunicator.h"
+#include "vtkCompositeDataIterator.h"
 #include "vtkCompositeDataSet.h"
 #include "vtkDataSet.h"
 #include "vtkFieldData.h"
@@ -106,9 +108,39 @@ bool vtkOctreeVolumeRepresentation::IsDrawable(vtkDataObject* data)
 }
 
 //----------------------------------------------------------------------------
-void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input)
+vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedPointSets(
+  vtkCompositeDataSet* composite, std::string& otherLeaf)
 {
-  const std::string type = input->GetClassName();
+  vtkNew<vtkAppendDataSets> append;
+  bool polyData = true;
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(composite->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    vtkDataObject* leaf = it->GetCurrentDataObject();
+    auto* points = vtkPointSet::SafeDownCast(leaf);
+    if (!points)
+    {
+      otherLeaf = leaf->GetClassName();
+      return nullptr;
+    }
+    polyData = polyData && vtkPolyData::SafeDownCast(points);
+    append->AddInputData(points);
+  }
+  if (append->GetNumberOfInputConnections(0) == 0)
+  {
+    return vtkSmartPointer<vtkPolyData>::New(); // no block on this rank: an empty piece
+  }
+  append->SetOutputDataSetType(polyData ? VTK_POLY_DATA : VTK_UNSTRUCTURED_GRID);
+  append->SetOutputPointsPrecision(vtkAlgorithm::DEFAULT_PRECISION);
+  append->Update();
+  return vtkPointSet::SafeDownCast(append->GetOutputDataObject(0));
+}
+
+//----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input, const std::string& otherLeaf)
+{
+  const std::string type = input->GetClassName() + (otherLeaf.empty() ? "" : " holding a " + otherLeaf);
   if (type == this->ReportedType)
   {
     return;
@@ -127,8 +159,8 @@ void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input)
   // Every rank holds the same type: one message, from the first rank.
   vtkWarningOnFirstRankMacro("Octree Volume cannot draw a "
     << type << ": it draws point sets (vtkPointSet: vtkPolyData, vtkUnstructuredGrid, "
-    << "vtkStructuredGrid, ...) and images (vtkImageData); nothing is drawn. To draw this data, "
-    << remedy << ".");
+    << "vtkStructuredGrid, ...), images (vtkImageData) and composite data of point sets; nothing "
+    << "is drawn. To draw this data, " << remedy << ".");
 }
 
 namespace
@@ -196,13 +228,25 @@ int vtkOctreeVolumeRepresentation::RequestData(
 //----------------------------------------------------------------------------
 void vtkOctreeVolumeRepresentation::CacheInput(vtkDataObject* data, int ranks)
 {
-  if (!IsDrawable(data))
+  // Composite data of point sets is drawn as one point set, as Merge Blocks
+  // would make it.
+  vtkSmartPointer<vtkPointSet> merged;
+  std::string otherLeaf;
+  if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
+  {
+    merged = MergedPointSets(composite, otherLeaf);
+  }
+  if (!IsDrawable(merged ? merged.Get() : data))
   {
     if (data)
     {
-      this->ReportUndrawable(data);
+      this->ReportUndrawable(data, otherLeaf);
     }
     return;
+  }
+  if (merged)
+  {
+    data = merged;
   }
   vtkDataSet* input = vtkDataSet::SafeDownCast(data);
   vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);

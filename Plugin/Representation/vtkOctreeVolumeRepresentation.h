@@ -38,10 +38,13 @@
  *   .cxx says why). Every rank's octree uses the cube of the global bounds,
  *   but a voxel that a cut crosses is drawn by two ranks, so pixels along
  *   the cuts can differ from the one-rank picture; a warning says so once.
- * - Input the mapper cannot draw (anything but vtkPointSet and vtkImageData:
- *   composite data, tables, rectilinear grids, ...) is accepted by the
- *   pipeline and draws nothing; a warning names its type, what can be drawn
- *   and the filter that converts it, once per input type.
+ * - Composite data (multiblock, partitioned) whose blocks are point sets is
+ *   drawn as one point set, as Merge Blocks would make it (MergedPointSets).
+ * - Input the mapper cannot draw (anything but vtkPointSet, vtkImageData and
+ *   composite data of point sets: tables, rectilinear grids, composite data
+ *   holding an image, ...) is accepted by the pipeline and draws nothing; a
+ *   warning names its type, what can be drawn and the filter that converts
+ *   it, once per input type.
  *
  * The mapper is created with vtkOctreeVolumeMapper::New(): CUDA when the
  * server has a usable device, else the CPU backend; the first render logs
@@ -62,8 +65,10 @@
 
 #include <string> // for std::string
 
+class vtkCompositeDataSet;
 class vtkDataSet;
 class vtkOctreeVolumeMapper;
+class vtkPointSet;
 class vtkOctreeVolumePresets;
 class vtkStringArray;
 class vtkTrivialProducer;
@@ -207,12 +212,23 @@ protected:
   static bool IsDrawable(vtkDataObject* data);
 
   /**
-   * The warning for an input the mapper cannot draw, naming its type, what
-   * can be drawn and the filter that converts it. Issued once per input type
-   * (and on the first rank only): RequestData does not repeat it for
-   * property changes or frames.
+   * The point sets of composite data (multiblock or partitioned: a reader's
+   * blocks) appended into one, as Merge Blocks makes them (vtkAppendDataSets:
+   * polydata where every block is, else an unstructured grid; point arrays
+   * that some blocks lack are dropped), or an empty vtkPolyData where this
+   * rank holds no block. Null where a block is not a point set, whose class
+   * goes to otherLeaf.
    */
-  void ReportUndrawable(vtkDataObject* input);
+  static vtkSmartPointer<vtkPointSet> MergedPointSets(vtkCompositeDataSet* composite, std::string& otherLeaf);
+
+  /**
+   * The warning for an input the mapper cannot draw, naming its type (and
+   * for composite data the block that is not a point set), what can be
+   * drawn and the filter that converts it. Issued once per input type (and
+   * on the first rank only): RequestData does not repeat it for property
+   * changes or frames.
+   */
+  void ReportUndrawable(vtkDataObject* input, const std::string& otherLeaf = std::string());
 
   vtkNew<vtkOctreeVolumeMapper> Mapper;
   // This rank's piece (a shallow copy of the input); null when the input

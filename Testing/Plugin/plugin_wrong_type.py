@@ -7,10 +7,11 @@ or `mpiexec -np 2 pvbatch`), collects what it prints (stdout and stderr,
 where ParaView's output window writes), and checks the warnings of
 vtkOctreeVolumeRepresentation:
 
-- a vtkMultiBlockDataSet (Group Datasets of a sphere and a cone) shown as
-  "Octree Volume", then rendered five times with camera and property changes
-  (the blend mode makes the representation run its RequestData again): the
-  warning naming vtkMultiBlockDataSet exactly once;
+- a vtkMultiBlockDataSet (Group Datasets of the Wavelet image and a
+  sphere) shown as "Octree Volume", then rendered five times with camera and
+  property changes (the blend mode makes the representation run its
+  RequestData again): the warning naming vtkMultiBlockDataSet and the image
+  block exactly once;
 - a vtkTable (ParaView's CSV reader on a particle file named .csv) given to
   the representation directly, rendered three times: the warning naming
   vtkTable, with the Table To Points hint, exactly once;
@@ -26,25 +27,26 @@ import os
 import subprocess
 import sys
 
-MULTIBLOCK = ("Octree Volume cannot draw a vtkMultiBlockDataSet: it draws point sets "
-              "(vtkPointSet: vtkPolyData, vtkUnstructuredGrid, vtkStructuredGrid, ...) and "
-              "images (vtkImageData); nothing is drawn. To draw this data, apply Merge Blocks "
-              "first to make one unstructured grid of its blocks.")
-TABLE = ("Octree Volume cannot draw a vtkTable: it draws point sets (vtkPointSet: vtkPolyData, "
-         "vtkUnstructuredGrid, vtkStructuredGrid, ...) and images (vtkImageData); nothing is "
-         "drawn. To draw this data, apply Table To Points first (or open a particle text file "
-         "with the Octoray Particle Reader).")
+DRAWS = ("it draws point sets (vtkPointSet: vtkPolyData, vtkUnstructuredGrid, vtkStructuredGrid, "
+         "...), images (vtkImageData) and composite data of point sets; nothing is drawn.")
+MULTIBLOCK = ("Octree Volume cannot draw a vtkMultiBlockDataSet holding a vtkImageData: " + DRAWS +
+              " To draw this data, apply Merge Blocks first to make one unstructured grid of its "
+              "blocks.")
+TABLE = ("Octree Volume cannot draw a vtkTable: " + DRAWS + " To draw this data, apply Table To "
+         "Points first (or open a particle text file with the Octoray Particle Reader).")
 
 
 def child(plugin, data, workdir):
-    from paraview.simple import (LoadPlugin, GroupDatasets, Sphere, Cone, Show, Render,
+    from paraview.simple import (LoadPlugin, GroupDatasets, Sphere, Wavelet, Show, Render,
                                  GetActiveViewOrCreate, CSVReader)
     from paraview import servermanager
     LoadPlugin(plugin, remote=False, ns=globals())
     view = GetActiveViewOrCreate("RenderView")
     view.ViewSize = [200, 150]
 
-    group = GroupDatasets(Input=[Sphere(), Cone()])
+    # An image among the blocks: composite data of point sets alone is drawn
+    # (plugin_composite.py).
+    group = GroupDatasets(Input=[Wavelet(), Sphere()])
     display = Show(group, view)
     display.SetRepresentationType("Octree Volume")
     for frame in range(5):
