@@ -241,7 +241,6 @@ def test_gradient_normals_follow_the_sphere():
     assert off_error > 2 * error, (off_error, error)
 
 
-
 @pytest.mark.parametrize("select,expected", [
     (None, "Every voxel of the image is at or below the background 5; nothing to draw."),
     ("NoSuchArray", "The image has no point scalars selected, so every voxel counts as 1, at or below the "
@@ -285,7 +284,6 @@ def test_a_small_change_of_the_background_rebuilds():
     window.Render()
     assert mapper.GetNumberOfBuilds() == 2
     assert mapper.GetNumberOfOctreePoints() == int((values > 5e-8).sum()) < low
-
 
 
 def test_vector_voxels_go_by_the_value_the_colour_function_reads():
