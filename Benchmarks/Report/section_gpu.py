@@ -110,6 +110,55 @@ def _staging_checks(ctx):
     ]
 
 
+TOOL_CHECKS_FILE = "summary-tool-check.txt"
+
+
+def tool_check_calls(path):
+    """[(header, lines)] of the calls recorded in TOOL_CHECKS_FILE, in order:
+    each part starts with "== " and a header of its own; the closing table
+    it holds starts with "== octoray GPU check", which is not a part."""
+    calls = []
+    with open(path) as f:
+        for line in f:
+            line = line.rstrip("\n")
+            if line.startswith("== ") and not line.startswith("== octoray GPU check"):
+                calls.append((line[3:], []))
+            elif calls:
+                calls[-1][1].append(line)
+    return calls
+
+
+def _later_calls(ctx, last=3):
+    """The last calls of TOOL_CHECKS_FILE (tests and sanitizers on later
+    commits than the report's run), each with its counts."""
+    path = ctx.gpu_file(TOOL_CHECKS_FILE)
+    if not path:
+        return []
+    rows = []
+    for header, lines in tool_check_calls(path)[-last:]:
+        text = "\n".join(lines)
+        engine = re.search(r"^\[  PASSED  \] (\d+) tests\.$", text, re.M)
+        mapper = re.search(r"^(\d+)% tests passed out of (\d+)$", text, re.M)
+        tools = len(re.findall(r"^\d+/\d+ Test +#\d+: engine\.tool\S* \.+ +Passed", text, re.M))
+        sanitizers = re.findall(r"^[\w-]+: +(\d+) =+ ERROR SUMMARY: (\d+) errors", text, re.M)
+        errors = sum(int(e) for _, e in sanitizers)
+        runs = sum(int(n) for n, _ in sanitizers)
+        rows.append((header.split(" (")[0],
+                     f"{engine.group(1)} passed" if engine else "no count",
+                     ("%s of %s passed" % (mapper.group(2), mapper.group(2)) if mapper and mapper.group(1) == "100"
+                      else f"{mapper.group(1)} % of {mapper.group(2)} passed" if mapper else "no count"),
+                     f"{tools} passed",
+                     f"{errors} errors over {runs} runs" if sanitizers else "not run"))
+    return [
+        "Later calls, tests and sanitizers alone, on the commits each names ([gpu/%s](gpu/%s), where each "
+        "part says what changed; commands in [gpu/COMMAND.md](gpu/COMMAND.md)):" % (TOOL_CHECKS_FILE,
+                                                                                  TOOL_CHECKS_FILE),
+        "",
+        ctx.table(["call", "engine tests", "mapper tests", "tool tests", "compute-sanitizer"], rows, "lllll"),
+        "",
+    ]
+
+
 def render(ctx):
     summary_path = ctx.gpu_file("summary.txt")
     if not summary_path:
@@ -168,6 +217,7 @@ def render(ctx):
         "",
         *_device_checks(ctx),
         *_staging_checks(ctx),
+        *_later_calls(ctx),
         "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",
         "plugin (ParaView is not built there); its CPU backend runs in `make test`.",
     ]
