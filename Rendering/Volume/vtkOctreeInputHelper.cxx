@@ -1,6 +1,7 @@
 #include "vtkOctreeInputHelper.h"
 
 #include "vtkAbstractMapper.h"
+#include "vtkCellData.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -292,23 +293,42 @@ std::string ShortArray(const vtkOctreeInputHelper::Request& r)
 
 //------------------------------------------------------------------------------
 // An array name the user set (`property`, not the default) that names no
-// point array: what the frame goes without, with the arrays there are, so a
-// misspelt name is seen. "" where it names one, or is the default.
-std::string MissingNamedArray(
-  vtkPointData* pd, const char* property, const char* name, const char* defaultName, const char* effect)
+// `kind` ("point", "cell") array of `data`: what the frame goes without,
+// with the arrays there are, so a misspelt name is seen. "" where it names
+// one, or is the default.
+std::string MissingNamedArray(vtkDataSetAttributes* data, const char* kind, const char* property, const char* name,
+  const char* defaultName, const char* effect)
 {
-  if (!name || std::strcmp(name, defaultName) == 0 || pd->GetArray(name))
+  if (!name || std::strcmp(name, defaultName) == 0 || data->GetArray(name))
   {
     return "";
   }
   std::string arrays;
-  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  for (int i = 0; i < data->GetNumberOfArrays(); ++i)
   {
-    const char* other = pd->GetArrayName(i);
+    const char* other = data->GetArrayName(i);
     arrays += (i ? ", " : "") + std::string(other ? other : "(unnamed)");
   }
-  return std::string(property) + " '" + name + "' names no point array of the input (its arrays: " +
+  return std::string(property) + " '" + name + "' names no " + kind + " array of the input (its arrays: " +
     (arrays.empty() ? "none" : arrays) + "); " + effect + ".";
+}
+
+//------------------------------------------------------------------------------
+// A scalar array selected by name (SelectScalarArray, ParaView's colour
+// array) that the input lacks, which the frame is drawn without: said, as
+// the other named arrays are. "" where there is none to say.
+std::string MissingScalarArray(vtkDataSet* input, vtkOctreeVolumeMapper* mapper)
+{
+  const int mode = mapper->GetScalarMode();
+  if (mapper->GetArrayAccessMode() != VTK_GET_ARRAY_BY_NAME ||
+    (mode != VTK_SCALAR_MODE_USE_POINT_FIELD_DATA && mode != VTK_SCALAR_MODE_USE_CELL_FIELD_DATA))
+  {
+    return "";
+  }
+  const bool cells = mode == VTK_SCALAR_MODE_USE_CELL_FIELD_DATA;
+  return MissingNamedArray(cells ? static_cast<vtkDataSetAttributes*>(input->GetCellData()) : input->GetPointData(),
+    cells ? "cell" : "point", "SelectScalarArray", mapper->GetArrayName(), "",
+    "the voxels are drawn in their own colours, or white");
 }
 
 //------------------------------------------------------------------------------
@@ -367,6 +387,14 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
     r.CellScalars = true;
     r.Scalars = nullptr;
   }
+  if (!r.Scalars)
+  {
+    const std::string missing = MissingScalarArray(input, mapper);
+    if (!missing.empty())
+    {
+      r.Notices.push_back(missing);
+    }
+  }
   const int components = r.Scalars ? r.Scalars->GetNumberOfComponents() : 0;
   r.Colours = r.Scalars && !property->GetIndependentComponents() && (components == 3 || components == 4);
   if (r.Scalars && !r.Colours)
@@ -381,8 +409,10 @@ vtkOctreeInputHelper::Request vtkOctreeInputHelper::MakeRequest(vtkDataSet* inpu
     r.Reflectivity = reflectivity ? pd->GetArray(reflectivity) : nullptr;
     r.Refraction = refraction ? pd->GetArray(refraction) : nullptr;
     const std::string missing[2] = {
-      MissingNamedArray(pd, "ReflectivityArrayName", reflectivity, DefaultReflectivityArrayName, "nothing reflects"),
-      MissingNamedArray(pd, "RefractionArrayName", refraction, DefaultRefractionArrayName, "nothing refracts")
+      MissingNamedArray(pd, "point", "ReflectivityArrayName", reflectivity, DefaultReflectivityArrayName,
+        "nothing reflects"),
+      MissingNamedArray(pd, "point", "RefractionArrayName", refraction, DefaultRefractionArrayName,
+        "nothing refracts")
     };
     for (const std::string& notice : missing)
     {

@@ -161,6 +161,32 @@ def test_a_named_array_the_input_lacks_is_said_once():
                                    "(its arrays: Intensity); nothing reflects.")
 
 
+@pytest.mark.parametrize("mode", ["SetScalarModeToUsePointFieldData", "SetScalarModeToUseCellFieldData"])
+def test_a_scalar_array_the_input_lacks_is_said_once(mode):
+    """SelectScalarArray naming an array the input lacks (a misspelling, or
+    in ParaView an array that some blocks of composite data lack): the
+    voxels are drawn as with no array, and one warning over frames names
+    the array, which kind of array it looked for and those there are."""
+    import vtk
+    cloud = random_cloud(1000)
+    intensity = vtk.vtkFloatArray()
+    intensity.SetName("Intensity")
+    intensity.SetNumberOfTuples(1000)
+    intensity.Fill(1.0)
+    cloud.GetPointData().AddArray(intensity)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(cloud)
+    window, said = offscreen_view(mapper)
+    window.Render()
+    plain = window_pixels(window)
+    getattr(mapper, mode)()
+    mapper.SelectScalarArray("intensity")
+    kind, arrays = ("cell", "none") if "Cell" in mode else ("point", "Intensity")
+    assert_said_once(window, said, "SelectScalarArray 'intensity' names no %s array of the input (its arrays: %s); "
+                                   "the voxels are drawn in their own colours, or white." % (kind, arrays))
+    assert (window_pixels(window) == plain).all()
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any
