@@ -139,11 +139,9 @@ def window_pixels(window):
     return vtk_to_numpy(grab.GetOutput().GetPointData().GetScalars()).reshape(-1, 3).copy()
 
 
-def test_a_named_array_the_input_lacks_is_said_once():
-    """ReflectivityArrayName set to a name the input has no array of (a
-    misspelling): one warning over frames, naming the property, the name
-    and the arrays there are. The default names missing say nothing: most
-    inputs have no reflectivity."""
+def intensity_cloud_view():
+    """1000 random points with a point array "Intensity" (all 1) drawn once
+    by a CPU mapper: (mapper, window, the mapper's messages)."""
     import vtk
     cloud = random_cloud(1000)
     intensity = vtk.vtkFloatArray()
@@ -155,6 +153,15 @@ def test_a_named_array_the_input_lacks_is_said_once():
     mapper.SetInputData(cloud)
     window, said = offscreen_view(mapper)
     window.Render()
+    return mapper, window, said
+
+
+def test_a_named_array_the_input_lacks_is_said_once():
+    """ReflectivityArrayName set to a name the input has no array of (a
+    misspelling): one warning over frames, naming the property, the name
+    and the arrays there are. The default names missing say nothing: most
+    inputs have no reflectivity."""
+    mapper, window, said = intensity_cloud_view()
     assert said == []
     mapper.SetReflectivityArrayName("reflectivity")
     assert_said_once(window, said, "ReflectivityArrayName 'reflectivity' names no point array of the input "
@@ -167,17 +174,7 @@ def test_a_scalar_array_the_input_lacks_is_said_once(mode):
     in ParaView an array that some blocks of composite data lack): the
     voxels are drawn as with no array, and one warning over frames names
     the array, which kind of array it looked for and those there are."""
-    import vtk
-    cloud = random_cloud(1000)
-    intensity = vtk.vtkFloatArray()
-    intensity.SetName("Intensity")
-    intensity.SetNumberOfTuples(1000)
-    intensity.Fill(1.0)
-    cloud.GetPointData().AddArray(intensity)
-    mapper = octoray.vtkCPUOctreeVolumeMapper()
-    mapper.SetInputData(cloud)
-    window, said = offscreen_view(mapper)
-    window.Render()
+    mapper, window, said = intensity_cloud_view()
     plain = window_pixels(window)
     getattr(mapper, mode)()
     mapper.SelectScalarArray("intensity")
