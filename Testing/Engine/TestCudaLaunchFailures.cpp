@@ -177,6 +177,31 @@ TEST_F(CudaFaultsLaunch, RenderKeepsTheOctreeAndTheNextFrame)
   EXPECT_EQ(Picture(*engine), picture);
 }
 
+// Normals estimated for a cloud without them (RenderSettings::
+// estimateNormals) are made at the first frame that shades by them: a
+// refused estimate is that frame's error, and the next frame makes them.
+TEST_F(CudaFaultsLaunch, RefusedNormalEstimationIsMadeByTheNextFrame)
+{
+  const Cloud cloud = UniformCloud(3000, 65).WithExactMeans(); // no normals
+  BuildOptions options;
+  options.depth = 6;
+  RenderSettings s = SmallView();
+  s.shade = ShadeMode::Phong;
+  s.estimateNormals = true;
+  const auto picture = [&](Engine& engine) {
+    Image image;
+    engine.Render(s, image);
+    return image.rgba;
+  };
+  auto engine = CreateEngine(Backend::CUDA);
+  engine->Build(cloud.View(), options);
+  InjectCudaLaunchFailure("EstimateNormalsKernel");
+  EXPECT_TRUE(IsRefusal(ErrorOf([&] { picture(*engine); }), "EstimateNormalsKernel"));
+  auto fresh = CreateEngine(Backend::CUDA);
+  fresh->Build(cloud.View(), options);
+  EXPECT_EQ(picture(*engine), picture(*fresh));
+}
+
 TEST_F(CudaFaultsLaunch, UpdateSaysWhatBecameOfTheOctree)
 {
   const Cloud base = UniformCloud(4000, 64).WithExactMeans(); // the in-place path: no rounded means

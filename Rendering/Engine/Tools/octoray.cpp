@@ -40,7 +40,8 @@ int Usage(std::FILE* to = stderr)
     "       octoray render FILE -o OUT.png [--size WxH] [--mode MODE] [--depth N] [--lod K]\n"
     "                      [--shadows] [--bounces N] [--backend auto|cpu|cuda] [--threads N]\n"
     "                      [--azimuth DEG] [--elevation DEG] [--zoom F]\n"
-    "  MODE: surface (flat colours, default), depthcue, phong, composite, mip, minip, average, additive\n"
+    "  MODE: surface (flat colours, default), depthcue, phong, composite, mip, minip, average, additive;\n"
+    "  phong lights points without normals by normals fitted to their voxels\n"
     "  the camera orbits the data's centre (azimuth about +z, elevation above the xy plane);\n"
     "  PNG through OpenImageIO where it was found at build time, else binary PPM\n");
 }
@@ -314,6 +315,7 @@ octoray::RenderSettings SceneSettings(const RenderOptions& o, const octoray::Poi
   s.maxBounces = o.bounces;
   s.lodPixels = static_cast<float>(o.lod);
   s.shadows = o.shadows;
+  s.estimateNormals = true; // as the VTK mapper does by default
   s.shade = o.mode->shade;
   s.blend = o.mode->blend;
   // The camera frames the leaves that hold the points, not the points
@@ -384,7 +386,7 @@ int Render(int argc, char** argv)
   const Built b = LoadAndBuild(argv[2], o.engine);
   const octoray::RenderSettings s = SceneSettings(o, b.file.View(), b.stats);
   octoray::Image image;
-  b.engine->Render(s, image); // first frame: buffers, caches
+  const octoray::RenderStats first = b.engine->Render(s, image); // buffers, caches, estimated normals
   const octoray::RenderStats stats = b.engine->Render(s, image);
   const auto start = std::chrono::steady_clock::now();
   const std::string written = WriteImage(o.output, o.width, o.height, Composite(image, Gain(image, s.blend)));
@@ -394,6 +396,11 @@ int Render(int argc, char** argv)
   PrintSource(b);
   std::printf("build           %.3f ms (depth %d, %zu nodes)\n", b.stats.seconds * 1e3, b.stats.depth,
     b.stats.nodes);
+  if (first.normalSeconds > 0)
+  {
+    std::printf("normals         %.3f ms, estimated from the voxels (the points have none)\n",
+      first.normalSeconds * 1e3);
+  }
   std::printf("render          %.3f ms, %dx%d, mode %s%s, %zu primary + %zu secondary rays\n", stats.seconds * 1e3,
     o.width, o.height, o.mode->name, o.shadows ? " + shadows" : "", stats.primaryRays, stats.secondaryRays);
   std::printf("throughput      %.2f Mrays/s (%.2f Mrays/s primary)\n", rays / stats.seconds * 1e-6,

@@ -156,7 +156,8 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
   }
   ValidateRender(State->count, DiscardedByUpdate);
   const auto start = std::chrono::steady_clock::now();
-  const OctreeView view = View();
+  double normalSeconds = 0.0;
+  const OctreeView view = ShadingView(settings, normalSeconds);
   const FrameConstants frame = MakeFrame(settings, view);
   image.width = settings.width;
   image.height = settings.height;
@@ -194,6 +195,7 @@ RenderStats CpuEngine::Render(const RenderSettings& settings, Image& image)
     });
   });
   RenderStats stats;
+  stats.normalSeconds = normalSeconds;
   stats.primaryRays = pixels;
   for (std::size_t r : secondary)
   {

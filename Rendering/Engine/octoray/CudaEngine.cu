@@ -168,7 +168,8 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   ImageWidth = ImageHeight = 0; // no picture until this one is complete
   ValidateRender(State->count, DiscardedByUpdate);
   const auto start = std::chrono::steady_clock::now();
-  const OctreeView view = View();
+  double normalSeconds = 0.0;
+  const OctreeView view = ShadingView(settings, normalSeconds);
   FrameConstants frame = MakeFrame(settings, view);
   PlaceFrameInputs(settings, frame);
   const std::size_t pixels = static_cast<std::size_t>(settings.width) * settings.height;
@@ -193,6 +194,7 @@ RenderStats CudaEngine::Render(const RenderSettings& settings, Image& image)
   });
   Dev.Synchronize("RenderKernel");
   RenderStats stats;
+  stats.normalSeconds = normalSeconds;
   stats.primaryRays = pixels;
   unsigned long long secondary = 0;
   Dev.ToHost(RayCounter.Get(), 1, &secondary, "RenderKernel");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "Engine.h"
+#include "NormalEstimation.h"
 #include "OctreeDriver.h"
 
 #include <memory>
@@ -37,6 +38,7 @@ public:
       throw;
     }
     DiscardedByUpdate = false;
+    ForgetEstimatedNormals();
     stats.bytes = Memory().Total();
     stats.seconds = SecondsSince(start);
     return stats;
@@ -53,6 +55,7 @@ public:
     bool writing = false;
     try
     {
+      ForgetEstimatedNormals(); // the nodes change, and an update may fail part-way
       return UpdateOctree(Dev, Scratch, *State, positions, writing);
     }
     catch (const Error& e)
@@ -90,7 +93,35 @@ public:
   // The octree in the device's memory, for the renderer.
   OctreeView View() const { return State->View(); }
 
+  // The octree as a frame of `settings` shades it: with the normals
+  // estimated from its voxels where it has none of its own and the frame
+  // asks for them (made now if not yet made for these nodes, the seconds
+  // that took in `normalSeconds`).
+  OctreeView ShadingView(const RenderSettings& settings, double& normalSeconds)
+  {
+    normalSeconds = 0.0;
+    OctreeView view = View();
+    if (view.normal || !settings.estimateNormals || !FrameUsesNormals(settings, view.attributes))
+    {
+      return view;
+    }
+    if (!State->normalsEstimated)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      EstimateNormals(Dev, *State);
+      normalSeconds = SecondsSince(start);
+    }
+    view.normal = State->estimatedNormals.Get();
+    return view;
+  }
+
 protected:
+  void ForgetEstimatedNormals()
+  {
+    State->normalsEstimated = false;
+    Dev.Release(State->estimatedNormals);
+  }
+
   // Declared first, so that its memory (CudaDevice's pool) outlives every
   // buffer below and in derived engines.
   mutable Device Dev;

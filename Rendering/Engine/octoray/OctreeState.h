@@ -26,6 +26,11 @@ struct OctreeState
   ScalarRange scalarRange; // what the scalars' codes are relative to (Scalar16.h)
   std::uint32_t levelBegin[kMaxLevel + 2] = {}; // nodes of level l: [levelBegin[l], levelBegin[l+1])
   NodeArrays<Device::template Buffer> nodes;
+  // Normals estimated from the voxels (NormalEstimation.h) for an octree of
+  // points without normals, made at the first frame that shades by them
+  // (RenderSettings::estimateNormals) and kept until the nodes change.
+  typename Device::template Buffer<OctNormal> estimatedNormals;
+  bool normalsEstimated = false;
 
   PointArraysView Points() const
   {
@@ -98,6 +103,7 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
 {
   MemoryReport m;
   ForEachNodeArray([&](auto a) { m.Add(MemoryReport::NodeArray(a.kLabel), a.Of(s.nodes).Bytes()); });
+  m.Add(MemoryReport::NodeArray("normals (estimated)"), s.estimatedNormals.Bytes());
   m.Add("point positions", s.points.xyzFloat.Bytes() + s.points.xyzDouble.Bytes());
   // Each attribute's words of the records.
   const PointRecordLayout& layout = s.points.layout;

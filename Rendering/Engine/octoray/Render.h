@@ -73,6 +73,12 @@ struct RenderSettings
   // the camera.
   std::vector<Light> lights;
   bool shadows = false;
+  // Where the octree has no normals (its points had none), light and bend
+  // rays by normals fitted to the voxels around each node
+  // (NormalEstimation.h), made at the first such frame after a build or an
+  // update and kept; off, by the six neighbours' occupancy gradient
+  // (RenderKernels.h's SurfaceNormal).
+  bool estimateNormals = false;
   // In world coordinates, at most kMaxClipPlanes; each normal non-zero.
   std::vector<ClipPlane> clipPlanes;
   int maxBounces = 2;          // reflections and refractions together
@@ -126,6 +132,9 @@ struct RenderStats
 {
   double seconds = 0.0;     // the frame, up to the picture in the backend's memory
   double copySeconds = 0.0; // CUDA: the copy of the picture to the host
+  // Of `seconds`: the normals estimated for this octree (RenderSettings::
+  // estimateNormals) where this frame made them; 0 where it did not.
+  double normalSeconds = 0.0;
   std::size_t primaryRays = 0;
   std::size_t secondaryRays = 0; // shadow, reflected and refracted
 };
