@@ -604,6 +604,10 @@ void vtkOctreeVolumeRepresentation::SetShadows(bool val)
 {
   this->Mapper->SetShadows(val);
 }
+void vtkOctreeVolumeRepresentation::SetEstimateNormals(bool val)
+{
+  this->Mapper->SetEstimateNormals(val);
+}
 void vtkOctreeVolumeRepresentation::SetMaximumBounces(int val)
 {
   this->Mapper->SetMaximumBounces(val);

@@ -104,6 +104,7 @@ public:
   void SetLeafDepth(int);
   void SetLODPixelThreshold(double);
   void SetShadows(bool);
+  void SetEstimateNormals(bool);
   void SetMaximumBounces(int);
   void SetDepthCue(double);
   void SetImageSampleDistance(double);

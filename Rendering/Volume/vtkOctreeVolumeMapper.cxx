@@ -391,6 +391,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << this->RootBounds[2] << " " << this->RootBounds[3] << " " << this->RootBounds[4] << " "
      << this->RootBounds[5] << "\n";
   os << indent << "Shadows: " << (this->Shadows ? "On" : "Off") << "\n";
+  os << indent << "EstimateNormals: " << (this->EstimateNormals ? "On" : "Off") << "\n";
   os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
   os << indent << "DepthCue: " << this->DepthCue << "\n";
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";

@@ -237,6 +237,21 @@ public:
 
   ///@{
   /**
+   * Points without normals (no normals array, or image input with
+   * ImageGradientNormals off): light them, and bend reflected and refracted
+   * rays, by the normal of the plane fitted to the voxels within two voxels
+   * of each one (made once per octree, at the first frame that shades it).
+   * Off: by the occupancy of the six neighbouring voxels, which on a scanned
+   * surface one voxel thick shows as speckle. On by default. Normals the
+   * input has are always used.
+   */
+  vtkSetMacro(EstimateNormals, bool);
+  vtkGetMacro(EstimateNormals, bool);
+  vtkBooleanMacro(EstimateNormals, bool);
+  ///@}
+
+  ///@{
+  /**
    * Reflections and refractions a ray may follow (surface mode). Default 2.
    */
   vtkSetClampMacro(MaximumBounces, int, 0, 8);
@@ -426,6 +441,7 @@ protected:
   double LODPixelThreshold = 1.0;
   double RootBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   bool Shadows = false;
+  bool EstimateNormals = true;
   int MaximumBounces = 2;
   double DepthCue = 0.0;
   double ImageSampleDistance = 1.0;

@@ -303,6 +303,7 @@ octoray::RenderSettings vtkOctreeVolumeMapper::vtkInternals::FrameSettings(
   vtkOctreeRenderSettings::SetShading(property, self->DepthCue, s);
   this->WarnOnce(vtkOctreeRenderSettings::UnappliedProperty(property));
   s.shadows = self->Shadows;
+  s.estimateNormals = self->EstimateNormals;
   s.maxBounces = self->MaximumBounces;
   s.lodPixels = static_cast<float>(self->LODPixelThreshold);
   const int ignoredLights = vtkOctreeRenderSettings::SetLights(ren->GetLights(), vol->GetMatrix(), s);

@@ -3,7 +3,7 @@
     python3 -m octoray.render INPUT -o out.png [--backend auto|cuda|cpu]
         [--size 1920x1080] [--mode surface|phong|depthcue|composite|mip|minip|average|additive]
         [--shadows] [--preset ct-bone|ct-skin|ct-muscle] [--threshold V]
-        [--color-by auto|colors|intensity|z|none|ARRAY] [--normals auto|pcl|none]
+        [--color-by auto|colors|intensity|z|none|ARRAY] [--normals auto|pcl|voxels|none]
         [--azimuth DEG] [--elevation DEG] [--zoom F] [--parallel] [--depth N]
         [--background LO HI] [--particles] [--no-fill]
         [--clip OX OY OZ NX NY NZ]... [--crop X0 X1 Y0 Y1 Z0 Z1]
@@ -24,7 +24,9 @@ Defaults: --preset applies a CT transfer function (Hounsfield units) and its
 threshold; points without RGB colours are coloured by their Intensity array,
 else by elevation z, through viridis over the 1st to 99th percentile;
 --mode phong estimates normals with PCL where the points have none (a
-slice stack's particles carry the reader's gradient normals); the
+slice stack's particles carry the reader's gradient normals; --normals
+voxels fits them to the octree's voxels instead, none lights the voxels by
+their occupancy); the
 camera faces a DICOM head from the front (patient anterior, head up) and a
 PCD scan from its sensor, --azimuth and --elevation turn it from there; a
 key light above-left of the camera casts the shadows (--shadows) and a
@@ -81,8 +83,9 @@ def parser():
     p.add_argument("--color-by", default="auto", metavar="WHAT",
                    help="points: colors, intensity, z, none or an array name, by its magnitude where it has "
                         "several components (auto: colors when the points have them, else Intensity, else z)")
-    p.add_argument("--normals", choices=["auto", "pcl", "none"], default="auto",
-                   help="auto: PCL normals for phong when the points have none")
+    p.add_argument("--normals", choices=["auto", "pcl", "voxels", "none"], default="auto",
+                   help="auto: PCL normals for phong when the points have none; voxels: fitted to the "
+                        "octree's voxels (the mapper's EstimateNormals); none: the voxels' occupancy")
     p.add_argument("--azimuth", type=float, default=0.0)
     p.add_argument("--elevation", type=float, default=0.0)
     p.add_argument("--zoom", type=float, default=1.0)
@@ -190,6 +193,7 @@ def main(argv=None):
               "cuda": octoray.vtkCudaOctreeVolumeMapper,
               "cpu": octoray.vtkCPUOctreeVolumeMapper}[args.backend]()
     mapper.SetLeafDepth(args.depth)
+    mapper.SetEstimateNormals(args.normals != "none")
     mapper.AddObserver("ProgressEvent", scene.ProgressBar("building"))
     {"surface": mapper.SetBlendModeToSurface,
      "composite": mapper.SetBlendModeToComposite,
