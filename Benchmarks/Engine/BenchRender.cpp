@@ -7,7 +7,10 @@
 //                        [--sphere-points N] [--parts modes,off] [--json PATH]
 //
 // --parts picks what runs: `modes` (throughput per mode and scene), `off`
-// (the everything-off frames), `traversal` (one core's primary rays in
+// (the everything-off frames), `normals` (the sphere field without its
+// normals: the time to estimate them from the voxels, and the Phong
+// picture by them and by occupancy against the one by the points' own
+// radial normals), `traversal` (one core's primary rays in
 // packets of eight, through Traverse one by one, and through the plain
 // slab-test traversal of ReferenceTraversal.h, in the same run); default
 // modes and off. Image error against time is
@@ -202,6 +205,58 @@ Record CompareTraversals(Engine& engine, const Scene& scene, int w, int h, int r
   return r;
 }
 
+// The mean over the pixels of the largest channel difference, in 1/255.
+double MeanDifference(const Image& a, const Image& b)
+{
+  double sum = 0.0;
+  const std::size_t pixels = a.rgba.size() / 4;
+  for (std::size_t i = 0; i < pixels; ++i)
+  {
+    float worst = 0.0f;
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::fabs(a.rgba[4 * i + c] - b.rgba[4 * i + c]));
+    sum += worst;
+  }
+  return 255.0 * sum / pixels;
+}
+
+// The sphere field's Phong picture by its radial normals, and without them
+// by the normals estimated from its voxels and by occupancy: how long the
+// estimate takes and how far each picture is from the first.
+Record CompareNormals(Engine& engine, const SphereField& spheres, int w, int h, int repeats)
+{
+  const Mode& phong = kModes[2];
+  BuildOptions options{ 8 };
+  RenderSettings s = MakeSettings(spheres.View(false, true), w, h, phong, 8);
+  Image given, estimated, occupancy;
+  engine.Build(spheres.View(false, true), options);
+  const Timing tGiven = Measure([&] { engine.Render(s, given); }, 1, repeats);
+  // Each build's first frame estimates them (the first build's is a warm-up).
+  s.estimateNormals = true;
+  std::vector<double> estimates;
+  for (int r = 0; r <= repeats; ++r)
+  {
+    engine.Build(spheres.View(false, false), options);
+    estimates.push_back(engine.Render(s, estimated).normalSeconds);
+  }
+  estimates.erase(estimates.begin());
+  const double estimate = Summarise(estimates).median;
+  const Timing tEstimated = Measure([&] { engine.Render(s, estimated); }, 1, repeats);
+  s.estimateNormals = false;
+  engine.Render(s, occupancy);
+  std::printf("\nnormals of the spheres (%zu points, depth 8, Phong, %dx%d): the points' own, estimated from the "
+              "voxels, occupancy\n",
+    spheres.xyz.size() / 3, w, h);
+  std::printf("| normals | estimate ms | frame ms | mean difference from the "
+              "points' own, 1/255 |\n| --- | ---: | ---: | ---: |\n");
+  std::printf("| the points' own (radial) | - | %.1f | 0 |\n", tGiven.median * 1e3);
+  std::printf("| estimated from the voxels | %.1f | %.1f | %.2f |\n", estimate * 1e3,
+    tEstimated.median * 1e3, MeanDifference(estimated, given));
+  std::printf("| occupancy of six neighbours | - | - | %.2f |\n", MeanDifference(occupancy, given));
+  return Record{ "render.spheres.normal-estimate", engine.Description(), spheres.xyz.size() / 3, 8, estimate,
+    "render.spheres.phong", tGiven.median };
+}
+
 int main(int argc, char** argv)
 {
   int w = 1920, h = 1080, repeats = 3, threads = 0;
@@ -282,6 +337,11 @@ int main(int argc, char** argv)
         {
           records.push_back(CompareTraversals(*engine, scene, w, h, repeats));
         }
+      }
+
+      if (wanted("normals"))
+      {
+        records.push_back(CompareNormals(*engine, spheres, w, h, repeats));
       }
 
       // Everything off: the sphere field without reflectivity, rendered
