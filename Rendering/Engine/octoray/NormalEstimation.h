@@ -78,24 +78,40 @@ OCTORAY_HD std::uint32_t NodeAt(const OctreeView& tree, int level, int x, int y,
                 : kInvalidIndex;
 }
 
+// The octants of a block of 4 cells an axis at (bx, by, bz), each 2 cells
+// an axis, that reach within kNormalFitRadius of cell (cx, cy, cz).
+OCTORAY_HD unsigned OctantsNear(int bx, int by, int bz, int cx, int cy, int cz)
+{
+  unsigned octants = 0;
+  for (unsigned o = 0; o < 8; ++o)
+  {
+    const int x = 4 * bx + 2 * static_cast<int>(o & 1u), y = 4 * by + 2 * static_cast<int>(o >> 1 & 1u),
+              z = 4 * bz + 2 * static_cast<int>(o >> 2 & 1u);
+    const bool near = x + 1 >= cx - kNormalFitRadius && x <= cx + kNormalFitRadius &&
+      y + 1 >= cy - kNormalFitRadius && y <= cy + kNormalFitRadius && z + 1 >= cz - kNormalFitRadius &&
+      z <= cz + kNormalFitRadius;
+    octants |= near ? 1u << o : 0u;
+  }
+  return octants;
+}
+
 // fn(x, y, z) for each occupied cell two levels below node `block` of cell
-// (bx, by, bz): the child masks of its children.
+// (bx, by, bz), in its children of `octants`: their child masks.
 template <typename Fn>
-OCTORAY_HD void ForEachGrandchildCell(const OctreeView& tree, std::uint32_t block, int bx, int by, int bz, Fn&& fn)
+OCTORAY_HD void ForEachGrandchildCell(
+  const OctreeView& tree, std::uint32_t block, int bx, int by, int bz, unsigned octants, Fn&& fn)
 {
   const unsigned children = ChildMaskOf(tree, block);
   const std::uint32_t firstChild = FirstChildOf(tree, block);
-  for (unsigned c = 0; c < 8; ++c)
+  for (unsigned left = children & octants; left != 0; left &= left - 1)
   {
-    const unsigned grandchildren = (children >> c & 1u) ? ChildMaskOf(tree, ChildIndex(children, firstChild, c)) : 0u;
-    for (unsigned g = 0; g < 8; ++g)
+    const unsigned c = LowestBit(left);
+    for (unsigned cells = ChildMaskOf(tree, ChildIndex(children, firstChild, c)); cells != 0; cells &= cells - 1)
     {
-      if (grandchildren >> g & 1u)
-      {
-        fn(4 * bx + 2 * static_cast<int>(c & 1u) + static_cast<int>(g & 1u),
-          4 * by + 2 * static_cast<int>(c >> 1 & 1u) + static_cast<int>(g >> 1 & 1u),
-          4 * bz + 2 * static_cast<int>(c >> 2 & 1u) + static_cast<int>(g >> 2 & 1u));
-      }
+      const unsigned g = LowestBit(cells);
+      fn(4 * bx + 2 * static_cast<int>(c & 1u) + static_cast<int>(g & 1u),
+        4 * by + 2 * static_cast<int>(c >> 1 & 1u) + static_cast<int>(g >> 1 & 1u),
+        4 * bz + 2 * static_cast<int>(c >> 2 & 1u) + static_cast<int>(g >> 2 & 1u));
     }
   }
 }
@@ -139,10 +155,33 @@ OCTORAY_HD void ForEachOccupiedNear(const OctreeView& tree, int level, int cx, i
     const std::uint32_t block = NodeAt(tree, level - 2, bx, by, bz);
     if (block != kInvalidIndex)
     {
-      ForEachGrandchildCell(tree, block, bx, by, bz, near);
+      ForEachGrandchildCell(tree, block, bx, by, bz, OctantsNear(bx, by, bz, cx, cy, cz), near);
     }
   }
 }
+
+// The first and second moments of a set of voxels' offsets, in integers
+// (offsets of at most kNormalFitRadius, at most 125 voxels: no overflow).
+struct VoxelMoments
+{
+  int count = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+
+  OCTORAY_HD void Add(int dx, int dy, int dz)
+  {
+    ++count;
+    x += dx, y += dy, z += dz;
+    xx += dx * dx, xy += dx * dy, xz += dx * dz, yy += dy * dy, yz += dy * dz, zz += dz * dz;
+  }
+
+  // The direction in which the voxels spread least (LeastSpreadDirection of
+  // their covariance).
+  OCTORAY_HD Vec3d LeastSpread() const
+  {
+    const double inv = 1.0 / count, mx = x * inv, my = y * inv, mz = z * inv;
+    return LeastSpreadDirection(xx * inv - mx * mx, xy * inv - mx * my, xz * inv - mx * mz, yy * inv - my * my,
+      yz * inv - my * mz, zz * inv - mz * mz);
+  }
+};
 
 // The normal of node `n` of `level` (either sign), from the voxels of that
 // level within kNormalFitRadius of it; zero where they fit no plane.
@@ -150,18 +189,10 @@ OCTORAY_HD OctNormal EstimateNodeNormal(const OctreeView& tree, int level, std::
 {
   std::uint32_t cx, cy, cz;
   DecodeMorton(tree.Key(n), cx, cy, cz);
-  double count = 0.0, sum[3] = { 0.0, 0.0, 0.0 }, products[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
+  VoxelMoments moments;
   ForEachOccupiedNear(tree, level, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz),
-    [&](int dx, int dy, int dz) {
-      count += 1.0;
-      sum[0] += dx, sum[1] += dy, sum[2] += dz;
-      products[0] += dx * dx, products[1] += dx * dy, products[2] += dx * dz;
-      products[3] += dy * dy, products[4] += dy * dz, products[5] += dz * dz;
-    });
-  const double m[3] = { sum[0] / count, sum[1] / count, sum[2] / count };
-  const Vec3d normal = LeastSpreadDirection(products[0] / count - m[0] * m[0], products[1] / count - m[0] * m[1],
-    products[2] / count - m[0] * m[2], products[3] / count - m[1] * m[1], products[4] / count - m[1] * m[2],
-    products[5] / count - m[2] * m[2]);
+    [&](int dx, int dy, int dz) { moments.Add(dx, dy, dz); });
+  const Vec3d normal = moments.LeastSpread();
   return EncodeNormal(Vec3f{ static_cast<float>(normal.x), static_cast<float>(normal.y), static_cast<float>(normal.z) });
 }
 
