@@ -344,4 +344,43 @@ inline Rgba NodeColour(const HostOctree& t, std::uint32_t node)
 {
   return t.color.empty() ? ToRgba(t.color8.at(node)) : t.color[node];
 }
+
+// One cloud built at `depth` by the CPU backend and by CUDA, for tests that
+// hold CUDA's pictures to the CPU's.
+struct BothBackends
+{
+  std::unique_ptr<Engine> cpu = CreateEngine(Backend::CPU);
+  std::unique_ptr<Engine> gpu = CreateEngine(Backend::CUDA);
+
+  BothBackends(const PointCloudView& points, int depth)
+  {
+    BuildOptions options;
+    options.depth = depth;
+    cpu->Build(points, options);
+    gpu->Build(points, options);
+  }
+};
+
+// Issue 4's rule for two backends' pictures of one frame: 99.9 % of the
+// pixels identical (colour), none off by more than 2/255 in any channel.
+inline ::testing::AssertionResult PicturesAgree(const Image& a, const Image& b)
+{
+  if (a.rgba.size() != b.rgba.size())
+    return ::testing::AssertionFailure() << "sizes differ";
+  const std::size_t pixels = a.rgba.size() / 4;
+  std::size_t identical = 0;
+  float worst = 0;
+  for (std::size_t i = 0; i < pixels; ++i)
+  {
+    float diff = 0;
+    for (int k = 0; k < 4; ++k)
+      diff = std::max(diff, std::fabs(a.rgba[4 * i + k] - b.rgba[4 * i + k]));
+    identical += diff == 0;
+    worst = std::max(worst, diff);
+  }
+  if (identical * 1000 < pixels * 999 || worst > 2.0f / 255)
+    return ::testing::AssertionFailure() << identical << " of " << pixels << " pixels identical, the worst off by "
+                                         << worst * 255 << "/255";
+  return ::testing::AssertionSuccess();
+}
 }
