@@ -210,7 +210,7 @@ template <class Device>
 void EstimateNormals(Device& d, OctreeState<Device>& s)
 {
   const OctreeView tree = s.View();
-  d.Reserve(s.estimatedNormals, tree.nodeCount, "node normals (estimated)");
+  d.Reserve(s.estimatedNormals, tree.nodeCount, MemoryReport::NodeArray(s.kEstimatedNormalsLabel).c_str());
   OctNormal* out = s.estimatedNormals.Get();
   for (int level = 0; level <= tree.depth; ++level)
   {

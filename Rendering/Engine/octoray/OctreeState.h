@@ -31,6 +31,7 @@ struct OctreeState
   // (RenderSettings::estimateNormals) and kept until the nodes change.
   typename Device::template Buffer<OctNormal> estimatedNormals;
   bool normalsEstimated = false;
+  static constexpr const char* kEstimatedNormalsLabel = "normals (estimated)"; // a node array's (MemoryReport)
 
   PointArraysView Points() const
   {
@@ -103,7 +104,7 @@ MemoryReport ReportMemory(const OctreeState<Device>& s, std::size_t sortBytes, s
 {
   MemoryReport m;
   ForEachNodeArray([&](auto a) { m.Add(MemoryReport::NodeArray(a.kLabel), a.Of(s.nodes).Bytes()); });
-  m.Add(MemoryReport::NodeArray("normals (estimated)"), s.estimatedNormals.Bytes());
+  m.Add(MemoryReport::NodeArray(s.kEstimatedNormalsLabel), s.estimatedNormals.Bytes());
   m.Add("point positions", s.points.xyzFloat.Bytes() + s.points.xyzDouble.Bytes());
   // Each attribute's words of the records.
   const PointRecordLayout& layout = s.points.layout;
