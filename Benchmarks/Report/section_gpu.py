@@ -138,13 +138,15 @@ def _later_calls(ctx, last=3):
     for header, lines in tool_check_calls(path)[-last:]:
         text = "\n".join(lines)
         engine = re.search(r"^\[  PASSED  \] (\d+) tests\.$", text, re.M)
+        failed = re.search(r"^\[  FAILED  \] (\d+) tests?, listed below:$", text, re.M)
         mapper = re.search(r"^(\d+)% tests passed out of (\d+)$", text, re.M)
         tools = len(re.findall(r"^\d+/\d+ Test +#\d+: engine\.tool\S* \.+ +Passed", text, re.M))
         sanitizers = re.findall(r"^[\w-]+: +(\d+) =+ ERROR SUMMARY: (\d+) errors", text, re.M)
         errors = sum(int(e) for _, e in sanitizers)
         runs = sum(int(n) for n, _ in sanitizers)
         rows.append((header.split(" (")[0],
-                     f"{engine.group(1)} passed" if engine else "no count",
+                     (f"{engine.group(1)} passed" if engine else "no count")
+                     + (f", {failed.group(1)} failed" if failed else ""),
                      ("%s of %s passed" % (mapper.group(2), mapper.group(2)) if mapper and mapper.group(1) == "100"
                       else f"{mapper.group(1)} % of {mapper.group(2)} passed" if mapper else "no count"),
                      f"{tools} passed",
@@ -155,6 +157,40 @@ def _later_calls(ctx, last=3):
                                                                                   TOOL_CHECKS_FILE),
         "",
         ctx.table(["call", "engine tests", "mapper tests", "tool tests", "compute-sanitizer"], rows, "lllll"),
+        "",
+    ]
+
+
+ESTIMATED_NORMALS_FILE = "estimated-normals.txt"
+
+
+def _estimated_normals(ctx):
+    """What normals estimated from the voxels cost and how far their
+    pictures are from the points' own, from ESTIMATED_NORMALS_FILE."""
+    path = ctx.gpu_file(ESTIMATED_NORMALS_FILE)
+    if not path:
+        return []
+    with open(path) as f:
+        text = f.read()
+    clusters = re.findall(r"^render depth (\d+), Phong \+ shadows \+ 1 bounce: [\d.]+ ms, (\d+) Mrays/s.*\n"
+                          r"render depth \1, normals estimated from the voxels in ([\d.]+) ms \((\d+) nodes\); "
+                          r"Phong \+ shadows \+ 1 bounce by them: [\d.]+ ms, (\d+) Mrays/s$", text, re.M)
+    spheres = re.findall(r"^(CPU \(\d+ threads\)|CUDA \([^)]*\)),.*\n(?:.*\n){5}"
+                         r"\| estimated from the voxels \| ([\d.]+) \| [\d.]+ \| ([\d.]+) \|\n"
+                         r"\| occupancy of six neighbours \| - \| - \| ([\d.]+) \|$", text, re.M)
+    parts = ["at depth %s %s ms for %s nodes, and Phong with shadows and a bounce by them %s Mrays/s against %s "
+             "by occupancy" % (depth, ms, f"{int(nodes):,}", by, occupancy)
+             for depth, occupancy, ms, nodes, by in clusters]
+    on = ["%s ms on %s" % (ms, backend) for backend, ms, _, _ in spheres]
+    differences = {(d, o) for _, _, d, o in spheres}
+    return [
+        "Normals estimated from the voxels for points without them (the engine's NormalEstimation.h, the "
+        "mapper's EstimateNormals, on by default; [gpu/%s](gpu/%s), made once per octree): for the 10 M "
+        "clustered points %s. For the sphere field's 1 M points at depth 8 they took %s; its Phong picture by "
+        "them is %s/255 from the one by the points' own radial normals, on average over the pixels, and by the "
+        "six neighbours' occupancy %s/255."
+        % (ESTIMATED_NORMALS_FILE, ESTIMATED_NORMALS_FILE, "; ".join(parts), " and ".join(on),
+           " and ".join(d for d, _ in sorted(differences)), " and ".join(o for _, o in sorted(differences))),
         "",
     ]
 
@@ -218,6 +254,7 @@ def render(ctx):
         *_device_checks(ctx),
         *_staging_checks(ctx),
         *_later_calls(ctx),
+        *_estimated_normals(ctx),
         "The VTK mapper's tests on the GPU are in the next section. Not run on the GPU: the ParaView",
         "plugin (ParaView is not built there); its CPU backend runs in `make test`.",
     ]
