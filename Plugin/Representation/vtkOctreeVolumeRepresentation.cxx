@@ -37,6 +37,7 @@
 #include "vtkVolumeProperty.h"
 
 #include <algorithm> // for std::copy, std::copy_n
+#include <set>
 #include <string>
 
 
@@ -138,6 +139,43 @@ vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedPointSets(
 }
 
 //----------------------------------------------------------------------------
+void vtkOctreeVolumeRepresentation::ReportDroppedArrays(vtkCompositeDataSet* composite, vtkPointSet* merged)
+{
+  std::set<std::string> dropped;
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(composite->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    vtkPointData* arrays = vtkDataSet::SafeDownCast(it->GetCurrentDataObject())->GetPointData();
+    for (int i = 0; i < arrays->GetNumberOfArrays(); ++i)
+    {
+      const char* name = arrays->GetArrayName(i);
+      if (name && !merged->GetPointData()->HasArray(name))
+      {
+        dropped.insert(name);
+      }
+    }
+  }
+  std::string names;
+  for (const std::string& name : dropped)
+  {
+    names += (names.empty() ? "" : ", ") + ("'" + name + "'");
+  }
+  if (names == this->ReportedDroppedArrays)
+  {
+    return;
+  }
+  this->ReportedDroppedArrays = names;
+  if (!names.empty())
+  {
+    vtkWarningMacro("Octree Volume draws the blocks of this "
+      << composite->GetClassName() << " as one point set with the point arrays every block has, as Merge "
+      << "Blocks makes it: " << names << (dropped.size() == 1 ? " is" : " are")
+      << " not in every block, so not drawn.");
+  }
+}
+
+//----------------------------------------------------------------------------
 void vtkOctreeVolumeRepresentation::ReportUndrawable(vtkDataObject* input, const std::string& otherLeaf)
 {
   const std::string type = input->GetClassName() + (otherLeaf.empty() ? "" : " holding a " + otherLeaf);
@@ -235,6 +273,10 @@ void vtkOctreeVolumeRepresentation::CacheInput(vtkDataObject* data, int ranks)
   if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
   {
     merged = MergedPointSets(composite, otherLeaf);
+    if (merged)
+    {
+      this->ReportDroppedArrays(composite, merged);
+    }
   }
   if (!IsDrawable(merged ? merged.Get() : data))
   {

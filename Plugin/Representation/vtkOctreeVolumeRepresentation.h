@@ -39,7 +39,8 @@
  *   but a voxel that a cut crosses is drawn by two ranks, so pixels along
  *   the cuts can differ from the one-rank picture; a warning says so once.
  * - Composite data (multiblock, partitioned) whose blocks are point sets is
- *   drawn as one point set, as Merge Blocks would make it (MergedPointSets).
+ *   drawn as one point set, as Merge Blocks would make it (MergedPointSets);
+ *   a warning names the point arrays that some blocks lack, dropped so.
  * - Input the mapper cannot draw (anything but vtkPointSet, vtkImageData and
  *   composite data of point sets: tables, rectilinear grids, composite data
  *   holding an image, ...) is accepted by the pipeline and draws nothing; a
@@ -223,6 +224,14 @@ protected:
   static vtkSmartPointer<vtkPointSet> MergedPointSets(vtkCompositeDataSet* composite, std::string& otherLeaf);
 
   /**
+   * Says, once for each set of names, which point arrays of the blocks of
+   * `composite` the merged point set `merged` lacks (those some blocks do
+   * not have, which Merge Blocks drops too): a colour map or a reflectivity
+   * array among them would otherwise vanish without a word.
+   */
+  void ReportDroppedArrays(vtkCompositeDataSet* composite, vtkPointSet* merged);
+
+  /**
    * The warning for an input the mapper cannot draw, naming its type (and
    * for composite data the block that is not a point set), what can be
    * drawn and the filter that converts it. Issued once per input type (and
@@ -242,6 +251,7 @@ protected:
   // mapper!").
   vtkNew<vtkTrivialProducer> EmptyPiece;
   std::string ReportedType;
+  std::string ReportedDroppedArrays;
   // Every rank's bounds together (this rank's on one), for cropping.
   double WholeBounds[6];
   bool Cropping = false;

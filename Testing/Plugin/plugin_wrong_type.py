@@ -16,6 +16,10 @@ vtkOctreeVolumeRepresentation:
   the representation directly, rendered three times: the warning naming
   vtkTable, with the Table To Points hint, exactly once;
 - in both, what the representation can draw (vtkPointSet, vtkImageData);
+- a Group Datasets of two particle files, one with a column "extra" that
+  the other lacks, rendered three times: drawn, with the warning that
+  "extra" is not in every block, so not drawn, exactly once (on several
+  ranks, the blocks are read on the first);
 - on several ranks, still one of each (the first rank speaks for all), and
   no warning about blending the ranks' pictures in order for data that is
   not drawn (the multiblock's composite blend mode);
@@ -32,6 +36,8 @@ DRAWS = ("it draws point sets (vtkPointSet: vtkPolyData, vtkUnstructuredGrid, vt
 MULTIBLOCK = ("Octree Volume cannot draw a vtkMultiBlockDataSet holding a vtkImageData: " + DRAWS +
               " To draw this data, apply Merge Blocks first to make one unstructured grid of its "
               "blocks.")
+DROPPED = ("Octree Volume draws the blocks of this vtkMultiBlockDataSet as one point set with the point "
+           "arrays every block has, as Merge Blocks makes it: 'extra' is not in every block, so not drawn.")
 TABLE = ("Octree Volume cannot draw a vtkTable: " + DRAWS + " To draw this data, apply Table To "
          "Points first (or open a particle text file with the Octoray Particle Reader).")
 
@@ -53,6 +59,24 @@ def child(plugin, data, workdir):
         view.GetActiveCamera().Azimuth(10)
         if frame == 3:
             display.OctreeBlendMode = "Composite"
+        Render(view)
+    display.Visibility = 0
+
+    # Blocks of point sets whose arrays differ: drawn, the array that some
+    # lack said once.
+    readers = []
+    for name, header in (("with_extra", "# x y z value extra"), ("without_extra", "# x y z value")):
+        path = os.path.join(workdir, name + ".particles")
+        with open(path, "w") as f:
+            f.write(header + "\n")
+            for i in range(20):
+                f.write("%d 0 %d 1%s\n" % (i, len(readers), " 2" if "extra" in header else ""))
+        readers.append(OctorayParticleReader(FileName=path))
+    blocks = GroupDatasets(Input=readers)
+    display = Show(blocks, view)
+    display.SetRepresentationType("Octree Volume")
+    for _ in range(3):
+        view.GetActiveCamera().Azimuth(10)
         Render(view)
     display.Visibility = 0
 
@@ -98,6 +122,7 @@ def main():
     check("CSV reader gives a vtkTable", "CSV reader output: vtkTable" in out, True)
     check("warnings naming vtkMultiBlockDataSet", out.count(MULTIBLOCK), 1)
     check("warnings naming vtkTable", out.count(TABLE), 1)
+    check("warnings naming the array some blocks lack", out.count(DROPPED), 1)
     check("'Octree Volume cannot draw' in all", out.count("Octree Volume cannot draw"), 2)
     check("blend-order warnings for data not drawn",
           out.count("blend each rank's picture without ordering") +
