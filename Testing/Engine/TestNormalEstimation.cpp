@@ -46,6 +46,15 @@ Cloud BarePoints(std::size_t n, std::uint64_t seed, OnSurface onSurface)
   }
   return c;
 }
+
+// `n` points on the sphere of radius 0.4 about the unit cube's centre.
+Cloud SpherePoints(std::size_t n, std::uint64_t seed)
+{
+  return BarePoints(n, seed, [](std::mt19937_64& rng) {
+    std::normal_distribution<double> gauss;
+    return Vec3d{ 0.5, 0.5, 0.5 } + 0.4 * Normalize(Vec3d{ gauss(rng), gauss(rng), gauss(rng) });
+  });
+}
 }
 
 TEST(LeastSpreadDirection, IsTheEigenvectorOfTheSmallestEigenvalue)
@@ -77,12 +86,7 @@ TEST(LeastSpreadDirection, IsTheEigenvectorOfTheSmallestEigenvalue)
 
 TEST(NormalEstimation, SphereNodesFaceAlongTheRadius)
 {
-  // 200,000 points on a sphere of radius 0.4 about the unit cube's centre.
-  const Cloud c = BarePoints(200000, 11, [](std::mt19937_64& rng) {
-    std::normal_distribution<double> gauss;
-    const Vec3d d = Normalize(Vec3d{ gauss(rng), gauss(rng), gauss(rng) });
-    return Vec3d{ 0.5, 0.5, 0.5 } + 0.4 * d;
-  });
+  const Cloud c = SpherePoints(200000, 11);
   auto engine = CreateEngine(Backend::CPU);
   HostOctree t = BuildOnHost(*engine, c.View(), 7);
   const OctreeView tree = t.View();
@@ -116,7 +120,7 @@ using EstimatedNormalsTest = BackendTest;
 
 TEST_P(EstimatedNormalsTest, TiltedSheetIsLitAsItsPlane)
 {
-  // A sheet of points, one voxel thick, on the plane z = 0.4 + 0.3 x - 0.2 y.
+  // A sheet of points, a voxel or two thick, on the plane z = 0.4 + 0.3 x - 0.2 y.
   const Vec3d planeNormal = Normalize(Vec3d{ -0.3, 0.2, 1.0 });
   const Cloud c = BarePoints(60000, 12, [](std::mt19937_64& rng) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -153,7 +157,7 @@ TEST_P(EstimatedNormalsTest, TiltedSheetIsLitAsItsPlane)
   const std::vector<double> estimated = errors(true), occupancy = errors(false);
   ASSERT_GT(estimated.size(), 2000u);
   // Of the 2696 pixels here, half were within 0.011 of the plane's 0.561
-  // and 99 % within 0.045 (about 1 and 4 degrees of the normal); by the
+  // and 99 % within 0.045 (about 1 and 5 degrees of the normal); by the
   // occupancy gradient, 0.144 and 0.461.
   EXPECT_LT(Quantile(estimated, 0.5), 0.02);
   EXPECT_LT(Quantile(estimated, 0.99), 0.08);
@@ -171,10 +175,7 @@ using EstimatedNormalsCUDA = CudaOnlyTest;
 // rule, 99.9 % of the pixels identical and none off by more than 2/255.
 TEST_F(EstimatedNormalsCUDA, PicturesEqualTheCpuBackend)
 {
-  const Cloud c = BarePoints(100000, 13, [](std::mt19937_64& rng) {
-    std::normal_distribution<double> gauss;
-    return Vec3d{ 0.5, 0.5, 0.5 } + 0.4 * Normalize(Vec3d{ gauss(rng), gauss(rng), gauss(rng) });
-  });
+  const Cloud c = SpherePoints(100000, 13);
   const BothBackends engines(c.View(), 7);
   const int w = 160, h = 120;
   const double eye[3] = { 1.8, -1.2, 1.4 }, target[3] = { 0.5, 0.5, 0.5 }, up[3] = { 0, 0, 1 };
