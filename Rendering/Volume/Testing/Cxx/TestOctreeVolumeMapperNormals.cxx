@@ -1,5 +1,5 @@
 // Shading points that have no normals (EstimateNormals): a tilted sheet of
-// white points, one voxel thick, lit by the headlight under a parallel
+// white points, a voxel or two thick, lit by the headlight under a parallel
 // camera, against the brightness its plane gives (ambient + diffuse times
 // the cosine between the plane's normal and the view); with EstimateNormals
 // off, the six-neighbour occupancy gradient misses it. Normals the input has
