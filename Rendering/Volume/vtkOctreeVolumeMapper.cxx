@@ -409,6 +409,7 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfTraces: " << this->NumberOfTraces << "\n";
   os << indent << "LastBuildSeconds: " << this->LastBuildSeconds << "\n";
   os << indent << "LastTraceSeconds: " << this->LastTraceSeconds << "\n";
+  os << indent << "LastNormalEstimateSeconds: " << this->LastNormalEstimateSeconds << "\n";
   os << indent << "LastDepthReadSeconds: " << this->LastDepthReadSeconds << "\n";
   os << indent << "LastUploadSeconds: " << this->LastUploadSeconds << "\n";
   os << indent << "LastDrawSeconds: " << this->LastDrawSeconds << "\n";

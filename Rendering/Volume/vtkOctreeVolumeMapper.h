@@ -380,10 +380,13 @@ public:
    * Seconds spent in the last build or update, the engine's last trace
    * (with its copy to the host, where it made one), and the VTK layer's
    * share of the last render: depth read-back, the picture's way into the
-   * textures (upload or device copy) and the composite draw.
+   * textures (upload or device copy) and the composite draw. Of the trace,
+   * LastNormalEstimateSeconds: the normals it estimated (EstimateNormals; 0
+   * where it made none, as every trace after an octree's first shaded one).
    */
   vtkGetMacro(LastBuildSeconds, double);
   vtkGetMacro(LastTraceSeconds, double);
+  vtkGetMacro(LastNormalEstimateSeconds, double);
   vtkGetMacro(LastDepthReadSeconds, double);
   vtkGetMacro(LastUploadSeconds, double);
   vtkGetMacro(LastDrawSeconds, double);
@@ -458,6 +461,7 @@ protected:
   vtkIdType NumberOfTraces = 0;
   double LastBuildSeconds = 0.0;
   double LastTraceSeconds = 0.0;
+  double LastNormalEstimateSeconds = 0.0;
   double LastDepthReadSeconds = 0.0;
   double LastUploadSeconds = 0.0;
   double LastDrawSeconds = 0.0;

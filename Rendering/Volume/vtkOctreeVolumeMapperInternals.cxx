@@ -563,6 +563,7 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::D
   }
   self->LastUploadSeconds = Now() - t0;
   self->LastTraceSeconds = stats.seconds + stats.copySeconds;
+  self->LastNormalEstimateSeconds = stats.normalSeconds;
   this->Transfer = s.copyToHost ? TRANSFER_HOST : TRANSFER_DEVICE;
   return Step::Done;
 }

@@ -707,14 +707,17 @@ def test_normals(tmp_path):
     the voxels by their occupancy; flat modes do not need them."""
     pcd = write_pcd(tmp_path / "bump.pcd", outlier=False)
     pictures = {}
-    for mode, normals, expect in (("phong", "auto", True), ("phong", "none", False), ("phong", "voxels", False),
-                                  ("surface", "auto", False), ("surface", "pcl", True)):
+    # (mode, --normals, PCL's normals made, the mapper's fitted)
+    for mode, normals, pcl, fitted in (("phong", "auto", True, False), ("phong", "none", False, False),
+                                       ("phong", "voxels", False, True), ("surface", "auto", False, False),
+                                       ("surface", "pcl", True, False)):
         out = tmp_path / ("%s-%s.png" % (mode, normals))
         r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", mode,
                 "--normals", normals, "--elevation", "60")
         assert r.returncode == 0, r.stderr
-        assert ("normals:" in r.stdout) == expect, r.stdout
-        assert ("normals" in r.stderr) == expect  # the progress line
+        assert ("normals: " in r.stdout and "(PCL, 16 neighbours)" in r.stdout) == pcl, r.stdout
+        assert ("normals" in r.stderr) == pcl  # PCL's progress line
+        assert ("(fitted to the voxels, in the first frame)" in r.stdout) == fitted, r.stdout
         pictures[(mode, normals)] = read_pixels(str(out))[2]
     def apart(a, b):
         """The fraction of pixels whose colours differ by more than 16."""

@@ -273,6 +273,7 @@ def main(argv=None):
     with scene.Timer() as first:
         window.Render()
     build = mapper.GetLastBuildSeconds()
+    fitted = mapper.GetLastNormalEstimateSeconds()  # normals fitted to the voxels, in the first frame
     if mapper.GetLastUsedBackend() < 0:
         print("error: nothing was drawn (see the messages above)", file=sys.stderr)
         return 1
@@ -301,6 +302,8 @@ def main(argv=None):
     print("load: %.3f s" % load)
     if normals_seconds is not None:
         print("normals: %.3f s (PCL, 16 neighbours)" % normals_seconds)
+    if fitted > 0:
+        print("normals: %.3f s (fitted to the voxels, in the first frame)" % fitted)
     print("build: %.3f s" % build)
     print("render: %.3f s (trace %.3f s, first frame with build %.3f s) at %dx%d"
           % (mapper.GetLastTraceSeconds() + mapper.GetLastDepthReadSeconds() + mapper.GetLastUploadSeconds()
