@@ -555,6 +555,52 @@ TEST_F(CudaFaults, OutOfMemoryKeepsThePreviousOctree)
   ExpectMatchesReference(after, big);
 }
 
+// The normals a render estimates for a cloud without them (the render's
+// own allocation site, RenderSettings::estimateNormals): out of memory there
+// is that frame's error, naming them; the octree stays, and the next frame
+// with room makes them and draws what a fresh engine draws.
+TEST_F(CudaFaults, OutOfMemoryForEstimatedNormalsKeepsTheOctree)
+{
+  const Cloud cloud = UniformCloud(20000, 66).WithExactMeans(); // no normals
+  BuildOptions options;
+  options.depth = 7;
+  RenderSettings s;
+  s.width = 64;
+  s.height = 48;
+  const double vp[16] = { 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, -0.5, 0, 0, 0, 0, 1 };
+  Invert4x4(vp, s.inverseViewProjection);
+  s.shade = ShadeMode::Phong;
+  s.estimateNormals = true;
+  RenderSettings occupancy = s;
+  occupancy.estimateNormals = false;
+  auto engine = CreateEngine(Backend::CUDA);
+  engine->Build(cloud.View(), options);
+  Image image;
+  engine->Render(occupancy, image); // the picture's own buffers
+  const std::size_t held = engine->Memory().ArrayBytes();
+  engine->SetMemoryBudget(held + 1024); // far less than 4 bytes a node
+  try
+  {
+    engine->Render(s, image);
+    FAIL() << "no error past the memory budget";
+  }
+  catch (const Error& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("octoray: out of memory for node normals (estimated)"), std::string::npos) << message;
+  }
+  EXPECT_LE(engine->Memory().ArrayBytes(), held + 1024);
+  EXPECT_EQ(engine->PointCount(), cloud.Size());
+
+  engine->SetMemoryBudget(~std::size_t(0));
+  Image estimated, fresh;
+  engine->Render(s, estimated);
+  auto other = CreateEngine(Backend::CUDA);
+  other->Build(cloud.View(), options);
+  other->Render(s, fresh);
+  EXPECT_EQ(estimated.rgba, fresh.rgba);
+}
+
 // Out-of-memory at every allocation site: budgets swept from nothing up to
 // what a build, an update and a render need. At each step the call either
 // succeeds or fails with the documented error, gives back what it took (the
