@@ -33,6 +33,7 @@
 #include <octoray/ReferenceTraversal.h>
 #include <octoray/RenderModes.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -223,9 +224,11 @@ double MeanDifference(const Image& a, const Image& b)
 // The sphere field's Phong picture by its radial normals, and without them
 // by the normals estimated from its voxels and by occupancy: how long the
 // estimate takes and how far each picture is from the first.
-Record CompareNormals(Engine& engine, const SphereField& spheres, int w, int h, int repeats)
+Record CompareNormals(Engine& engine, const std::string& backendName, const SphereField& spheres, int w, int h,
+  int repeats)
 {
-  const Mode& phong = kModes[2];
+  const Mode& phong =
+    *std::find_if(std::begin(kModes), std::end(kModes), [](const Mode& m) { return std::string(m.name) == "phong"; });
   BuildOptions options{ 8 };
   RenderSettings s = MakeSettings(spheres.View(false, true), w, h, phong, 8);
   Image given, estimated, occupancy;
@@ -253,7 +256,8 @@ Record CompareNormals(Engine& engine, const SphereField& spheres, int w, int h, 
   std::printf("| estimated from the voxels | %.1f | %.1f | %.2f |\n", estimate * 1e3,
     tEstimated.median * 1e3, MeanDifference(estimated, given));
   std::printf("| occupancy of six neighbours | - | - | %.2f |\n", MeanDifference(occupancy, given));
-  return Record{ "render.spheres.normal-estimate", engine.Description(), spheres.xyz.size() / 3, 8, estimate,
+  return Record{ "render.spheres.normal-estimate", backendName + "-" + engine.Description(), spheres.xyz.size() / 3, 8,
+    estimate,
     "render.spheres.phong", tGiven.median };
 }
 
@@ -341,7 +345,7 @@ int main(int argc, char** argv)
 
       if (wanted("normals"))
       {
-        records.push_back(CompareNormals(*engine, spheres, w, h, repeats));
+        records.push_back(CompareNormals(*engine, backendName, spheres, w, h, repeats));
       }
 
       // Everything off: the sphere field without reflectivity, rendered
