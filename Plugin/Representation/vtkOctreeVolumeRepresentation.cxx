@@ -35,6 +35,7 @@
 #include "vtkTrivialProducer.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkVolumeProperty.h"
+#include "vtkWeakPointer.h"
 
 #include <algorithm> // for std::copy, std::copy_n
 #include <set>
@@ -136,6 +137,40 @@ vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedPointSets(
   append->SetOutputPointsPrecision(vtkAlgorithm::DEFAULT_PRECISION);
   append->Update();
   return vtkPointSet::SafeDownCast(append->GetOutputDataObject(0));
+}
+
+//----------------------------------------------------------------------------
+vtkMTimeType vtkOctreeVolumeRepresentation::LatestBlockTime(vtkCompositeDataSet* composite)
+{
+  // A composite data set's own time does not follow its blocks: a script
+  // that moves a block's points in place modifies only that block.
+  vtkMTimeType latest = composite->GetMTime();
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(composite->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    latest = std::max(latest, it->GetCurrentDataObject()->GetMTime());
+  }
+  return latest;
+}
+
+//----------------------------------------------------------------------------
+vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedBlocks(
+  vtkCompositeDataSet* composite, std::string& otherLeaf)
+{
+  const vtkMTimeType changed = LatestBlockTime(composite);
+  if (this->Merged && composite == this->MergedInput && changed == this->MergedInputTime)
+  {
+    return this->Merged;
+  }
+  this->Merged = MergedPointSets(composite, otherLeaf);
+  this->MergedInput = composite;
+  this->MergedInputTime = changed;
+  if (this->Merged)
+  {
+    this->ReportDroppedArrays(composite, this->Merged);
+  }
+  return this->Merged;
 }
 
 //----------------------------------------------------------------------------
@@ -272,11 +307,11 @@ void vtkOctreeVolumeRepresentation::CacheInput(vtkDataObject* data, int ranks)
   std::string otherLeaf;
   if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
   {
-    merged = MergedPointSets(composite, otherLeaf);
-    if (merged)
-    {
-      this->ReportDroppedArrays(composite, merged);
-    }
+    merged = this->MergedBlocks(composite, otherLeaf);
+  }
+  else
+  {
+    this->Merged = nullptr; // the memory of blocks no longer shown
   }
   if (!IsDrawable(merged ? merged.Get() : data))
   {

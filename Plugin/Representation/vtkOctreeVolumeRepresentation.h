@@ -63,6 +63,7 @@
 #include "vtkNew.h"                 // for vtkNew
 #include "vtkOctreeVolumePresets.h" // for vtkNew<vtkOctreeVolumePresets>
 #include "vtkVolumeProperty.h"      // for vtkNew<vtkVolumeProperty>
+#include "vtkWeakPointer.h"         // for vtkWeakPointer
 
 #include <string> // for std::string
 
@@ -224,6 +225,21 @@ protected:
   static vtkSmartPointer<vtkPointSet> MergedPointSets(vtkCompositeDataSet* composite, std::string& otherLeaf);
 
   /**
+   * MergedPointSets of `composite`, made again only where the composite
+   * data or a block changed since the last merge: an update that hands
+   * over the same blocks (a blend mode or colour array chosen) keeps the
+   * merged arrays, so the mapper keeps its octree, where a new append
+   * copied every point and the mapper rebuilt from the copy.
+   */
+  vtkSmartPointer<vtkPointSet> MergedBlocks(vtkCompositeDataSet* composite, std::string& otherLeaf);
+
+  /**
+   * The latest modification time of `composite` and of its blocks (their
+   * points and arrays).
+   */
+  static vtkMTimeType LatestBlockTime(vtkCompositeDataSet* composite);
+
+  /**
    * Says, once for each set of names, which point arrays of the blocks of
    * `composite` the merged point set `merged` lacks (those some blocks do
    * not have, which Merge Blocks drops too): a colour map or a reflectivity
@@ -250,6 +266,11 @@ protected:
   // vtkPVLODVolume without one fails to render: "You must give me a
   // mapper!").
   vtkNew<vtkTrivialProducer> EmptyPiece;
+  // The composite data last merged, when it or a block last changed then,
+  // and the merged point set (MergedBlocks); null for other input.
+  vtkWeakPointer<vtkCompositeDataSet> MergedInput;
+  vtkMTimeType MergedInputTime = 0;
+  vtkSmartPointer<vtkPointSet> Merged;
   std::string ReportedType;
   std::string ReportedDroppedArrays;
   // Every rank's bounds together (this rank's on one), for cropping.
