@@ -2,6 +2,8 @@
 of Data/External (the reader's image output):
 
 - the panel offers "none" and exactly the names vtkOctreeVolumePresets has;
+- the image's panel has Image Background and Fill Between Slices, the
+  reader's particles' panel (point data) neither, but the CT Preset;
 - a preset puts its own colour and opacity functions (the documented
   control points) on the volume and the preset's surface threshold on the
   mapper, overriding ImageBackground; "none" gives back ParaView's colour
@@ -43,6 +45,13 @@ domain = display.GetProperty("Preset").SMProperty.FindDomain("vtkSMStringListDom
 offered = [domain.GetString(i) for i in range(domain.GetNumberOfStrings())]
 check("the panel offers none + %s (got %s)" % (known, offered), offered == ["none"] + known)
 check("the default is none", display.Preset == "none")
+
+particles = Show(OutputPort(reader, 0), view)
+image_only = ["ImageBackground", "FillBetweenSlices"]
+check("the image's panel has %s" % image_only, all(p in display.ListProperties() for p in image_only))
+check("the particles' panel has neither, but the preset",
+      not any(p in particles.ListProperties() for p in image_only) and "Preset" in particles.ListProperties())
+Hide(OutputPort(reader, 0), view)
 
 view.ResetCamera()
 camera = view.GetActiveCamera()
