@@ -39,8 +39,9 @@
  *   to the sub-volume (SetCropping, CroppingRegionPlanes with
  *   SetCroppingRegionFlagsToSubVolume) take voxels away for every ray:
  *   what they remove is neither seen, nor casts shadows, nor is reflected;
- *   a voxel they cut is drawn up to the cut, lit by the data's normals
- *   where it has them, else by the plane's. At most 12 planes together;
+ *   a voxel they cut is drawn up to the cut and lit by the plane's normal
+ *   (the flat face a solid cut open shows, where the data's own normals,
+ *   a CT's gradient inside bone, are noise). At most 12 planes together;
  *   VTK's other cropping regions are said once and not applied;
  * - work only when needed: the octree is rebuilt when the input or the
  *   arrays it uses change, updated in place when only point positions change

@@ -294,36 +294,51 @@ OCTORAY_HD bool CutNormal(const FrameConstants& f, const Ray& ray, const NodeHit
   return nearest < hit.size;
 }
 
-// Surface normal at a hit, facing the viewer. Averaged point normals where
-// the data has them and they do not cancel (a mean shorter than half a
-// length step, 1/510, is stored as zero: OctahedralNormal.h); otherwise the
-// occupancy gradient of the six neighbours at the hit's level (it follows
-// the shape, not the voxel's blocky faces); where the gradient vanishes
-// (e.g. inside a solid block), the clipping plane's where one cuts the
-// voxel the ray starts in, else the entry face.
+// The occupancy gradient of the six neighbours at the hit's level: it
+// follows the shape, not the voxel's blocky faces. Zero where it vanishes
+// (inside a solid block, a sheet one voxel thick).
+OCTORAY_HD Vec3f OccupancyGradient(const OctreeView& tree, const NodeHit& hit)
+{
+  Vec3f n{ 0.0f, 0.0f, 0.0f };
+  const float half = 0.5f * hit.size;
+  const Vec3f centre = hit.lo + Vec3f{ half, half, half };
+  for (int a = 0; a < 3; ++a)
+  {
+    Vec3f p = centre;
+    p[a] -= hit.size;
+    const float below = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
+    p[a] += 2.0f * hit.size;
+    const float above = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
+    n[a] = below - above;
+  }
+  return n;
+}
+
+// Surface normal at a hit, facing the viewer. Where a clipping plane cuts
+// the voxel the ray starts in, the plane's: what the ray sees there is the
+// cut, a flat face, whatever the data says inside the solid (a CT's
+// gradient within bone is noise, and shaded by it the cut was mottled;
+// Weiskopf et al. 2003 light a clip surface by the clip geometry's normal
+// for the same reason). Elsewhere the averaged point normals where the
+// data has them and they do not cancel (a mean shorter than half a length
+// step, 1/510, is stored as zero: OctahedralNormal.h); otherwise the
+// occupancy gradient; where that vanishes too, the entry face.
 OCTORAY_HD Vec3f SurfaceNormal(const FrameConstants& f, const OctreeView& tree, const Ray& ray, const NodeHit& hit)
 {
-  Vec3f n = tree.normal ? DecodeNormal(tree.normal[hit.node]) : Vec3f{ 0.0f, 0.0f, 0.0f };
-  if (Dot(n, n) < 1e-6f)
-  {
-    const float half = 0.5f * hit.size;
-    const Vec3f centre = hit.lo + Vec3f{ half, half, half };
-    for (int a = 0; a < 3; ++a)
-    {
-      Vec3f p = centre;
-      p[a] -= hit.size;
-      const float below = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
-      p[a] += 2.0f * hit.size;
-      const float above = Occupied(tree, hit.level, p) ? 1.0f : 0.0f;
-      n[a] = below - above;
-    }
-  }
+  Vec3f n{ 0.0f, 0.0f, 0.0f };
   const bool startsInside = hit.tEnter < ray.tMin;
-  if (Dot(n, n) < 1e-6f && !(startsInside && CutNormal(f, ray, hit, n)))
+  if (!(startsInside && CutNormal(f, ray, hit, n)))
   {
-    n = Vec3f{ 0.0f, 0.0f, 0.0f };
-    const int axis = hit.axis >= 0 ? hit.axis : 2;
-    n[axis] = ray.direction[axis] > 0.0f ? -1.0f : 1.0f;
+    n = tree.normal ? DecodeNormal(tree.normal[hit.node]) : Vec3f{ 0.0f, 0.0f, 0.0f };
+    if (Dot(n, n) < 1e-6f)
+    {
+      n = OccupancyGradient(tree, hit);
+    }
+    if (Dot(n, n) < 1e-6f)
+    {
+      const int axis = hit.axis >= 0 ? hit.axis : 2;
+      n[axis] = ray.direction[axis] > 0.0f ? -1.0f : 1.0f;
+    }
   }
   n = Normalize(n);
   return Dot(n, ray.direction) > 0.0f ? -n : n;
