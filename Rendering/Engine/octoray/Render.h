@@ -48,6 +48,8 @@ constexpr int kMaxLights = 8;
 // A clipping plane, as VTK's mappers take them (vtkAbstractMapper's
 // clipping planes): the side the normal points to is kept,
 // normal . (p - origin) >= 0; the rest of the scene is not there for any ray.
+// A voxel the plane cuts is drawn up to the cut, a flat face lit by the
+// plane's normal (RenderKernels.h's SurfaceNormal).
 struct ClipPlane
 {
   double origin[3] = { 0, 0, 0 };
