@@ -1,7 +1,7 @@
 // Normals estimated from the voxels of points that have none
 // (NormalEstimation.h): the plane fit against known eigenvectors and a
-// sphere's radii, and the Phong picture of a tilted sheet of points against
-// the light its plane reflects, on every backend.
+// sphere's radii, and the Phong picture of a tilted sheet of points, and of
+// its ragged edge, against the light its plane reflects, on every backend.
 #include "CudaOnlyTest.h"
 #include "TestRenderSupport.h"
 
@@ -208,6 +208,72 @@ TEST_P(EstimatedNormalsTest, TiltedSheetIsLitAsItsPlane)
   EXPECT_LT(Quantile(estimated, 0.5), 0.02);
   EXPECT_LT(Quantile(estimated, 0.99), 0.08);
   EXPECT_GT(Quantile(occupancy, 0.5), 5 * Quantile(estimated, 0.5));
+}
+
+// The sheet's ragged edge: past x = 0.5 only every fourth row of voxels
+// (depth 6) has points, fingers one voxel wide. Each finger voxel's window
+// holds its own finger alone, a line that fits no plane; its parent's, of
+// twice the cells, spans three fingers and finds the sheet's plane, which
+// the finger takes. Without that, the occupancy gradient and entry faces
+// of the fingers' stairs lit them.
+TEST_P(EstimatedNormalsTest, FingersOfARaggedEdgeAreLitAsTheirSheet)
+{
+  const Vec3d planeNormal = Normalize(Vec3d{ -0.3, 0.2, 1.0 });
+  const Cloud c = BarePoints(120000, 15, [](std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    double x = u(rng), y = u(rng);
+    if (x > 0.5)
+    {
+      y = (4 * std::floor(y * 16) + 0.5) / 64; // the middle of every fourth row
+    }
+    return Vec3d{ x, y, 0.4 + 0.3 * x - 0.2 * y };
+  });
+  BuildOptions options;
+  options.depth = 6;
+  engine->Build(c.View(), options);
+  HostOctree t;
+  engine->CopyToHost(t);
+  const int w = 128, h = 128;
+  const double eye[3] = { 0.5, -0.4, 2.2 }, target[3] = { 0.5, 0.5, 0.5 };
+  const double up[3] = { 0, 1, 0 };
+  const Matrix vp = ViewProjection(eye, target, up, 40, 1.0, 0.5, 10);
+  RenderSettings s = Settings(vp, w, h);
+  s.shade = ShadeMode::Phong;
+  s.specular = 0.0f;
+  Light sun;
+  sun.position[0] = 0.3, sun.position[1] = -0.5, sun.position[2] = 1.0, sun.position[3] = 0.0;
+  s.lights.push_back(sun);
+  const double expected =
+    s.ambient + s.diffuse * Dot(planeNormal, Normalize(Vec3d{ sun.position[0], sun.position[1], sun.position[2] }));
+
+  // The brightness of every pixel whose first voxel is a finger's (beyond
+  // the sheet's window: x past 0.5 by more than two voxels), off from the
+  // plane's.
+  const auto errors = [&](bool estimate) {
+    s.estimateNormals = estimate;
+    Image image;
+    engine->Render(s, image);
+    std::vector<double> off;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+      {
+        const BruteHit b = BruteForceFirstHit(t, vp, w, h, x, y, {});
+        double lo[3], hi[3];
+        if (b.hit && (NodeBox(t, b.node, t.depth, lo, hi), lo[0] > 0.5 + 3.0 / 64))
+          off.push_back(std::fabs(image.rgba[4 * Pixel(image, x, y)] - expected));
+      }
+    return off;
+  };
+  const std::vector<double> estimated = errors(true), occupancy = errors(false);
+  PrintSpread("fingers, brightness off the plane's " + std::to_string(expected) + ", estimated", estimated);
+  PrintSpread("fingers, brightness off the plane's, occupancy", occupancy);
+  // Of the 1507 finger pixels here, half were within 0.010 of the plane's
+  // 0.561 and 99 % within 0.032; by the occupancy gradient 0.158 and 0.461,
+  // and with each node's own fit alone (a throwaway change) the same.
+  ASSERT_GT(estimated.size(), 500u);
+  EXPECT_LT(Quantile(estimated, 0.5), 0.02);
+  EXPECT_LT(Quantile(estimated, 0.9), 0.05);
+  EXPECT_GT(Quantile(occupancy, 0.5), 3 * Quantile(estimated, 0.5));
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, EstimatedNormalsTest, ::testing::Values(Backend::CPU, Backend::CUDA), BackendName);

@@ -204,8 +204,25 @@ inline bool FrameUsesNormals(const RenderSettings& settings, unsigned attributes
   return settings.blend == BlendMode::Surface && (settings.shade == ShadeMode::Phong || bounces);
 }
 
-// Fills s.estimatedNormals with every node's EstimateNodeNormal, one loop
-// a level.
+// Node n's estimated normal: its own fit, or where its voxels fit no plane
+// (the ragged edge of a scanned sheet is a line at its level, a stray
+// voxel beside it a ball) its parent's, already in `estimated`: the
+// parent's window spans twice the cells and sees the surface the node lies
+// on. Zero where no ancestor found a plane either.
+OCTORAY_HD OctNormal EstimateOrInheritNormal(
+  const OctreeView& tree, int level, std::uint32_t n, const OctNormal* estimated)
+{
+  const OctNormal own = EstimateNodeNormal(tree, level, n);
+  if (level == 0 || own.bits != 0) // a zero normal encodes as 0
+  {
+    return own;
+  }
+  return estimated[tree.Find(level - 1, tree.Key(n) >> 3)];
+}
+
+// Fills s.estimatedNormals with every node's EstimateOrInheritNormal, one
+// loop a level from the root down, so that a parent's is made before its
+// children look it up.
 template <class Device>
 void EstimateNormals(Device& d, OctreeState<Device>& s)
 {
@@ -217,7 +234,7 @@ void EstimateNormals(Device& d, OctreeState<Device>& s)
     const std::uint32_t begin = tree.levelBegin[level];
     d.ForEach("EstimateNormalsKernel", tree.LevelSize(level), OCTORAY_LAMBDA(std::size_t i) {
       const std::uint32_t n = begin + static_cast<std::uint32_t>(i);
-      out[n] = EstimateNodeNormal(tree, level, n);
+      out[n] = EstimateOrInheritNormal(tree, level, n, out);
     });
   }
   d.Synchronize("EstimateNormalsKernel");
