@@ -30,13 +30,13 @@ def test_demo_quarter_size(tmp_path):
     for line in ("[1/3] head CT", "108 slices, 256 x 256 x 108 voxels", "-1024..2986 HU",
                  "ct-bone  threshold 306 HU", "ct-skin  threshold -750 HU", "depth 8, leaf 0.957",
                  "vtkSmartVolumeMapper", "cut      CT-Bone cropped to the back 55 % of the head", "1 build:",
-                 "[2/3] laser scan", "460,400 points", "PCL NormalEstimationOMP",
+                 "[2/3] laser scan", "460,400 points", "s: fitted to the voxels, in the first frame",
                  "Intensity through viridis over 0..52 (percentiles 1..99 of 0..246)",
                  "[3/3] thesis LiDAR", "1,065 points", "colours: the points' own RGB", "backend CPU",
                  "demo                               total"):
         assert line in out, line
-    # The progress lines (stderr): reading, normals, building.
-    for label in ("reading", "normals", "building"):
+    # The progress lines (stderr): reading, building.
+    for label in ("reading", "building"):
         assert label in r.stderr
     expected = {"ct-bone.png": (240, 240), "ct-skin.png": (240, 240), "ct-compare.png": (400, 200),
                 "ct-bone-cut.png": (240, 240),

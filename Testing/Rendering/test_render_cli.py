@@ -702,15 +702,15 @@ def test_color_by_a_vector_array_is_by_its_magnitude():
 
 
 def test_normals(tmp_path):
-    """--mode phong estimates PCL normals for points without them (auto);
-    --normals voxels leaves it to the mapper's fit to the voxels, none lights
-    the voxels by their occupancy; flat modes do not need them."""
+    """--mode phong lights points without normals by the mapper's fit to the
+    voxels (auto, voxels); --normals pcl estimates PCL's normals, none
+    lights the voxels by their occupancy; flat modes need none."""
     pcd = write_pcd(tmp_path / "bump.pcd", outlier=False)
     pictures = {}
     # (mode, --normals, PCL's normals made, the mapper's fitted)
-    for mode, normals, pcl, fitted in (("phong", "auto", True, False), ("phong", "none", False, False),
-                                       ("phong", "voxels", False, True), ("surface", "auto", False, False),
-                                       ("surface", "pcl", True, False)):
+    for mode, normals, pcl, fitted in (("phong", "auto", False, True), ("phong", "none", False, False),
+                                       ("phong", "voxels", False, True), ("phong", "pcl", True, False),
+                                       ("surface", "auto", False, False), ("surface", "pcl", True, False)):
         out = tmp_path / ("%s-%s.png" % (mode, normals))
         r = run(str(pcd), "-o", str(out), "--backend", "cpu", "--size", "96x96", "--mode", mode,
                 "--normals", normals, "--elevation", "60")
@@ -723,8 +723,9 @@ def test_normals(tmp_path):
         """The fraction of pixels whose colours differ by more than 16."""
         return (np.abs(pictures[a].astype(int) - pictures[b].astype(int)) > 16).any(axis=-1).mean()
     # PCL's normals shade the bump differently from the octree's occupancy,
-    # and alike the normals fitted to the voxels.
+    # and alike the normals fitted to the voxels, which auto draws.
     print("phong pixels apart from PCL's: occupancy %.3f, voxels %.3f"
-          % (apart(("phong", "auto"), ("phong", "none")), apart(("phong", "auto"), ("phong", "voxels"))))
-    assert apart(("phong", "auto"), ("phong", "none")) > 0.01
-    assert apart(("phong", "auto"), ("phong", "voxels")) < 0.5 * apart(("phong", "auto"), ("phong", "none"))
+          % (apart(("phong", "pcl"), ("phong", "none")), apart(("phong", "pcl"), ("phong", "voxels"))))
+    assert apart(("phong", "pcl"), ("phong", "none")) > 0.01
+    assert apart(("phong", "pcl"), ("phong", "voxels")) < 0.5 * apart(("phong", "pcl"), ("phong", "none"))
+    assert (pictures[("phong", "auto")] == pictures[("phong", "voxels")]).all()

@@ -23,10 +23,10 @@ stdout.
 Defaults: --preset applies a CT transfer function (Hounsfield units) and its
 threshold; points without RGB colours are coloured by their Intensity array,
 else by elevation z, through viridis over the 1st to 99th percentile;
---mode phong estimates normals with PCL where the points have none (a
-slice stack's particles carry the reader's gradient normals; --normals
-voxels fits them to the octree's voxels instead, none lights the voxels by
-their occupancy); the
+--mode phong lights points that have no normals by normals fitted to the
+octree's voxels (the mapper's EstimateNormals; a slice stack's particles
+carry the reader's gradient normals; --normals pcl estimates them with PCL
+instead, none lights the voxels by their occupancy); the
 camera faces a DICOM head from the front (patient anterior, head up) and a
 PCD scan from its sensor, --azimuth and --elevation turn it from there; a
 key light above-left of the camera casts the shadows (--shadows) and a
@@ -84,8 +84,9 @@ def parser():
                    help="points: colors, intensity, z, none or an array name, by its magnitude where it has "
                         "several components (auto: colors when the points have them, else Intensity, else z)")
     p.add_argument("--normals", choices=["auto", "pcl", "voxels", "none"], default="auto",
-                   help="auto: PCL normals for phong when the points have none; voxels: fitted to the "
-                        "octree's voxels (the mapper's EstimateNormals); none: the voxels' occupancy")
+                   help="auto: for points without normals, fitted to the octree's voxels (the mapper's "
+                        "EstimateNormals), for a slice stack's particles the reader's gradient; voxels: "
+                        "fitted to the voxels; pcl: PCL's, 16 neighbours; none: the voxels' occupancy")
     p.add_argument("--azimuth", type=float, default=0.0)
     p.add_argument("--elevation", type=float, default=0.0)
     p.add_argument("--zoom", type=float, default=1.0)
@@ -183,9 +184,10 @@ def main(argv=None):
         return 1
     image = isinstance(data, vtk.vtkImageData)
 
-    # ---- Normals: PCL's where shading needs them and the points have none.
+    # ---- Normals: PCL's where asked for; else the mapper fits them to the
+    # voxels where shading needs them and the points have none.
     normals_seconds = None
-    if not image and (args.normals == "pcl" or (args.normals == "auto" and shade and not scene.has_normals(data))):
+    if not image and args.normals == "pcl":
         data, normals_seconds, invalid = scene.estimate_normals(data)
 
     # ---- Mapper, colours and scene.
