@@ -14,7 +14,7 @@ pattern), without normals:
   normals is evenly lit, as a plane under directional lights is: the
   drawn pixels' brightness spreads (standard deviation) by at most 4/255.
   Without normals, "Estimate Normals" (on by default) lights the voxels by
-  the plane fitted to their neighbours: a spread of at most 10/255 (6.9
+  the plane fitted to their neighbours: a spread of at most 10/255 (4.3
   here; the voxels' steps tilt some fits by a few degrees).
   With it off, they are lit by their occupancy, which follows the plane's
   steps: the spread must be at least three times the filter's.
