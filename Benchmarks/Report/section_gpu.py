@@ -171,7 +171,9 @@ def _estimated_normals(ctx):
     if not path:
         return []
     with open(path) as f:
-        text = f.read()
+        # The latest run: each run after the first is appended below a
+        # line of dashes.
+        text = re.split(r"^-{20,}$", f.read(), flags=re.M)[-1]
     clusters = re.findall(r"^render depth (\d+), Phong \+ shadows \+ 1 bounce: [\d.]+ ms, (\d+) Mrays/s.*\n"
                           r"render depth \1, normals estimated from the voxels in ([\d.]+) ms \((\d+) nodes\); "
                           r"Phong \+ shadows \+ 1 bounce by them: [\d.]+ ms, (\d+) Mrays/s$", text, re.M)
@@ -185,7 +187,7 @@ def _estimated_normals(ctx):
     differences = {(d, o) for _, _, d, o in spheres}
     return [
         "Normals estimated from the voxels for points without them (the engine's NormalEstimation.h, the "
-        "mapper's EstimateNormals, on by default; [gpu/%s](gpu/%s), made once per octree): for the 10 M "
+        "mapper's EstimateNormals, on by default; made once per octree; the latest run of [gpu/%s](gpu/%s)): for the 10 M "
         "clustered points %s. For the sphere field's 1 M points at depth 8 they took %s; its Phong picture by "
         "them is %s/255 from the one by the points' own radial normals, on average over the pixels, and by the "
         "six neighbours' occupancy %s/255."
