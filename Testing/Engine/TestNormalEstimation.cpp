@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace octoray;
@@ -202,6 +203,19 @@ std::vector<double> BrightnessOff(Engine& engine, RenderSettings s, bool estimat
         off.push_back(std::fabs(image.rgba[4 * Pixel(image, x, y)] - expected));
   return off;
 }
+
+// BrightnessOff by the estimated normals and by occupancy, their spreads
+// printed as `what`'s.
+template <typename Counts>
+std::pair<std::vector<double>, std::vector<double>> EstimatedAndOccupancyOff(
+  Engine& engine, const RenderSettings& s, double expected, const std::string& what, Counts counts)
+{
+  auto off = std::make_pair(
+    BrightnessOff(engine, s, true, expected, counts), BrightnessOff(engine, s, false, expected, counts));
+  PrintSpread(what + ", brightness off the plane's " + std::to_string(expected) + ", estimated", off.first);
+  PrintSpread(what + ", brightness off the plane's, occupancy", off.second);
+  return off;
+}
 }
 
 TEST_P(EstimatedNormalsTest, TiltedSheetIsLitAsItsPlane)
@@ -221,10 +235,7 @@ TEST_P(EstimatedNormalsTest, TiltedSheetIsLitAsItsPlane)
   const RenderSettings s = SunlitPhong(ViewProjection(eye, target, up, 40, 1.0, 0.5, 10), 96, 96, expected);
   // Every pixel that hits the sheet.
   const auto drawn = [](int x, int y, const Image& image) { return image.rgba[4 * Pixel(image, x, y) + 3] > 0; };
-  const std::vector<double> estimated = BrightnessOff(*engine, s, true, expected, drawn);
-  const std::vector<double> occupancy = BrightnessOff(*engine, s, false, expected, drawn);
-  PrintSpread("tilted sheet, brightness off the plane's " + std::to_string(expected) + ", estimated", estimated);
-  PrintSpread("tilted sheet, brightness off the plane's, occupancy", occupancy);
+  const auto [estimated, occupancy] = EstimatedAndOccupancyOff(*engine, s, expected, "tilted sheet", drawn);
   ASSERT_GT(estimated.size(), 2000u);
   // Of the 2696 pixels here, half were within 0.011 of the plane's 0.561
   // and 99 % within 0.042 (about 1 and 5 degrees of the normal); by the
@@ -269,10 +280,7 @@ TEST_P(EstimatedNormalsTest, FingersOfARaggedEdgeAreLitAsTheirSheet)
     double lo[3], hi[3];
     return b.hit && (NodeBox(t, b.node, t.depth, lo, hi), lo[0] > 0.5 + 3.0 / 64);
   };
-  const std::vector<double> estimated = BrightnessOff(*engine, s, true, expected, onFinger);
-  const std::vector<double> occupancy = BrightnessOff(*engine, s, false, expected, onFinger);
-  PrintSpread("fingers, brightness off the plane's " + std::to_string(expected) + ", estimated", estimated);
-  PrintSpread("fingers, brightness off the plane's, occupancy", occupancy);
+  const auto [estimated, occupancy] = EstimatedAndOccupancyOff(*engine, s, expected, "fingers", onFinger);
   // Of the 1507 finger pixels here, half were within 0.010 of the plane's
   // 0.561 and 99 % within 0.032; by the occupancy gradient 0.158 and 0.461,
   // and with each node's own fit alone (a throwaway change) the same.
