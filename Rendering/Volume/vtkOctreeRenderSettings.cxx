@@ -75,6 +75,27 @@ void vtkOctreeRenderSettings::SetShading(
 }
 
 //------------------------------------------------------------------------------
+// Whether `f` is 1 wherever it is read: every point 1, and outside its
+// range the end points' values (clamping on).
+static bool IsOneEverywhere(vtkPiecewiseFunction* f)
+{
+  if (f->GetSize() == 0 || !f->GetClamping())
+  {
+    return false;
+  }
+  for (int i = 0; i < f->GetSize(); ++i)
+  {
+    double node[4];
+    f->GetNodeValue(i, node);
+    if (node[1] != 1.0)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
 std::string vtkOctreeRenderSettings::UnappliedProperty(vtkVolumeProperty* property)
 {
   if (property->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
@@ -82,8 +103,12 @@ std::string vtkOctreeRenderSettings::UnappliedProperty(vtkVolumeProperty* proper
     return "The volume property's 2D transfer function (TransferFunctionMode TF_2D) is not applied; the octree is "
            "drawn through its colour function and scalar opacity.";
   }
-  // As VTK's GPU ray caster decides whether to apply it.
-  if (property->HasGradientOpacity(0) && !property->GetDisableGradientOpacity(0))
+  // As VTK's GPU ray caster decides whether to apply it, but for a function
+  // of 1 everywhere, which changes nothing: the default that
+  // GetGradientOpacity makes, and so what DeepCopy of any property gives
+  // (ParaView's CT Preset copies its property).
+  if (property->HasGradientOpacity(0) && !property->GetDisableGradientOpacity(0) &&
+    !IsOneEverywhere(property->GetGradientOpacity(0)))
   {
     return "The volume property's gradient opacity is not applied; the octree's opacity is the scalar opacity's "
            "alone (DisableGradientOpacityOn turns it off, and this warning with it).";

@@ -9,7 +9,9 @@ of Data/External (the reader's image output):
   mapper, overriding ImageBackground; "none" gives back ParaView's colour
   map, opacity function and the ImageBackground set in the panel;
 - the pictures: bone-coloured (red > green > blue) with ct-bone, different
-  from the picture without a preset;
+  from the picture without a preset, and no warning that a gradient
+  opacity is not applied (the preset's copy of ParaView's property has
+  VTK's default, 1 everywhere);
 - an unknown name is an error and leaves no preset;
 - a preset on a display left at Solid Color maps the image's active
   scalars: ct-bone's picture.
@@ -81,7 +83,14 @@ check("without a preset the panel's ImageBackground (100) is used", mapper.GetIm
 paraview_colour = actor.GetProperty().GetRGBTransferFunction(0)
 
 display.Preset = "ct-bone"
+# What the mapper says while it draws the preset, in a string window.
+from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow  # noqa: E402
+paraview_window, said = vtkOutputWindow.GetInstance(), vtkStringOutputWindow()
+vtkOutputWindow.SetInstance(said)
 bone = picture("preset_ct-bone.png")
+vtkOutputWindow.SetInstance(paraview_window)
+check("ct-bone draws without a word of gradient opacity (the preset copies ParaView's property, whose "
+      "gradient opacity is 1 everywhere): %r" % said.GetOutput(), "gradient opacity" not in said.GetOutput())
 threshold = octoray.vtkOctreeVolumePresets.GetSurfaceThreshold("ct-bone")
 check("ct-bone sets the mapper's ImageBackground to its threshold %g (got %g)"
       % (threshold, mapper.GetImageBackground()), mapper.GetImageBackground() == threshold)

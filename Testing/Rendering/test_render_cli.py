@@ -331,11 +331,13 @@ def test_a_blend_mode_the_engine_has_not_is_said_once(mode, expected):
     (lambda p: p.SetTransferFunctionModeTo2D(),
      "The volume property's 2D transfer function (TransferFunctionMode TF_2D) is not applied"),
     (lambda p: (p.SetGradientOpacity(ramp_up()), p.DisableGradientOpacityOn()), None),
+    (lambda p: p.GetGradientOpacity(), None),
 ])
 def test_volume_property_parts_the_engine_does_not_apply_are_said_once(configure, expected):
     """A gradient opacity (VTK's CT examples set one) or a 2D transfer
     function: one warning over frames, the picture as without; a gradient
-    opacity switched off says nothing."""
+    opacity switched off says nothing, nor does VTK's default one, 1
+    everywhere, which GetGradientOpacity makes (and DeepCopy with it)."""
     mapper, window, said, whole = drawn_cloud()
     configure(window.GetRenderers().GetFirstRenderer().GetVolumes().GetLastProp().GetProperty())
     if expected is None:
