@@ -3,7 +3,8 @@
 // baselines and threshold for both backends). Each test also checks that the
 // comparison can fail: another mode's picture must fail against the same
 // baseline. Arguments: --mode NAME, --backend cpu|cuda, and VTK's -V BASELINE
-// -T TEMPORARY.
+// -T TEMPORARY (this mode's picture there; the other mode's in
+// TEMPORARY/other-mode).
 #include "octorayMapperTesting.h"
 
 #include "vtkColorTransferFunction.h"
@@ -12,7 +13,9 @@
 #include "vtkRenderer.h"
 #include "vtkTrivialProducer.h"
 
+#include <filesystem>
 #include <sstream>
+#include <string>
 
 using namespace octoray_test;
 
@@ -122,10 +125,19 @@ int TestOctreeVolumeMapperModes(int argc, char* argv[])
   picture->DeepCopy(grab->GetOutput());
   vtkNew<vtkTrivialProducer> producer;
   producer->SetOutput(picture);
+  // Its failed picture goes to a folder of its own under -T: in -T itself
+  // it took the place of this mode's picture, from which a baseline is
+  // redrawn.
   vtkNew<vtkTesting> testing;
   for (int i = 0; i < argc; ++i)
   {
-    testing->AddArgument(argv[i]);
+    std::string argument = argv[i];
+    if (i > 0 && std::string(argv[i - 1]) == "-T")
+    {
+      argument += "/other-mode";
+      std::filesystem::create_directories(argument);
+    }
+    testing->AddArgument(argument.c_str());
   }
   testing->SetRenderWindow(otherWindow);
   std::ostringstream quiet;
