@@ -6,8 +6,8 @@
 #include "vtkCellArray.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkCommunicator.h"
-#include "vtkCompositeDataIterator.h"
 #include "vtkCompositeDataSet.h"
+#include "vtkCompositeDataSetRange.h"
 #include "vtkDataSet.h"
 #include "vtkFieldData.h"
 #include "vtkIdTypeArray.h"
@@ -115,11 +115,8 @@ vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedPointSets(
 {
   vtkNew<vtkAppendDataSets> append;
   bool polyData = true;
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(composite->NewIterator());
-  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  for (vtkDataObject* leaf : vtk::Range(composite))
   {
-    vtkDataObject* leaf = it->GetCurrentDataObject();
     auto* points = vtkPointSet::SafeDownCast(leaf);
     if (!points)
     {
@@ -145,11 +142,9 @@ vtkMTimeType vtkOctreeVolumeRepresentation::LatestBlockTime(vtkCompositeDataSet*
   // A composite data set's own time does not follow its blocks: a script
   // that moves a block's points in place modifies only that block.
   vtkMTimeType latest = composite->GetMTime();
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(composite->NewIterator());
-  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  for (vtkDataObject* leaf : vtk::Range(composite))
   {
-    latest = std::max(latest, it->GetCurrentDataObject()->GetMTime());
+    latest = std::max(latest, leaf->GetMTime());
   }
   return latest;
 }
@@ -177,11 +172,9 @@ vtkSmartPointer<vtkPointSet> vtkOctreeVolumeRepresentation::MergedBlocks(
 void vtkOctreeVolumeRepresentation::ReportDroppedArrays(vtkCompositeDataSet* composite, vtkPointSet* merged)
 {
   std::set<std::string> dropped;
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(composite->NewIterator());
-  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  for (vtkDataObject* leaf : vtk::Range(composite))
   {
-    vtkPointData* arrays = vtkDataSet::SafeDownCast(it->GetCurrentDataObject())->GetPointData();
+    vtkPointData* arrays = vtkDataSet::SafeDownCast(leaf)->GetPointData();
     for (int i = 0; i < arrays->GetNumberOfArrays(); ++i)
     {
       const char* name = arrays->GetArrayName(i);
