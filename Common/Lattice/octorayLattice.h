@@ -127,6 +127,55 @@ struct Axis
 };
 
 /**
+ * Sets each axis's Fill from the source's spacing and the axes' Stride and
+ * Count (FillFactors of the selected samples' steps): how the reader's
+ * particles and the mapper's images both fill between slices.
+ */
+inline void FillAxes(const double spacing[3], Axis axes[3])
+{
+  double step[3];
+  long long count[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    step[a] = spacing[a] * static_cast<double>(axes[a].Stride);
+    count[a] = axes[a].Count;
+  }
+  int fill[3];
+  FillFactors(step, count, fill);
+  for (int a = 0; a < 3; ++a)
+  {
+    axes[a].Fill = fill[a];
+  }
+}
+
+/**
+ * An image's samples: its points, or with `cells` its cells (one fewer
+ * along each axis that has cells, at their centres). Gives how many lie
+ * along each index axis and where the first lies: the extent's first index
+ * through the image's index-to-physical map, which is at its Origin only
+ * where the extent starts at 0 (not for the Wavelet source's -10..10, nor
+ * for the pieces of an image split over ranks). `Image` is vtkImageData; a
+ * template, so that this header needs no VTK.
+ */
+template <class Image>
+void ImageSamples(Image* image, bool cells, int dims[3], double first[3])
+{
+  image->GetDimensions(dims);
+  const int* extent = image->GetExtent();
+  double index[3] = { static_cast<double>(extent[0]), static_cast<double>(extent[2]),
+    static_cast<double>(extent[4]) };
+  for (int a = 0; a < 3 && cells; ++a)
+  {
+    if (dims[a] > 1)
+    {
+      --dims[a];
+      index[a] += 0.5;
+    }
+  }
+  image->TransformContinuousIndexToPhysicalPoint(index, first);
+}
+
+/**
  * Every sample of plane `r2` (a sample index along axis 2), row by row:
  * visit(r0, r1, values), `values` (the caller's buffer of `comps` doubles)
  * holding the components interpolated from the source: `data` holds
@@ -313,10 +362,8 @@ struct Lattice
  * The lattice of the samples of `axes` over an image: where its first
  * sample lies, its spacing per index axis and its direction matrix
  * (row-major; index axis a runs along column a), as vtkImageData has them.
- * The first sample is the data array's first value: for a vtkImageData its
- * extent's first index (TransformIndexToPhysicalPoint), which lies at its
- * Origin only where the extent starts at 0 (not for the Wavelet source's
- * -10..10, nor for the pieces of an image split over ranks).
+ * The first sample is the data array's first value: for a vtkImageData
+ * ImageSamples's `first`.
  */
 inline Lattice LatticeOf(const Axis axes[3], const double first[3], const double spacing[3], const double direction[9])
 {

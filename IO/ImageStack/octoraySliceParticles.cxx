@@ -284,15 +284,7 @@ bool SelectAxes(const int dims[3], const double spacing[3], const ParticleOption
   }
   if (options.FillBetweenSlices)
   {
-    const double step[3] = { spacing[0] * axes[0].Stride, spacing[1] * axes[1].Stride,
-      spacing[2] * axes[2].Stride };
-    const long long count[3] = { axes[0].Count, axes[1].Count, axes[2].Count };
-    int fill[3];
-    octoray::lattice::FillFactors(step, count, fill);
-    for (int a = 0; a < 3; ++a)
-    {
-      axes[a].Fill = fill[a];
-    }
+    octoray::lattice::FillAxes(spacing, axes);
   }
   return true;
 }
@@ -327,7 +319,8 @@ std::string ParticleOptionsProblem(const int dims[3], const ParticleOptions& opt
 void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyData* output)
 {
   int dims[3];
-  image->GetDimensions(dims);
+  double first[3];
+  octoray::lattice::ImageSamples(image, false, dims, first);
   const double* spacing = image->GetSpacing();
   Axis axes[3];
   if (!SelectAxes(dims, spacing, options, axes))
@@ -335,9 +328,6 @@ void MakeParticles(vtkImageData* image, const ParticleOptions& options, vtkPolyD
     output->SetPoints(vtkSmartPointer<vtkPoints>::New());
     return;
   }
-  const int* extent = image->GetExtent();
-  double first[3];
-  image->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], first);
   const octoray::lattice::Lattice lattice =
     octoray::lattice::LatticeOf(axes, first, spacing, image->GetDirectionMatrix()->GetData());
   const long long size[3] = { dims[0], dims[1], dims[2] };

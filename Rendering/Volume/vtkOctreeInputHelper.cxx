@@ -623,25 +623,62 @@ bool vtkOctreeInputHelper::PointLattice(octoray::lattice::Lattice& lattice, doub
 }
 
 //------------------------------------------------------------------------------
-// The voxels of an image: its points, or with cell scalars its cells (one
-// fewer along each axis that has cells, at their centres). How many along
-// each axis, and where the first lies: the extent's first index, which is
-// at the Origin only where the extent starts at 0.
-static void ImageSamples(vtkImageData* image, bool cells, int dims[3], double first[3])
+// The lattice of an image's voxels (its points, or with cell scalars its
+// cells; octorayLattice.h's ImageSamples), with the planes between slices
+// where FillBetweenSlices asks for them; `axes` and `size` as ImagePoints
+// takes them.
+static octoray::lattice::Lattice ImageLattice(vtkImageData* image, const vtkOctreeInputHelper::Request& r,
+  octoray::lattice::Axis axes[3], long long size[3])
 {
-  image->GetDimensions(dims);
-  const int* extent = image->GetExtent();
-  double index[3] = { static_cast<double>(extent[0]), static_cast<double>(extent[2]),
-    static_cast<double>(extent[4]) };
-  for (int a = 0; a < 3 && cells; ++a)
+  int dims[3];
+  double first[3];
+  octoray::lattice::ImageSamples(image, r.CellCentred, dims, first);
+  for (int a = 0; a < 3; ++a)
   {
-    if (dims[a] > 1)
-    {
-      --dims[a];
-      index[a] += 0.5;
-    }
+    size[a] = axes[a].Count = dims[a];
   }
-  image->TransformContinuousIndexToPhysicalPoint(index, first);
+  if (r.FillBetweenSlices)
+  {
+    octoray::lattice::FillAxes(image->GetSpacing(), axes);
+  }
+  return octoray::lattice::LatticeOf(axes, first, image->GetSpacing(), image->GetDirectionMatrix()->GetData());
+}
+
+//------------------------------------------------------------------------------
+// ImagePoints over the request's scalars, of whatever type and layout they
+// come in (none: the whole grid).
+static void ImageVoxels(vtkImageData* image, const vtkOctreeInputHelper::Request& r,
+  const octoray::lattice::Axis axes[3], const long long size[3], const octoray::lattice::Lattice& lattice,
+  ImageOutput out, const std::function<void(double)>& progress)
+{
+  vtkDataArray* scalars = r.Scalars;
+  if (!scalars)
+  {
+    const double* none = nullptr;
+    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, 0, out, progress);
+    return;
+  }
+  const int comps = scalars->GetNumberOfComponents();
+  const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
+  const double* spacing = image->GetSpacing();
+  const double* direction = image->GetDirectionMatrix()->GetData();
+  if (scalars->HasStandardMemoryLayout())
+  {
+    switch (scalars->GetDataType())
+    {
+      vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
+        lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent, out, progress, spacing, direction));
+    }
+    return;
+  }
+  // Another memory layout (e.g. struct of arrays): the values as doubles.
+  std::vector<double> values(static_cast<std::size_t>(scalars->GetNumberOfTuples()) * comps);
+  for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+  {
+    scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
+  }
+  ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent,
+    out, progress, spacing, direction);
 }
 
 //------------------------------------------------------------------------------
@@ -654,59 +691,13 @@ void vtkOctreeInputHelper::ImageView(
   const Request& r, octoray::PointCloudView& view, const std::function<void(double)>& progress)
 {
   auto* image = vtkImageData::SafeDownCast(r.Input);
-  vtkDataArray* scalars = r.Scalars;
-  int dims[3];
-  double first[3];
-  ImageSamples(image, r.CellCentred, dims, first);
-  const long long size[3] = { dims[0], dims[1], dims[2] };
   octoray::lattice::Axis axes[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    axes[a].Count = size[a];
-  }
-  const double* spacing = image->GetSpacing();
-  if (r.FillBetweenSlices)
-  {
-    int fill[3];
-    octoray::lattice::FillFactors(spacing, size, fill);
-    for (int a = 0; a < 3; ++a)
-    {
-      axes[a].Fill = fill[a];
-    }
-  }
-  const octoray::lattice::Lattice lattice =
-    octoray::lattice::LatticeOf(axes, first, spacing, image->GetDirectionMatrix()->GetData());
-  const int comps = scalars ? scalars->GetNumberOfComponents() : 0;
-  const bool bytes = vtkUnsignedCharArray::SafeDownCast(scalars) != nullptr;
+  long long size[3];
+  const octoray::lattice::Lattice lattice = ImageLattice(image, r, axes, size);
   this->Normal.clear();
   const ImageOutput out{ this->Xyz, this->Scalar, this->Color8, this->ColorFloat,
     r.ImageGradientNormals ? &this->Normal : nullptr };
-  const double* direction = image->GetDirectionMatrix()->GetData();
-  if (!scalars)
-  {
-    const double* none = nullptr;
-    ImagePoints(none, 0, axes, size, lattice, r.ImageBackground, false, false, 0, out, progress);
-  }
-  else if (scalars->HasStandardMemoryLayout())
-  {
-    switch (scalars->GetDataType())
-    {
-      vtkTemplateMacro(ImagePoints(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), comps, axes, size,
-        lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent, out, progress, spacing, direction));
-    }
-  }
-  else
-  {
-    // Another memory layout (e.g. struct of arrays): the values as doubles.
-    std::vector<double> values(static_cast<std::size_t>(scalars->GetNumberOfTuples()) * comps);
-    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
-    {
-      scalars->GetTuple(i, &values[static_cast<std::size_t>(i) * comps]);
-    }
-    ImagePoints(values.data(), comps, axes, size, lattice, r.ImageBackground, r.Colours, bytes, r.ScalarComponent, out,
-      progress,
-      spacing, direction);
-  }
+  ImageVoxels(image, r, axes, size, lattice, out, progress);
   view.count = this->Xyz.size() / 3;
   view.xyzDouble = this->Xyz.data();
   view.color8 = this->Color8.empty() ? nullptr : this->Color8.data();
@@ -714,26 +705,31 @@ void vtkOctreeInputHelper::ImageView(
   view.colorComponents = r.Colours ? 4 : 0;
   view.scalar = this->Scalar.empty() ? nullptr : this->Scalar.data();
   view.normal = this->Normal.empty() ? nullptr : this->Normal.data();
-
-  // The points' lattice and bounds, for the leaf grid.
   if (view.count > 0)
   {
-    double* b = this->LatticeBounds;
+    this->RememberImageLattice(lattice);
+  }
+}
+
+//------------------------------------------------------------------------------
+// The image points' lattice and bounds, for the leaf grid (PointLattice).
+void vtkOctreeInputHelper::RememberImageLattice(const octoray::lattice::Lattice& lattice)
+{
+  double* b = this->LatticeBounds;
+  for (int a = 0; a < 3; ++a)
+  {
+    b[2 * a] = b[2 * a + 1] = this->Xyz[a];
+  }
+  for (std::size_t i = 0; i < this->Xyz.size(); i += 3)
+  {
     for (int a = 0; a < 3; ++a)
     {
-      b[2 * a] = b[2 * a + 1] = this->Xyz[a];
+      b[2 * a] = std::min(b[2 * a], this->Xyz[i + a]);
+      b[2 * a + 1] = std::max(b[2 * a + 1], this->Xyz[i + a]);
     }
-    for (std::size_t i = 0; i < view.count; ++i)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        b[2 * a] = std::min(b[2 * a], this->Xyz[3 * i + a]);
-        b[2 * a + 1] = std::max(b[2 * a + 1], this->Xyz[3 * i + a]);
-      }
-    }
-    this->Lattice = lattice;
-    this->HasLattice = true;
   }
+  this->Lattice = lattice;
+  this->HasLattice = true;
 }
 
 //------------------------------------------------------------------------------

@@ -171,6 +171,7 @@ private:
 
   void PointSetView(const Request& request, octoray::PointCloudView& view);
   void ImageView(const Request& request, octoray::PointCloudView& view, const std::function<void(double)>& progress);
+  void RememberImageLattice(const octoray::lattice::Lattice& lattice);
   void FindScalarRange(const octoray::PointCloudView& view);
 
   bool Built = false;
