@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 
 #include <sys/stat.h>
 
@@ -49,10 +50,49 @@ bool IsPictureExtension(const std::string& name)
   return std::find(std::begin(known), std::end(known), ext) != std::end(known);
 }
 
+// The conversions a file pattern may hold: one integer, as in slice_%03d.png;
+// %% for a percent sign. Anything else would make snprintf read an
+// argument it is not given.
+bool CheckPattern(const std::string& pattern, std::string& error)
+{
+  static const std::regex conversion("%[-+ 0#]*[0-9]*[diuxXo]");
+  int integers = 0;
+  for (std::size_t at = pattern.find('%'); at != std::string::npos; at = pattern.find('%', at))
+  {
+    std::smatch found;
+    const std::string rest = pattern.substr(at);
+    if (rest.compare(0, 2, "%%") == 0)
+    {
+      at += 2;
+      continue;
+    }
+    if (!std::regex_search(rest, found, conversion, std::regex_constants::match_continuous))
+    {
+      const std::size_t end = rest.find_first_of("diouxXcsfFeEgGaApn", 1);
+      error = "the file pattern '" + pattern + "' has '" + rest.substr(0, end == std::string::npos ? end : end + 1) +
+        "'; it takes one integer conversion, such as %d or %03d (%% for a percent sign)";
+      return false;
+    }
+    ++integers;
+    at += found.length();
+  }
+  if (integers != 1)
+  {
+    error = "the file pattern '" + pattern + "' has " + std::to_string(integers) +
+      " integer conversions; it takes one, such as %d or %03d, for the slice number";
+    return false;
+  }
+  return true;
+}
+
 // The pattern filled with each number of the range: every file must exist.
 bool FromPattern(
   const char* pattern, const int range[2], std::vector<std::string>& files, std::string& error)
 {
+  if (!CheckPattern(pattern, error))
+  {
+    return false;
+  }
   const int first = range[0];
   const int last = range[1];
   std::vector<std::string> missing;

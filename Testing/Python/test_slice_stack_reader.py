@@ -451,6 +451,32 @@ def test_error_pattern_matches_nothing(tmp_path):
     assert out.GetNumberOfPoints() == 0
 
 
+@pytest.mark.parametrize("name, wrong", [
+    ("s_%s.png", "has '%s'; it takes one integer conversion, such as %d or %03d (%% for a percent sign)"),
+    ("s_%n.png", "has '%n'; it takes one integer conversion"),
+    ("s_%5.2f.png", "has '%5.2f'; it takes one integer conversion"),
+    ("s_%03d_%d.png", "has 2 integer conversions; it takes one, such as %d or %03d, for the slice number"),
+    ("s.png", "has 0 integer conversions; it takes one")])
+def test_error_pattern_without_one_integer(tmp_path, name, wrong):
+    """A pattern is filled by snprintf with the slice number alone: any
+    other conversion would read an argument that is not there (%s and %n
+    crashed the reader), so the reader names it before filling."""
+    write_slices(vtk.vtkPNGWriter, str(tmp_path), "s_%d.png", np.ones((2, 4, 4), np.uint8))
+    pattern = os.path.join(str(tmp_path), name)
+    r, out, msgs = reader_for(FilePattern=pattern, FileNameRange=(0, 1))
+    assert r.GetErrorMessage().startswith("the file pattern '%s' %s" % (pattern, wrong))
+    assert out.GetNumberOfPoints() == 0
+
+
+def test_pattern_with_a_percent_sign(tmp_path):
+    folder = os.path.join(str(tmp_path), "100%")
+    write_slices(vtk.vtkPNGWriter, folder, "s_%d.png", np.full((2, 4, 4), 9, np.uint8))
+    r, out, msgs = reader_for(FilePattern=os.path.join(str(tmp_path), "100%%", "s_%d.png"),
+                              FileNameRange=(0, 1))
+    assert r.GetErrorMessage() == ""
+    assert r.GetImageOutput().GetDimensions() == (4, 4, 2)
+
+
 def test_error_empty_directory(tmp_path):
     folder = os.path.join(str(tmp_path), "empty")
     os.makedirs(folder)

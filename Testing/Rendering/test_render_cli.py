@@ -3,11 +3,13 @@
 Run under xvfb-run by ctest (the renderer opens an offscreen OpenGL window).
 """
 import os
+import shutil
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+import vtk
 import octoray
 from mapper_views import assert_said_once, gathered, offscreen_view
 from octoray.png import read_png
@@ -525,6 +527,39 @@ def test_render_slice_stack_closed(tmp_path):
     assert runs["image"]["leaf"] == runs["particles"]["leaf"]
     assert abs(float(runs["unfilled"]["leaf"]) - 2.5) < 1e-4
     assert int(runs["unfilled"]["points"]) * 4 < int(runs["particles"]["points"])
+
+
+def test_a_pattern_reads_every_slice_it_names(tmp_path):
+    """A printf pattern of slice names without --range reads from the
+    lowest number it names a file for to the highest (it read slice 0 alone
+    before), and a gap between them is the reader's error naming the file."""
+    from vtk.util.numpy_support import numpy_to_vtk
+    for k in range(3, 7):
+        image = vtk.vtkImageData()
+        image.SetDimensions(8, 6, 1)
+        image.GetPointData().SetScalars(numpy_to_vtk(np.full(48, 200, np.uint8), deep=1))
+        writer = vtk.vtkPNGWriter()
+        writer.SetInputData(image)
+        writer.SetFileName(str(tmp_path / ("s_%02d.png" % k)))
+        writer.Write()
+    pattern = str(tmp_path / "s_%02d.png")
+    r = run(pattern, "-o", str(tmp_path / "p.png"), "--backend", "cpu", "--size", "64x48")
+    assert r.returncode == 0, r.stderr
+    assert "input: 192 voxels (8 x 6 x 4)" in r.stdout
+    os.remove(str(tmp_path / "s_05.png"))
+    r = run(pattern, "-o", str(tmp_path / "p.png"), "--backend", "cpu", "--size", "64x48")
+    assert r.returncode == 1
+    assert r.stderr.splitlines()[-1].startswith("error: slice file '%s' is missing" % (tmp_path / "s_05.png"))
+
+
+def test_a_file_with_a_percent_sign_is_read_as_a_file(tmp_path):
+    folder = tmp_path / "100%done"
+    folder.mkdir()
+    shutil.copy(PARTICLES, str(folder / "scan_50%s.particles"))
+    r = run(str(folder / "scan_50%s.particles"), "-o", str(tmp_path / "x.png"), "--backend", "cpu",
+            "--size", "64x48")
+    assert r.returncode == 0, r.stderr
+    assert "input: " in r.stdout and "points" in r.stdout
 
 
 def test_missing_input_is_an_error(tmp_path):

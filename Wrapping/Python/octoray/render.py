@@ -10,8 +10,8 @@
 
 INPUT is a particle text file (.particles, .txt, .xyz, .gz, ...), a PCL point
 cloud (.pcd: ascii, binary or binary_compressed), a folder of image slices or
-DICOM files, or a printf pattern of slice names ("ct_%03d.png", with --range
-FIRST LAST). Slice stacks are drawn from the reader's image output (its
+DICOM files, or a printf pattern of slice names ("ct_%03d.png"; --range FIRST
+LAST, by default every number it names a file for). Slice stacks are drawn from the reader's image output (its
 volume, a vtkImageData; --particles: its particles): voxels above
 --threshold (default: the preset's, else 0) become the octree, with
 interpolated points between slices (--no-fill: not), so the stack draws as a
@@ -91,7 +91,9 @@ def parser():
     p.add_argument("--elevation", type=float, default=0.0)
     p.add_argument("--zoom", type=float, default=1.0)
     p.add_argument("--depth", type=int, default=0, help="octree leaf level (0: automatic)")
-    p.add_argument("--range", type=int, nargs=2, default=(0, 0), metavar=("FIRST", "LAST"))
+    p.add_argument("--range", type=int, nargs=2, default=None, metavar=("FIRST", "LAST"),
+                   help="the slice numbers a pattern of slice names reads (default: every number it names "
+                        "a file for, from the lowest to the highest)")
     p.add_argument("--background", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                    help="slice intensities that are background: as --threshold HI (--particles: the "
                         "reader's BackgroundRange)")

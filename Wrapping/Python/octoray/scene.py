@@ -22,6 +22,7 @@ Defaults a user would otherwise have to find:
   noisy scan speckle, and the fill lifts the specks).
 """
 import os
+import re
 import sys
 import time
 
@@ -93,15 +94,35 @@ class Timer:
 
 
 def input_kind(path):
-    """'slices' (a folder or a printf pattern of slices), 'pcd' or 'particles'."""
-    if os.path.isdir(path) or "%" in path:
+    """'slices' (a folder or a printf pattern of slices), 'pcd' or 'particles'.
+    A file that exists is read as a file, a % in its name or not."""
+    if os.path.isdir(path) or ("%" in path and not os.path.isfile(path)):
         return "slices"
     if path.lower().endswith((".pcd", ".pcd.gz")):
         return "pcd"
     return "particles"
 
 
-def make_reader(path, file_range=(0, 0)):
+def pattern_range(pattern):
+    """The lowest and highest numbers for which the printf pattern of slice
+    names (one integer conversion, as in ct_%03d.png) names a file in its
+    folder; None where it names none (the reader then says what is wrong
+    with the pattern, or that it matches nothing)."""
+    folder, name = os.path.split(pattern)
+    conversion = re.search(r"%[-+ 0#]*[0-9]*[diu]", name)
+    if conversion is None or not os.path.isdir(folder or "."):
+        return None
+    parts = [re.escape(part.replace("%%", "%")) for part in (name[:conversion.start()], name[conversion.end():])]
+    names = re.compile(parts[0] + r"\s*([-+]?[0-9]+)" + parts[1] + "$")
+    numbers = [int(m.group(1)) for m in map(names.match, os.listdir(folder or ".")) if m]
+    numbers = [n for n in numbers if os.path.isfile(pattern % n)]
+    return (min(numbers), max(numbers)) if numbers else None
+
+
+def make_reader(path, file_range=None):
+    """The reader for `path`; a pattern of slice names reads the numbers
+    `file_range` (FIRST, LAST), by default every number it names a file for
+    (pattern_range): the reader says which are missing between them."""
     kind = input_kind(path)
     if kind == "slices":
         reader = octoray.vtkSliceStackReader()
@@ -109,7 +130,7 @@ def make_reader(path, file_range=(0, 0)):
             reader.SetDirectoryName(path)
         else:
             reader.SetFilePattern(path)
-            reader.SetFileNameRange(*file_range)
+            reader.SetFileNameRange(*(file_range or pattern_range(path) or (0, 0)))
         return reader
     reader = octoray.vtkPCDReader() if kind == "pcd" else octoray.vtkParticleReader()
     reader.SetFileName(path)
@@ -117,7 +138,7 @@ def make_reader(path, file_range=(0, 0)):
     return reader
 
 
-def read(path, file_range=(0, 0), progress_label="reading", stream=None, configure=None,
+def read(path, file_range=None, progress_label="reading", stream=None, configure=None,
          particles=False):
     """Reads `path` with a progress line; returns (reader, data, seconds).
     Slice stacks give the reader's image output (vtkImageData), or with
