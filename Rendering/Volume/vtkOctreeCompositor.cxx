@@ -87,49 +87,73 @@ static void DepthTextureFormat(unsigned int format, GLenum& base, GLenum& type)
 }
 
 //------------------------------------------------------------------------------
+// Makes or resizes the texture and its framebuffer for `width` x `height`
+// depths of `format`. Leaves the draw framebuffer binding to the caller.
+void vtkOctreeCompositor::DepthTarget::Fit(vtkOpenGLState* state, int width, int height, unsigned int format)
+{
+  if (this->Framebuffer && this->Size[0] == width && this->Size[1] == height && this->Format == format)
+  {
+    return;
+  }
+  if (!this->Framebuffer)
+  {
+    glGenFramebuffers(1, &this->Framebuffer);
+    glGenTextures(1, &this->Texture);
+  }
+  GLenum base = GL_DEPTH_COMPONENT, type = GL_UNSIGNED_INT;
+  DepthTextureFormat(format, base, type);
+  glBindTexture(GL_TEXTURE_2D, this->Texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(format), width, height, 0, base, type, nullptr);
+  // Sampled texel for texel: no filtering, no mipmaps (without which the
+  // texture would be incomplete), no comparison.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->Framebuffer);
+  glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, base == GL_DEPTH_STENCIL ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+    GL_TEXTURE_2D, this->Texture, 0);
+  this->Size[0] = width;
+  this->Size[1] = height;
+  this->Format = format;
+}
+
+//------------------------------------------------------------------------------
+void vtkOctreeCompositor::DepthTarget::Release(bool withContext)
+{
+  if (withContext && this->Framebuffer)
+  {
+    glDeleteFramebuffers(1, &this->Framebuffer);
+    glDeleteTextures(1, &this->Texture);
+  }
+  *this = DepthTarget();
+}
+
+//------------------------------------------------------------------------------
 // Copies the viewport's depth from the framebuffer VTK draws into (a blit,
 // which also resolves a multisampled one) into a single-sampled depth
-// texture of the same format (a blit needs one), at the origin. Returns the
-// framebuffer that holds it; the draw and read bindings are as they were.
+// texture of the same format (a blit needs one), at the origin. The scissor
+// test is off meanwhile: VTK scissors a renderer's viewport, which would
+// keep the copy's corner from being written for a viewport away from the
+// window's corner (the volume then drew as if everything lay in front of
+// it). Returns the framebuffer that holds the copy; the draw and read
+// bindings are as they were.
 unsigned int vtkOctreeCompositor::CopyDepth(
   vtkOpenGLRenderWindow* window, unsigned int drawFramebuffer, int x0, int y0, int width, int height)
 {
   vtkOpenGLState* state = window->GetState();
   const unsigned int format = DepthFormat(drawFramebuffer);
+  vtkOpenGLState::ScopedglEnableDisable scissor(state, GL_SCISSOR_TEST);
+  state->vtkglDisable(GL_SCISSOR_TEST);
   state->PushDrawFramebufferBinding();
   state->PushReadFramebufferBinding();
-  if (!this->CopyFramebuffer || this->CopySize[0] != width || this->CopySize[1] != height ||
-    this->CopyFormat != format)
-  {
-    if (!this->CopyFramebuffer)
-    {
-      glGenFramebuffers(1, &this->CopyFramebuffer);
-      glGenTextures(1, &this->CopyTexture);
-    }
-    GLenum base = GL_DEPTH_COMPONENT, type = GL_UNSIGNED_INT;
-    DepthTextureFormat(format, base, type);
-    glBindTexture(GL_TEXTURE_2D, this->CopyTexture);
-    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(format), width, height, 0, base, type, nullptr);
-    // Sampled texel for texel: no filtering, no mipmaps (without which the
-    // texture would be incomplete), no comparison.
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CopyFramebuffer);
-    const bool withStencil = base == GL_DEPTH_STENCIL;
-    glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, withStencil ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
-      GL_TEXTURE_2D, this->CopyTexture, 0);
-    this->CopySize[0] = width;
-    this->CopySize[1] = height;
-    this->CopyFormat = format;
-  }
+  this->Copy.Fit(state, width, height, format);
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
-  state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CopyFramebuffer);
+  state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->Copy.Framebuffer);
   glBlitFramebuffer(x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
   state->PopReadFramebufferBinding();
   state->PopDrawFramebufferBinding();
-  return this->CopyFramebuffer;
+  return this->Copy.Framebuffer;
 }
 
 //------------------------------------------------------------------------------
@@ -218,16 +242,18 @@ const float* vtkOctreeCompositor::ReadDepthToDevice(
     error = "the depth shader did not compile";
     return nullptr;
   }
-  this->WindowDepth->AssignToExistingTexture(this->CopyTexture, GL_TEXTURE_2D);
+  this->WindowDepth->AssignToExistingTexture(this->Copy.Texture, GL_TEXTURE_2D);
   {
     vtkOpenGLState::ScopedglViewport viewport(state);
     vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
     vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
+    vtkOpenGLState::ScopedglEnableDisable scissor(state, GL_SCISSOR_TEST); // as in CopyDepth
     state->PushDrawFramebufferBinding();
     state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, this->FloatDepthFramebuffer);
     state->vtkglViewport(0, 0, width, height);
     state->vtkglDisable(GL_DEPTH_TEST);
     state->vtkglDisable(GL_BLEND);
+    state->vtkglDisable(GL_SCISSOR_TEST);
     this->WindowDepth->Activate();
     this->DepthQuad->Program->SetUniformi("octorayWindowDepth", this->WindowDepth->GetTextureUnit());
     this->DepthQuad->Render();
@@ -385,7 +411,7 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
 void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
 {
   auto* glWindow = vtkOpenGLRenderWindow::SafeDownCast(window);
-  if (glWindow && (this->ColorTexture || this->CopyFramebuffer || this->FloatDepth))
+  if (glWindow && (this->ColorTexture || this->Copy.Framebuffer || this->FloatDepth))
   {
     glWindow->MakeCurrent();
   }
@@ -414,24 +440,12 @@ void vtkOctreeCompositor::ReleaseGraphicsResources(vtkWindow* window)
   }
   this->FloatDepth = nullptr;
   this->WindowDepth = nullptr;
-  if (glWindow)
+  if (glWindow && this->FloatDepthFramebuffer)
   {
-    const unsigned int framebuffers[2] = { this->CopyFramebuffer, this->FloatDepthFramebuffer };
-    for (unsigned int f : framebuffers)
-    {
-      if (f)
-      {
-        glDeleteFramebuffers(1, &f);
-      }
-    }
-    if (this->CopyTexture)
-    {
-      glDeleteTextures(1, &this->CopyTexture);
-    }
+    glDeleteFramebuffers(1, &this->FloatDepthFramebuffer);
   }
-  this->CopyFramebuffer = this->FloatDepthFramebuffer = this->CopyTexture = 0;
-  this->CopySize[0] = this->CopySize[1] = 0;
-  this->CopyFormat = 0;
+  this->FloatDepthFramebuffer = 0;
+  this->Copy.Release(glWindow != nullptr);
   this->PictureReady = false;
   this->Window = nullptr;
 }

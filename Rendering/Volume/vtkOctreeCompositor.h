@@ -28,6 +28,7 @@
 class vtkOctreeCudaInterop;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
+class vtkOpenGLState;
 class vtkTextureObject;
 class vtkWindow;
 
@@ -98,13 +99,20 @@ private:
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
   std::unique_ptr<vtkOctreeCudaInterop> Interop;
   bool PictureReady = false;
-  // A single-sampled copy of the window's depth (a depth texture of its
-  // format, in its own framebuffer): for reading a multisampled window, and
-  // as the source of the float copy for CUDA.
-  unsigned int CopyFramebuffer = 0;
-  unsigned int CopyTexture = 0;
-  int CopySize[2] = { 0, 0 };
-  unsigned int CopyFormat = 0;
+  // A depth texture of a window's depth format in a framebuffer of its own.
+  struct DepthTarget
+  {
+    unsigned int Framebuffer = 0;
+    unsigned int Texture = 0;
+    int Size[2] = { 0, 0 };
+    unsigned int Format = 0;
+    void Fit(vtkOpenGLState* state, int width, int height, unsigned int format);
+    void Release(bool withContext);
+  };
+  // A single-sampled copy of the viewport's depth at the origin: for
+  // reading a multisampled window, and as the source of the float copy for
+  // CUDA.
+  DepthTarget Copy;
   // The window depth as a single-channel float texture, drawn from the copy,
   // which CUDA-OpenGL interop can read; WindowDepth wraps the copy's texture
   // for sampling.
