@@ -396,6 +396,11 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
   state->vtkglDepthMask(GL_TRUE);
   state->vtkglEnable(GL_BLEND);
   state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  // Over, whatever equation a pass left (dual depth peeling leaves MAX).
+  GLint equation[2] = { GL_FUNC_ADD, GL_FUNC_ADD };
+  glGetIntegerv(GL_BLEND_EQUATION_RGB, &equation[0]);
+  glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &equation[1]);
+  state->vtkglBlendEquation(GL_FUNC_ADD);
   this->ColorTexture->Activate();
   this->DepthTexture->Activate();
   this->Quad->Program->SetUniformi("octorayColor", this->ColorTexture->GetTextureUnit());
@@ -404,6 +409,7 @@ bool vtkOctreeCompositor::Draw(vtkOpenGLRenderWindow* window)
   this->Quad->Render();
   this->DepthTexture->Deactivate();
   this->ColorTexture->Deactivate();
+  state->vtkglBlendEquationSeparate(static_cast<unsigned int>(equation[0]), static_cast<unsigned int>(equation[1]));
   return true;
 }
 

@@ -215,7 +215,7 @@ void vtkOctreeVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
   else if (input && input->GetNumberOfPoints() > 0) // nothing to draw is not an error
   {
-    this->Internals->RenderOctree(ren, vol, window, input);
+    this->Internals->RenderOutsidePeeling(ren, vol, window, input);
   }
 
   // What the frame cost, for VTK's level-of-detail and interactive-rate

@@ -2,13 +2,19 @@
 
 #include "vtkCamera.h"
 #include "vtkDataSet.h"
+#include "vtkDualDepthPeelingPass.h"
+#include "vtkInformation.h"
+#include "vtkInformationObjectBaseVectorKey.h"
 #include "vtkMath.h"
+#include "vtkOpenGLRenderPass.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLState.h"
 #include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 #include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
 
 #include <octoray/DepthSignature.h>
 #include <octoray/Engine.h>
@@ -106,6 +112,67 @@ void vtkOctreeVolumeMapper::vtkInternals::RenderOctree(
     vtkErrorWithObjectMacro(this->Self, "Could not compile the composite shader.");
   }
   this->Self->LastDrawSeconds = Now() - t0;
+}
+
+//------------------------------------------------------------------------------
+// Whether VTK's dual depth peeling of volumes (vtkRenderer's
+// UseDepthPeelingForVolumes, with translucent geometry in the scene; on in
+// ParaView's views) is drawing the volume: the pass is among the render
+// passes in the volume's keys.
+static bool InVolumePeeling(vtkInformation* keys)
+{
+  vtkInformationObjectBaseVectorKey* passes = vtkOpenGLRenderPass::RenderPasses();
+  for (int i = 0; keys && keys->Has(passes) && i < keys->Length(passes); ++i)
+  {
+    if (vtkDualDepthPeelingPass::SafeDownCast(keys->Get(passes, i)))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+//------------------------------------------------------------------------------
+// Dual depth peeling calls volume mappers inside its own framebuffer, once
+// or more a frame, where VTK's GPU ray caster casts between the peeled
+// layers through the pass's shader code; the octree's picture, drawn there,
+// came out garbled. Here it is drawn once a frame, as without peeling, into
+// the framebuffer that the pass composites its layers onto (the pass steps
+// out to it the same way to read the opaque depth): over the opaque
+// geometry, behind every translucent layer. Said once.
+void vtkOctreeVolumeMapper::vtkInternals::RenderOutsidePeeling(
+  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window, vtkDataSet* input)
+{
+  vtkInformation* keys = vol->GetPropertyKeys();
+  if (!InVolumePeeling(keys))
+  {
+    this->RenderOctree(ren, vol, window, input);
+    return;
+  }
+  this->WarnOnce("The renderer peels volumes with translucent geometry (UseDepthPeelingForVolumes; in ParaView, "
+                 "the view's Depth Peeling for Volumes), which the octree cannot join: it is drawn over the opaque "
+                 "geometry and behind every translucent layer. Turn volume peeling off to draw it in front of "
+                 "translucent geometry behind it.");
+  if (keys->GetMTime() == this->PeeledFrame)
+  {
+    return; // drawn in this frame's first peel
+  }
+  this->PeeledFrame = keys->GetMTime();
+  vtkOpenGLState* state = window->GetState();
+  GLint peelingFramebuffer = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &peelingFramebuffer);
+  state->PopDrawFramebufferBinding();
+  {
+    int width = 0, height = 0, x0 = 0, y0 = 0;
+    ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+    vtkOpenGLState::ScopedglViewport viewport(state);
+    vtkOpenGLState::ScopedglScissor scissor(state);
+    state->vtkglViewport(x0, y0, width, height);
+    state->vtkglScissor(x0, y0, width, height);
+    this->RenderOctree(ren, vol, window, input);
+  }
+  state->PushDrawFramebufferBinding();
+  state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<unsigned int>(peelingFramebuffer));
 }
 
 //------------------------------------------------------------------------------

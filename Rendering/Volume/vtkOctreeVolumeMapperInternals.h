@@ -50,6 +50,7 @@ public:
   }
 
   void RenderOctree(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window, vtkDataSet* input);
+  void RenderOutsidePeeling(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* window, vtkDataSet* input);
   Step Acquire();
   Step PrepareOctree(vtkDataSet* input, vtkVolumeProperty* property);
   Step Build(const vtkOctreeInputHelper::Request& request);
@@ -95,6 +96,10 @@ public:
   std::set<std::string> InputWarnings;
   vtkMTimeType InputWarningMTime = 0;
   bool InteropUnusable = false; // said once; the host path from then on
+  // The frame of dual depth peeling the octree was last drawn in, by the
+  // MTime of the volume's keys, to which the peeling pass adds itself at
+  // the start of each frame (RenderOutsidePeeling).
+  vtkMTimeType PeeledFrame = 0;
 
   // The last picture and what it was traced from.
   octoray::Image Image;
