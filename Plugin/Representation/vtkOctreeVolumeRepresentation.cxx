@@ -273,20 +273,22 @@ int vtkOctreeVolumeRepresentation::RequestData(
   {
     this->CacheInput(vtkDataObject::GetData(inputVector[0], 0), ranks);
   }
-  // Data split over ranks: every rank builds its octree in the cube around
-  // the global bounds (and, with LeafDepth set, at the same depth), so the
-  // ranks' voxels align and depth compositing reproduces the one-rank
-  // picture. RequestData runs on every rank of the pipeline update (whatever
-  // each rank holds, also nothing or an undrawable type), so the reduction
-  // is collective. On one rank the mapper takes the piece's own bounds.
+  // Every rank builds its octree in the cube around the bounds of the whole
+  // data (and, with LeafDepth set, at the same depth), so the ranks' voxels
+  // align and depth compositing reproduces the one-rank picture; one rank
+  // takes the data's bounds too, not those of the points it draws (an
+  // image's voxels above the background), whose cube put an image split
+  // over ranks on a shifted grid. RequestData runs on every rank of the
+  // pipeline update (whatever each rank holds, also nothing or an
+  // undrawable type), so the reduction is collective.
   double globalBounds[6];
-  vtkMath::UninitializeBounds(globalBounds);
+  std::copy_n(this->DataBounds, 6, globalBounds);
   if (ranks > 1)
   {
     ReduceBoundsOverRanks(this->DataBounds, globalBounds);
   }
   this->Mapper->SetRootBounds(globalBounds);
-  std::copy_n(ranks > 1 ? globalBounds : this->DataBounds, 6, this->WholeBounds);
+  std::copy_n(globalBounds, 6, this->WholeBounds);
 
   return this->Superclass::RequestData(request, inputVector, outputVector);
 }

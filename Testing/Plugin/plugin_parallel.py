@@ -10,8 +10,10 @@ usage: plugin_parallel.py PLUGIN DATA_FILE READER OUTPUT.png
 
 READER: the proxy to read DATA_FILE with, by its XML name (e.g.
 OctorayParticleReader); "open" takes what OpenDataFile picks (File > Open),
-which --expect-reader checks. A missing DATA_FILE fails the test and says
-that `make data` fetches it.
+which --expect-reader checks; "Wavelet" (DATA_FILE "-") is ParaView's
+source, an image that it splits over the ranks by extent, drawn with
+--image-background as its background. A missing DATA_FILE fails the test and
+says that `make data` fetches it.
 
 1. The user's script, as written: Show, SetRepresentationType, SaveScreenshot
    with ParaView's defaults. It must not fail on any rank (it crashed rank 1
@@ -54,11 +56,12 @@ parser.add_argument("--expect-array", action="append", default=[],
 parser.add_argument("--shade", action="store_true", help="Phong shading (normals)")
 parser.add_argument("--leaf-depth", type=int, default=6)
 parser.add_argument("--unit-distance", type=float)
+parser.add_argument("--image-background", type=float, help="the Octree Volume's ImageBackground")
 parser.add_argument("--centre", action="store_true",
                     help="translate the data's centre to the origin (Transform filter)")
 args = parser.parse_args()
 
-if not os.path.isfile(args.data):
+if args.reader != "Wavelet" and not os.path.isfile(args.data):
     print(f"FAILED: the test data {args.data} is missing; `make data` fetches it "
           "(Data/External: from Debian packages, not committed)")
     sys.exit(1)
@@ -72,6 +75,8 @@ if ranks != args.ranks:
 LoadPlugin(args.plugin, remote=False, ns=globals())
 if args.reader == "open":
     r = OpenDataFile(args.data)
+elif args.reader == "Wavelet":
+    r = Wavelet()
 else:
     r = getattr(servermanager.sources, args.reader)(**{
         "OctorayParticleReader": {"FileName": args.data},
@@ -95,6 +100,10 @@ if args.centre:
     r.Transform.Translate = [-0.5 * (b[0] + b[1]), -0.5 * (b[2] + b[3]), -0.5 * (b[4] + b[5])]
 d = Show(r)
 d.SetRepresentationType("Octree Volume")
+if args.image_background is not None:
+    ColorBy(d, ("POINTS", "RTData"))
+    d.ImageBackground = args.image_background
+    d.LeafDepth = args.leaf_depth
 plain = os.path.splitext(args.output)[0] + "_default_camera.png"
 SaveScreenshot(plain)
 if not os.path.isfile(plain):
