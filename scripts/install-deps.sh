@@ -41,8 +41,9 @@ packages=(
   llvm-14 lld-14
   # reader benchmarks compare against pandas (pyarrow engine when present)
   python3-pandas
-  # independent reference values for the DICOM tests
-  python3-pydicom
+  # independent reference values for the DICOM tests; TIFF slices of every
+  # pixel type for the slice reader's tests
+  python3-pydicom python3-tifffile
   # make report: plots, and SSIM from an independent implementation
   python3-matplotlib python3-skimage
 )

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 
 namespace fs = std::filesystem;
@@ -22,44 +23,56 @@ namespace
 {
 using namespace OIIO;
 
-// The VTK type a picture's pixels are kept in: their own for 8- and 16-bit
-// integers, else float; and back.
+// The VTK type a picture's pixels are kept in, and its name: their own,
+// read as they are stored (OpenImageIO would scale integers to 0..1 in
+// float, and round doubles: int32 2147483647 came back as 1.0, uint32
+// 4000000001 as 0.931); half floats as float.
+struct PixelType
+{
+  TypeDesc::BASETYPE Stored;
+  int Kept;
+  const char* Name;
+};
+constexpr PixelType kPixelTypes[] = {
+  { TypeDesc::UINT8, VTK_UNSIGNED_CHAR, "uint8" },
+  { TypeDesc::INT8, VTK_SIGNED_CHAR, "int8" },
+  { TypeDesc::UINT16, VTK_UNSIGNED_SHORT, "uint16" },
+  { TypeDesc::INT16, VTK_SHORT, "int16" },
+  { TypeDesc::UINT32, VTK_UNSIGNED_INT, "uint32" },
+  { TypeDesc::INT32, VTK_INT, "int32" },
+  { TypeDesc::UINT64, VTK_UNSIGNED_LONG_LONG, "uint64" },
+  { TypeDesc::INT64, VTK_LONG_LONG, "int64" },
+  { TypeDesc::FLOAT, VTK_FLOAT, "float" },
+  { TypeDesc::DOUBLE, VTK_DOUBLE, "double" },
+};
+
 int VTKTypeOf(TypeDesc format)
 {
-  switch (format.basetype)
+  for (const PixelType& t : kPixelTypes)
   {
-    case TypeDesc::UINT8:
-      return VTK_UNSIGNED_CHAR;
-    case TypeDesc::UINT16:
-      return VTK_UNSIGNED_SHORT;
-    case TypeDesc::INT16:
-      return VTK_SHORT;
-    default:
-      return VTK_FLOAT;
+    if (t.Stored == format.basetype)
+    {
+      return t.Kept;
+    }
   }
+  return VTK_FLOAT; // half
+}
+
+const PixelType& PixelTypeOf(int vtkType)
+{
+  const PixelType* end = std::end(kPixelTypes);
+  const PixelType* found = std::find_if(std::begin(kPixelTypes), end, [&](const PixelType& t) { return t.Kept == vtkType; });
+  return found != end ? *found : PixelTypeOf(VTK_FLOAT);
 }
 
 TypeDesc FormatOf(int vtkType)
 {
-  return vtkType == VTK_UNSIGNED_CHAR ? TypeDesc::UINT8
-    : vtkType == VTK_UNSIGNED_SHORT   ? TypeDesc::UINT16
-    : vtkType == VTK_SHORT            ? TypeDesc::INT16
-                                      : TypeDesc::FLOAT;
+  return PixelTypeOf(vtkType).Stored;
 }
 
 const char* TypeName(int vtkType)
 {
-  switch (vtkType)
-  {
-    case VTK_UNSIGNED_CHAR:
-      return "uint8";
-    case VTK_UNSIGNED_SHORT:
-      return "uint16";
-    case VTK_SHORT:
-      return "int16";
-    default:
-      return "float";
-  }
+  return PixelTypeOf(vtkType).Name;
 }
 
 const char* ChannelName(int c)

@@ -424,6 +424,25 @@ def test_fill_single_slice_and_equal_spacing(tmp_path):
     assert out.GetNumberOfPoints() == 27
 
 
+@pytest.mark.parametrize("dtype", [np.int8, np.int32, np.uint32, np.float64])
+def test_tiff_slices_keep_their_pixel_type(tmp_path, dtype):
+    """Integer and double TIFF slices are read as they are stored, in the
+    VTK type of theirs: OpenImageIO's float scaled integers to 0..1 and
+    rounded doubles (int32 2147483647 came back as 1.0)."""
+    import tifffile
+    info = np.iinfo(dtype) if np.issubdtype(dtype, np.integer) else np.finfo(dtype)
+    values = np.array([[info.max, info.min + 1, 5], [16777217 % int(info.max), 0, 3]], dtype)
+    if dtype == np.float64:
+        values = np.array([[1e300, 0.1, 1.0000000001], [-2.5, 0.0, 3.0]])
+    for k in range(2):
+        tifffile.imwrite(os.path.join(str(tmp_path), "s%d.tif" % k), values + dtype(k))
+    r, out, msgs = reader_for(DirectoryName=str(tmp_path))
+    assert r.GetErrorMessage() == ""
+    got = stack_of(r)
+    assert got.dtype == dtype
+    assert (got == np.stack([values + dtype(k) for k in range(2)])).all(), got
+
+
 # --- errors ----------------------------------------------------------------
 
 def test_error_missing_slice_in_pattern(tmp_path):
