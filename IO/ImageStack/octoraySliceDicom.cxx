@@ -119,6 +119,22 @@ bool DecodePixels(const gdcm::Image& img, DicomSlice& s, std::string& error)
   return Rescale(img, buffer, count, s, error);
 }
 
+// The value of a text element without its padding; "" where it is missing.
+std::string TextOf(const gdcm::DataSet& data, const gdcm::Tag& tag)
+{
+  if (!data.FindDataElement(tag) || !data.GetDataElement(tag).GetByteValue())
+  {
+    return std::string();
+  }
+  const gdcm::ByteValue* value = data.GetDataElement(tag).GetByteValue();
+  std::string text(value->GetPointer(), value->GetLength());
+  while (!text.empty() && (text.back() == '\0' || text.back() == ' '))
+  {
+    text.pop_back();
+  }
+  return text;
+}
+
 // File f as slice s of a stack of `files` files whose first slice (null
 // for the first itself) it must match in size and type.
 bool ReadSlice(const std::string& f, const DicomSlice* first, size_t files, DicomSlice& s,
@@ -161,6 +177,9 @@ bool ReadSlice(const std::string& f, const DicomSlice* first, size_t files, Dico
       " frames; a series of several files must have one frame per file";
     return false;
   }
+  const gdcm::DataSet& data = reader.GetFile().GetDataSet();
+  s.HasOrigin = data.FindDataElement(gdcm::Tag(0x0020, 0x0032));
+  s.Series = TextOf(data, gdcm::Tag(0x0020, 0x000e));
   const double* o = img.GetOrigin();
   const double* dc = img.GetDirectionCosines();
   const double* sp = img.GetSpacing();

@@ -27,7 +27,9 @@ struct DicomSlice
   std::vector<float> Values;      // grey: stored value * slope + intercept
   std::vector<unsigned char> RGB; // or 8-bit colour
   double Origin[3], Row[3], Col[3], Spacing[3];
-  double Position = 0; // along the stack's normal (octoraySliceChecks.h)
+  bool HasOrigin = false; // Image Position (Patient), (0020,0032): GDCM gives 0 where it is missing
+  std::string Series;     // Series Instance UID, (0020,000E); "" where missing
+  double Position = 0;    // along the stack's normal (octoraySliceChecks.h)
 };
 
 // The stack's dimensions from the first file's header alone (reading stops

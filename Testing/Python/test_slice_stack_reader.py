@@ -252,6 +252,72 @@ def test_dicom_series_out_of_order(tmp_path, data_dir):
     np.testing.assert_allclose(array(r.GetOutput(), "Scalars")[sel], between[jj, ii], rtol=1e-5, atol=1e-3)
 
 
+def ct5n_copy(tmp_path, data_dir, change=None):
+    """CT5N's five slices copied into a folder; change(name, dataset) may
+    edit each with pydicom first (returning False leaves a file out)."""
+    src = os.path.join(data_dir, "DICOM", "CT5N")
+    folder = os.path.join(str(tmp_path), "ct")
+    os.makedirs(folder)
+    for name in sorted(os.listdir(src)):
+        d = pydicom.dcmread(os.path.join(src, name))
+        if change is None or change(name, d) is not False:
+            d.save_as(os.path.join(folder, name))
+    return folder
+
+
+def test_dicom_slice_without_position_is_named(tmp_path, data_dir):
+    """GDCM puts a slice without Image Position (Patient) at 0, which
+    stacked it out of order without a word."""
+    def drop(name, d):
+        if name == "2693.dcm":
+            del d.ImagePositionPatient
+    folder = ct5n_copy(tmp_path, data_dir, drop)
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert r.GetErrorMessage() == ("DICOM slice '%s' has no Image Position (Patient) (0020,0032), so its place "
+                                   "in the stack is unknown" % os.path.join(folder, "2693.dcm"))
+
+
+def test_dicom_two_series_in_a_folder_are_named(tmp_path, data_dir):
+    """Two series in one folder were interleaved into one volume."""
+    def other_series(name, d):
+        if name in ("2062.dcm", "2392.dcm"):
+            d.SeriesInstanceUID = "1.2.3.4.5"
+    folder = ct5n_copy(tmp_path, data_dir, other_series)
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert "belong to two series (Series Instance UID " in r.GetErrorMessage()
+    assert "'1.2.3.4.5'" in r.GetErrorMessage() and "2062.dcm" in r.GetErrorMessage()
+    assert out.GetNumberOfPoints() == 0
+
+
+def test_dicom_slice_of_another_pixel_spacing_is_named(tmp_path, data_dir):
+    def wider(name, d):
+        if name == "3023.dcm":
+            d.PixelSpacing = [0.6, 0.6]
+    folder = ct5n_copy(tmp_path, data_dir, wider)
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert r.GetErrorMessage() == ("DICOM slice '%s' has a pixel spacing of 0.6 x 0.6 but slice '%s' has "
+                                   "0.488281 x 0.488281; a stack needs one pixel spacing"
+                                   % (os.path.join(folder, "3023.dcm"), os.path.join(folder, "2062.dcm")))
+
+
+def test_dicom_gap_names_its_slices(tmp_path, data_dir):
+    """A slice missing from a series: a warning names the slices around the
+    widest gap and how far the mean spacing puts slices from their places."""
+    folder = ct5n_copy(tmp_path, data_dir, lambda name, d: name != "2693.dcm")
+    r, out, msgs = reader_for(DirectoryName=folder)
+    assert r.GetErrorMessage() == ""
+    z = {name: float(pydicom.dcmread(os.path.join(folder, name)).ImagePositionPatient[2])
+         for name in os.listdir(folder)}
+    around = sorted(z, key=z.get)
+    k = int(np.argmax(np.diff([z[n] for n in around])))
+    mean = (z[around[-1]] - z[around[0]]) / 3
+    worst = max(abs(z[n] - z[around[0]] - i * mean) for i, n in enumerate(around))
+    assert len(msgs.warnings) == 1, msgs.warnings
+    assert ("to 5 (between '%s' and '%s': a slice missing there?); the volume uses the mean, %g, which puts slices "
+            "up to %g from their positions" % (os.path.join(folder, around[k]), os.path.join(folder, around[k + 1]),
+                                               mean, worst)) in msgs.warnings[0], msgs.warnings
+
+
 def test_dicom_single_ct_slice(data_dir):
     path = os.path.join(data_dir, "DICOM", "CT_small", "CT_small.dcm")
     r, out, msgs = reader_for(Files=[path], BackgroundRange=(-5000, 0))
