@@ -289,7 +289,10 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::B
     this->Input.PointCloud(request, [self](double progress) { self->UpdateProgress(progress); });
   if (view.count == 0)
   {
+    // Not again at every frame (a 256^3 image was scanned each time) until
+    // the input or its settings change.
     this->WarnNothingToDraw(request);
+    this->Input.RememberFailure(request);
     return Step::Stop;
   }
   self->UpdateProgress(0.5);

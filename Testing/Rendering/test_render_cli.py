@@ -228,6 +228,29 @@ def test_a_failed_build_is_said_once_until_the_input_changes():
     assert len(said) == 1 and mapper.GetNumberOfBuilds() == 1
 
 
+def test_an_image_with_nothing_to_draw_is_not_scanned_again():
+    """An image with every voxel at or below the background is said once
+    and not scanned again at every frame (each frame scanned it, with 45
+    progress events at 256^3), until the image changes."""
+    from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    image = vtk.vtkImageData()
+    image.SetDimensions(32, 32, 32)
+    values = numpy_to_vtk(np.zeros(32 ** 3, np.float32), deep=1)
+    image.GetPointData().SetScalars(values)
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputData(image)
+    window, said = offscreen_view(mapper)
+    window.Render()
+    progress = []
+    mapper.AddObserver("ProgressEvent", lambda caller, event: progress.append(1))
+    assert_said_once(window, said, "Every voxel of the image is at or below the background 0; nothing to draw.")
+    assert progress == [] and mapper.GetNumberOfBuilds() == 0
+    vtk_to_numpy(values)[:100] = 5.0
+    values.Modified()
+    window.Render()
+    assert progress and mapper.GetNumberOfBuilds() == 1 and mapper.GetNumberOfOctreePoints() == 100
+
+
 def test_a_short_point_array_is_refused_by_name():
     """A point array with fewer tuples than points (the engine reads one a
     point) is refused, once, naming the array; nothing is drawn, nothing
