@@ -452,11 +452,14 @@ void vtkOctreeVolumeRepresentation::AttachPiece(vtkInformation* inInfo)
   vtkAlgorithmOutput* producerPort = vtkPVRenderView::GetPieceProducer(inInfo, this);
   vtkDataSet* piece =
     producerPort ? vtkDataSet::SafeDownCast(producerPort->GetProducer()->GetOutputDataObject(0)) : nullptr;
-  if (!this->BackendReported)
+  // Once per server, by its first rank: say which backend draws, so a
+  // server without a GPU tells the user it uses the CPU (it was said by
+  // every rank for every display).
+  static bool backendReported = false;
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (!backendReported && (!controller || controller->GetLocalProcessId() == 0))
   {
-    // Once per representation and process: say which backend draws, so a
-    // server without a GPU tells the user it uses the CPU.
-    this->BackendReported = true;
+    backendReported = true;
     if (!vtkOctreeVolumeMapper::IsCudaAvailable())
     {
       vtkOutputWindowDisplayText("Octree Volume: no usable CUDA device on this server; "

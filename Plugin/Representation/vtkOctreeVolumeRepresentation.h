@@ -278,7 +278,6 @@ protected:
   bool Cropping = false;
   double CroppingOrigin[3] = { 0, 0, 0 };
   double CroppingScale[3] = { 1, 1, 1 };
-  bool BackendReported = false;
   bool OrderWarningIssued = false;
 
   // The preset (SetPreset): its own property, whose settings follow
