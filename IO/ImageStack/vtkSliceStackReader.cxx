@@ -110,7 +110,12 @@ int vtkSliceStackReader::FillOutputPortInformation(int port, vtkInformation* inf
 void vtkSliceStackReader::Fail(const std::string& message)
 {
   this->ErrorMessage = message;
-  vtkErrorMacro(<< message);
+  if (message != this->SaidError || this->GetMTime() != this->SaidErrorMTime)
+  {
+    this->SaidError = message;
+    this->SaidErrorMTime = this->GetMTime();
+    vtkErrorMacro(<< message);
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -139,6 +144,11 @@ int vtkSliceStackReader::RequestInformation(
   // picture's page count), so that pipelines downstream (and ParaView) see a
   // whole extent before any pixel is read.
   this->ErrorMessage.clear();
+  vtkInformation* info = outputVector->GetInformationObject(1);
+  // Where the slices cannot be listed, an empty volume: the pipeline then
+  // does not add that it has no extent to the error.
+  const int none[6] = { 0, -1, 0, -1, 0, -1 };
+  info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), none, 6);
   std::vector<std::string> files;
   if (!this->ListSlices(files))
   {
@@ -155,7 +165,6 @@ int vtkSliceStackReader::RequestInformation(
     return 0;
   }
   const int extent[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
-  vtkInformation* info = outputVector->GetInformationObject(1);
   info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   info->Set(vtkDataObject::SPACING(), this->Spacing, 3);
   info->Set(vtkDataObject::ORIGIN(), this->Origin, 3);

@@ -239,6 +239,10 @@ protected:
   bool GenerateParticles = true;
   bool IsDICOM = false;
   std::string ErrorMessage;
+  // The last error said and the reader's MTime then: ParaView asks for the
+  // information and the data of one update, and each failed alike.
+  std::string SaidError;
+  vtkMTimeType SaidErrorMTime = 0;
   std::vector<std::string> SliceFiles;
   // The files' signature when GetMTime() last looked and when it changed;
   // the outputs of the last successful update, which a failed update leaves

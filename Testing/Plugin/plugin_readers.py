@@ -91,6 +91,19 @@ strided.UpdatePipeline()
 check("DICOM series: a stride of 2 thins the particles",
       0 < strided.GetDataInformation(0).GetNumberOfPoints() < dicom_points, True)
 
+# A folder without slices: the reader says so once, and nothing else (in one
+# update ParaView asks for the information and then the data: the error was
+# said twice, and VTK added that the volume output had no whole extent).
+from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow  # noqa: E402
+empty = tempfile.mkdtemp()
+paraview_window, said = vtkOutputWindow.GetInstance(), vtkStringOutputWindow()
+vtkOutputWindow.SetInstance(said)
+OctoraySliceFolderReader(DirectoryName=empty).UpdatePipeline()
+vtkOutputWindow.SetInstance(paraview_window)
+check("empty folder: the reader's error, said once",
+      said.GetOutput().count("the directory '%s' has no image or DICOM files" % empty), 1)
+check("empty folder: no word of a whole extent", "whole extent" in said.GetOutput(), False)
+
 if failures:
     print("FAILED:", ", ".join(failures))
     sys.exit(1)
