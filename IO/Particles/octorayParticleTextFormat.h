@@ -160,6 +160,37 @@ inline std::vector<std::pair<std::string, int>> SplitTokens(const char* b, const
   return tokens;
 }
 
+// A line of decimal commas ("1,5 2,5 3,5", read as the six fields 1 5 2 5
+// 3 5, as a comma parts fields): two or more fields parted by blanks, each
+// of digits with one comma between two of them and no point; the first such
+// comma, or null. Fields parted by blanks and commas alike ("1.5\t2.5,3.5")
+// are not.
+inline const char* DecimalComma(const char* b, const char* e)
+{
+  const char* first = nullptr;
+  int fields = 0;
+  for (const char* p = SkipBlanks(b, e); p < e && *p != '#'; p = SkipBlanks(p, e), ++fields)
+  {
+    const char* comma = nullptr;
+    for (; p < e && !IsBlank(*p); ++p)
+    {
+      const bool between = *p == ',' && comma == nullptr && p > b && p + 1 < e &&
+        std::isdigit(static_cast<unsigned char>(p[-1])) && std::isdigit(static_cast<unsigned char>(p[1]));
+      if (!(between || std::isdigit(static_cast<unsigned char>(*p)) || *p == '-' || *p == '+'))
+      {
+        return nullptr;
+      }
+      comma = between ? p : comma;
+    }
+    if (!comma)
+    {
+      return nullptr;
+    }
+    first = first ? first : comma;
+  }
+  return fields >= 2 ? first : nullptr;
+}
+
 inline std::string Lower(std::string s)
 {
   for (char& c : s)
@@ -315,6 +346,16 @@ inline std::string NotText(
     return Where(file, lineNo, at - p + 1) + "a NUL byte (at byte offset " + std::to_string(at - data) +
       "): this is a binary file, not particle text";
   }
+  // A CR is a blank where it ends a CRLF line; one inside a line ends the
+  // lines of classic Mac OS files, which would otherwise run together into
+  // one line of many columns.
+  const char* last = e > p && e[-1] == '\r' ? e - 1 : e;
+  if (const void* cr = std::memchr(p, '\r', static_cast<size_t>(last - p)))
+  {
+    return Where(file, lineNo, static_cast<const char*>(cr) - p + 1) +
+      "a carriage return inside a line: lines that end in CR alone (classic Mac OS) are not read; convert the "
+      "file to LF or CRLF line ends";
+  }
   return "";
 }
 
@@ -343,6 +384,13 @@ inline bool ReadPrologueLine(Prologue& r, const char* data, const char* p, const
   }
   r.FirstData = static_cast<size_t>(p - data);
   r.FirstDataLine = lineNo;
+  if (const char* comma = DecimalComma(q, e))
+  {
+    r.Error = Where(file, lineNo, comma - p + 1) +
+      "a comma between digits in a line whose fields are parted by blanks: a decimal comma? Write decimals "
+      "with a point (1.5); a comma parts fields";
+    return false;
+  }
   const char* binary = FirstBinaryByte(q, e);
   if (binary != e)
   {
@@ -431,7 +479,9 @@ inline const char* Expected(Sink target, Real v)
     case Sink::R:
     case Sink::G:
     case Sink::B:
-      return v < 0 || v > 255 ? "a colour value 0-255" : nullptr;
+      // Whole numbers: 0-1 colours (Open3D's .xyzrgb) rounded to black.
+      return v < 0 || v > 255 || v != std::floor(v) ? "a whole colour value 0-255 (scale 0-1 colours by 255)"
+                                                     : nullptr;
     case Sink::Reflectivity:
       return v < 0 || v > 1 ? "a reflectivity 0-1" : nullptr;
     case Sink::Refraction:

@@ -132,7 +132,7 @@ class Failures(unittest.TestCase):
             f.write("0 0 0 10 20 30\n\n# between\n1 1 1 10 272 30\n")
         status, _, err = run("stats", bad, "--backend", "cpu")
         self.assertEqual(status, 1)
-        self.assertIn(bad + ":4:10: expected a colour value 0-255 for column 5 (g), found '272'", err)
+        self.assertIn(bad + ":4:10: expected a whole colour value 0-255 (scale 0-1 colours by 255) for column 5 (g), found '272'", err)
 
     def test_formats_it_does_not_read(self):
         """A PCD file and a gzip-compressed particle file are named for what

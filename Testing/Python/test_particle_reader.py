@@ -152,8 +152,19 @@ def test_double_precision_and_no_vertices(tmp_path):
     ("1 2 3\n4 5 -inf\n", "p.txt:2:5: expected a finite number for column 3 (z), found '-inf'"),
     ("1 2 3\n4,,6\n", "p.txt:2:3: expected a number for column 2 after the comma, found an empty field"),
     ("1 2 3 0 0 0\n1 2 3 0 256 0\n",
-     "p.txt:2:9: expected a colour value 0-255 for column 5 (g), found '256'"),
+     "p.txt:2:9: expected a whole colour value 0-255 (scale 0-1 colours by 255) for column 5 (g), found '256'"),
     ("1 2 3 0 0 0 1.5 0\n", "p.txt:1:13: expected a reflectivity 0-1 for column 7 (reflectivity), found '1.5'"),
+    # Open3D's .xyzrgb: colours 0-1, which read as whole numbers were black.
+    ("1 2 3 0.2 0.7 0.5\n",
+     "p.txt:1:7: expected a whole colour value 0-255 (scale 0-1 colours by 255) for column 4 (r), found '0.2'"),
+    # Classic Mac OS line ends ran together into one line of six columns.
+    ("1 2 3\r4 5 6\r", "p.txt:1:6: a carriage return inside a line: lines that end in CR alone (classic Mac OS) "
+     "are not read; convert the file to LF or CRLF line ends"),
+    ("# x y z\r1 2 3\r", "p.txt:1:8: a carriage return inside a line"),
+    # A decimal comma was read as a field separator: 1 5 2 5 3 5.
+    ("1,5 2,5 3,5\n", "p.txt:1:2: a comma between digits in a line whose fields are parted by blanks: a decimal "
+     "comma? Write decimals with a point (1.5); a comma parts fields"),
+    ("1.5, 2.5, 3.5\n1,2,3\n", None),  # commas part fields, with or without blanks
     ("1 2\n", "p.txt:1:1: expected 3 (x y z), 4 (x y z scalar), 6 (x y z r g b) or 8"),
     ("# x y q\n1 2 3\n", None),  # not a header (no z): a comment, then 3 columns
     ("# x y z x\n1 2 3 4\n", "p.txt:1:1: bad header line: column 'x' is named twice"),
