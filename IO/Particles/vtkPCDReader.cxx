@@ -38,7 +38,7 @@ struct Sink
   {
     Points,
     Colors,
-    Values // float (or Real for the points) arrays, component by component
+    Values // arrays of numbers, component by component
   };
   Kind What = Values;
   std::vector<int> Fields; // Points / Normals: 3 fields of one value; else one field
@@ -53,13 +53,43 @@ struct Arrays
   vtkSmartPointer<vtkDataArray> Points;
   vtkSmartPointer<vtkUnsignedCharArray> Colors;
   vtkSmartPointer<vtkFloatArray> Normals;
-  vtkSmartPointer<vtkFloatArray> Intensity;
-  std::vector<vtkSmartPointer<vtkFloatArray>> Extras;
+  vtkSmartPointer<vtkDataArray> Intensity;
+  std::vector<vtkSmartPointer<vtkDataArray>> Extras;
 };
 
+// The VTK type that holds a field's values as they are stored: a float
+// array made a double timestamp of 1700000000.1 read 1700000000, a uint32
+// label of 16777217 read 16777216.
+int VTKTypeOf(const Field& f)
+{
+  switch (f.Type == 'F' ? f.Size : f.Type == 'I' ? -f.Size : 16 + f.Size)
+  {
+    case 8:
+      return VTK_DOUBLE;
+    case -1:
+      return VTK_SIGNED_CHAR;
+    case -2:
+      return VTK_SHORT;
+    case -4:
+      return VTK_INT;
+    case -8:
+      return VTK_LONG_LONG;
+    case 17:
+      return VTK_UNSIGNED_CHAR;
+    case 18:
+      return VTK_UNSIGNED_SHORT;
+    case 20:
+      return VTK_UNSIGNED_INT;
+    case 24:
+      return VTK_UNSIGNED_LONG_LONG;
+    default:
+      return VTK_FLOAT;
+  }
+}
+
 // Points from x y z; Colors from rgba or rgb (4 bytes, one value); Normals
-// from normal_x normal_y normal_z; every other field but padding a float
-// array of its name (Intensity for intensity).
+// from normal_x normal_y normal_z; every other field but padding an array of
+// its name and its own type (Intensity for intensity).
 Arrays MakeArrays(const Header& h, bool real64)
 {
   Arrays a;
@@ -106,7 +136,7 @@ Arrays MakeArrays(const Header& h, bool real64)
     {
       continue;
     }
-    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    auto array = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(VTKTypeOf(fd)));
     array->SetName(fd.Name == "intensity" ? "Intensity" : fd.Name.c_str());
     a.Sinks.push_back({ Sink::Values, { static_cast<int>(f) }, array, static_cast<int>(fd.Count) });
     if (fd.Name == "intensity")
@@ -122,7 +152,7 @@ Arrays MakeArrays(const Header& h, bool real64)
 }
 
 // Converts points [i0, i0 + m) of the fields of s into its array.
-void Convert(const Header& h, const Body& body, const Sink& s, size_t i0, size_t m, bool real64)
+void Convert(const Header& h, const Body& body, const Sink& s, size_t i0, size_t m)
 {
   const size_t comps = static_cast<size_t>(s.Components);
   if (s.What == Sink::Colors)
@@ -142,15 +172,10 @@ void Convert(const Header& h, const Body& body, const Sink& s, size_t i0, size_t
     const Source& src = body.Sources[k];
     const unsigned char* base =
       src.Base + i0 * src.Stride + (perField ? 0 : c * static_cast<size_t>(fd.Size));
-    if (s.What == Sink::Points && real64)
+    switch (s.Array->GetDataType())
     {
-      double* out = static_cast<vtkDoubleArray*>(s.Array.Get())->GetPointer(0);
-      Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
-    }
-    else
-    {
-      float* out = static_cast<vtkFloatArray*>(s.Array.Get())->GetPointer(0);
-      Gather(fd.Type, fd.Size, base, src.Stride, m, out + i0 * comps + c, comps);
+      vtkTemplateMacro(Gather(fd.Type, fd.Size, base, src.Stride, m,
+        static_cast<VTK_TT*>(s.Array->GetVoidPointer(0)) + i0 * comps + c, comps));
     }
   }
 }
@@ -346,7 +371,7 @@ bool vtkPCDReader::ReadPoints(const char* data, size_t size, vtkPolyData* output
     const size_t m = std::min(ChunkPoints, n - i0);
     for (const Sink& s : arrays.Sinks)
     {
-      Convert(h, body, s, i0, m, real64);
+      Convert(h, body, s, i0, m);
     }
     if (!this->ContinueReading(
           decoded + (0.95 - decoded) * static_cast<double>(i0 + m) / static_cast<double>(n)))

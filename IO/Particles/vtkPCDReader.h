@@ -11,17 +11,17 @@
  * itself: no PCL, no third-party library.
  *
  * Output (each only where the file has it):
- * - points from x y z (float, or double with SetOutputPointsPrecision;
- *   the other arrays are float whatever the file stores); one vertex cell
- *   per point (GenerateVertices);
+ * - points from x y z (float, or double with SetOutputPointsPrecision);
+ *   one vertex cell per point (GenerateVertices);
  * - `Colors`: unsigned char RGB from a packed `rgb` field, RGBA from
  *   `rgba` (4 bytes, float or uint32, 0xAARRGGBB), the active scalars;
  * - `Normals`: from `normal_x normal_y normal_z`, the active normals;
- * - `Intensity`: from `intensity` (float), the active scalars when there
- *   are no colours;
+ * - `Intensity`: from `intensity`, the active scalars when there are no
+ *   colours;
  * - every other field (`curvature`, `label`, a descriptor such as `fpfh`
- *   with COUNT 33, ...) as a float array of its own name with COUNT
- *   components; padding fields `_` are skipped;
+ *   with COUNT 33, ...) as an array of its own name with COUNT components;
+ *   padding fields `_` are skipped. `Intensity` and these keep the type the
+ *   file stores (F8 a double array, U4 an unsigned int one, ...);
  * - field data: `SkippedPointCount`, `PCDWidth`, `PCDHeight` and
  *   `PCDViewpoint` (tx ty tz qw qx qy qz).
  *

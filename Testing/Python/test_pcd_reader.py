@@ -92,9 +92,8 @@ def decode(path):
         table = np.loadtxt(raw[pos:].decode("ascii").splitlines(), dtype=np.float64, ndmin=2)
         assert table.shape == (n, sum(counts))
         col = 0
-        for name, t, c in zip(names, types, counts):
-            values = table[:, col:col + c]
-            fields[name] = values.astype(np.float32) if t == "F" else values
+        for name, dt, c in zip(names, dtypes, counts):
+            fields[name] = table[:, col:col + c].astype(dt)
             col += c
     elif form == "binary":
         record = np.dtype([(name if name != "_" else "_%d" % k, dt, (c,))
@@ -168,8 +167,10 @@ def compare(path):
     for name, values in fields.items():
         if name in done:
             continue
+        # In the type the file stores: nothing rounded to float.
         got = array(out, "Intensity" if name == "intensity" else name)
-        want = values.astype(np.float32)[keep]
+        want = values[keep]
+        assert got.dtype == want.dtype, (name, got.dtype, want.dtype)
         assert np.array_equal(got.reshape(want.shape), want, equal_nan=True), name
     return header, fields, out, keep
 
@@ -235,6 +236,30 @@ def test_package_clouds(name):
         fd = out.GetFieldData()
         assert fd.GetArray("PCDWidth").GetValue(0) == int(header["WIDTH"][0])
         assert fd.GetArray("PCDHeight").GetValue(0) == int(header["HEIGHT"][0])
+
+
+@pytest.mark.parametrize("form", ["ascii", "binary"])
+def test_fields_keep_their_type(tmp_path, form):
+    """A double timestamp and a uint32 label as the file stores them (read
+    into float arrays, 1700000000.1 became 1700000000 and 16777217 became
+    16777216)."""
+    stamps = np.array([1700000000.0, 1700000000.1, 1700000000.2])
+    labels = np.array([16777217, 4000000001, 7], np.uint32)
+    head = ("VERSION 0.7\nFIELDS x y z timestamp label\nSIZE 4 4 4 8 4\nTYPE F F F F U\nCOUNT 1 1 1 1 1\n"
+            "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA %s\n" % form)
+    path = os.path.join(str(tmp_path), "typed.pcd")
+    with open(path, "wb") as f:
+        f.write(head.encode())
+        for k in range(3):
+            if form == "ascii":
+                f.write(("%d 0 0 %.10f %d\n" % (k, stamps[k], labels[k])).encode())
+            else:
+                f.write(struct.pack("<fffdI", k, 0, 0, stamps[k], labels[k]))
+    compare(path)
+    r, out, messages = read(path)
+    assert array(out, "timestamp").dtype == np.float64 and array(out, "label").dtype == np.uint32
+    assert array(out, "timestamp").tolist() == stamps.tolist()
+    assert array(out, "label").tolist() == labels.tolist()
 
 
 def test_errors_from_python(tmp_path):

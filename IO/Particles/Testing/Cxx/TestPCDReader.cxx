@@ -435,9 +435,13 @@ void CheckRich(vtkPolyData* out, const Values& v, const std::vector<size_t>& nan
     return;
   }
   CHECK(pd->GetArray("fpfh")->GetNumberOfComponents() == 5);
+  // Each in the type the file stores, its values exact (into float arrays
+  // they were rounded: a uint32 label of 4294967295 read 4294967296).
   const char* scalars[] = { "label", "ring", "flag", "delta", "tiny", "offset", "big", "ubig",
     "time" };
   const int scalarIndex[] = { 12, 13, 14, 15, 16, 17, 18, 19, 20 };
+  const int scalarType[] = { VTK_UNSIGNED_INT, VTK_UNSIGNED_SHORT, VTK_UNSIGNED_CHAR, VTK_SHORT, VTK_SIGNED_CHAR,
+    VTK_INT, VTK_LONG_LONG, VTK_UNSIGNED_LONG_LONG, VTK_DOUBLE };
   size_t bad = 0;
   vtkIdType o = 0;
   for (size_t p = 0; p < n; ++p)
@@ -469,12 +473,12 @@ void CheckRich(vtkPolyData* out, const Values& v, const std::vector<size_t>& nan
     for (int s = 0; s < 9; ++s)
     {
       vtkDataArray* a = pd->GetArray(scalars[s]);
-      if (!a || a->GetDataType() != VTK_FLOAT)
+      if (!a || a->GetDataType() != scalarType[s])
       {
         ++bad;
         continue;
       }
-      const double want = static_cast<double>(static_cast<float>(v[p][scalarIndex[s]]));
+      const double want = v[p][scalarIndex[s]];
       if (a->GetComponent(o, 0) != want)
       {
         std::cerr << form << ": point " << p << " " << scalars[s] << " = " << a->GetComponent(o, 0)
