@@ -76,7 +76,8 @@ TEST(CommandLine, EachWrongArgumentIsNamed)
   EXPECT_EQ(o.Error({ "--depth", "22" }), "--depth expects a whole number from 0 to 21, not '22'");
   EXPECT_EQ(o.Error({ "--depth", "2.5" }), "--depth expects a whole number from 0 to 21, not '2.5'");
   EXPECT_EQ(o.Error({ "--backend", "gpu" }), "--backend expects one of cpu, cuda, not 'gpu'");
-  EXPECT_EQ(o.Error({ "--size", "640x360x2" }), "--size expects a size WxH such as 1920x1080, not '640x360x2'");
+  EXPECT_EQ(o.Error({ "--size", "640x360x2" }),
+    "--size expects a size WxH such as 1920x1080, at most 16384 a side, not '640x360x2'");
   EXPECT_EQ(o.depth, 10) << "a refused value leaves the option as it was";
   EXPECT_EQ(o.backend, "cpu");
 }

@@ -505,6 +505,36 @@ def test_bad_cuts_are_errors_naming_the_option(tmp_path, cut, expected):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.parametrize("option, expected", [
+    (("--size", "100000x100000"), "argument --size: at most 16384 pixels a side (OpenGL's usual limit), got "
+     "'100000x100000'"),
+    (("--zoom", "0"), "argument --zoom: expected a number above 0, got '0'"),
+    (("--zoom", "-1"), "argument --zoom: expected a number above 0, got '-1'"),
+    (("--zoom", "nan"), "argument --zoom: expected a finite number, got 'nan'"),
+    (("--azimuth", "nan"), "argument --azimuth: expected a finite number, got 'nan'"),
+    (("--elevation", "inf"), "argument --elevation: expected a finite number, got 'inf'"),
+])
+def test_bad_view_options_are_errors_naming_the_option(tmp_path, option, expected):
+    """A size past OpenGL's textures flooded its errors and crashed; --zoom 0
+    or -1 were ignored; NaN angles or zoom made the camera singular."""
+    r = run(PARTICLES, "-o", str(tmp_path / "x.png"), *option)
+    assert r.returncode == 2 and expected in r.stderr, r.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("", "-o names a folder, {tmp}/; give the PNG file to write"),
+    ("out.jpg", "-o writes a PNG picture; name the file .png, got {tmp}/out.jpg"),
+    ("missing/out.png", "-o: no folder {tmp}/missing to write out.png into"),
+])
+def test_a_bad_output_is_said_before_reading(tmp_path, name, expected):
+    """Said first, not after reading and drawing: a folder got VTK's "Ran
+    out of disk space", a .jpg name PNG bytes."""
+    r = run(PARTICLES, "-o", str(tmp_path) + "/" + name)
+    assert r.returncode == 2 and expected.format(tmp=tmp_path) in r.stderr, r.stderr
+    assert "load:" not in r.stdout and "reading" not in r.stderr
+
+
 def test_render_dicom_folder(tmp_path):
     out = tmp_path / "ct.png"
     r = run(os.path.join(DATA, "DICOM", "CT_small"), "-o", str(out), "--backend", "cpu", "--size", "96x96",

@@ -141,7 +141,7 @@ public:
   // A picture size, "WxH", both above 0.
   CommandLine& Size(const char* name, int& width, int& height)
   {
-    return Option(name, "a size WxH such as 1920x1080", [&width, &height](const std::string& v) {
+    return Option(name, "a size WxH such as 1920x1080, at most 16384 a side", [&width, &height](const std::string& v) {
       return ParseSize(v, width, height);
     });
   }
@@ -234,12 +234,16 @@ public:
     return true;
   }
 
-  // A picture size "WxH", both above 0, that is the whole of `text`.
+  // A picture size "WxH", both above 0 and at most kMaxSide (as the Python
+  // tool's, OpenGL's usual limit; 40000x40000 ended in a bare
+  // std::bad_alloc), that is the whole of `text`.
+  static constexpr int kMaxSide = 16384;
   static bool ParseSize(const std::string& text, int& width, int& height)
   {
     int w = 0, h = 0;
     char rest = 0;
-    if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w <= 0 || h <= 0)
+    if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w <= 0 || h <= 0 || w > kMaxSide ||
+      h > kMaxSide)
     {
       return false;
     }

@@ -57,6 +57,9 @@ MODES = {
 ProgressBar = scene.ProgressBar
 
 
+MAX_SIDE = 16384
+
+
 def parse_size(text):
     try:
         w, h = (int(v) for v in text.lower().split("x"))
@@ -64,7 +67,30 @@ def parse_size(text):
         raise argparse.ArgumentTypeError("expected WIDTHxHEIGHT, e.g. 1920x1080, got %r" % text)
     if w <= 0 or h <= 0:
         raise argparse.ArgumentTypeError("the size must be positive, got %r" % text)
+    if max(w, h) > MAX_SIDE:
+        # Past it OpenGL refused the window's textures, with a flood of its
+        # errors and a crash.
+        raise argparse.ArgumentTypeError("at most %d pixels a side (OpenGL's usual limit), got %r" % (MAX_SIDE, text))
     return w, h
+
+
+def finite(text):
+    """A finite number (NaN made the camera's matrices singular)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected a number, got %r" % text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError("expected a finite number, got %r" % text)
+    return value
+
+
+def positive(text):
+    """A finite number above 0 (--zoom 0 and -1 were ignored)."""
+    value = finite(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError("expected a number above 0, got %r" % text)
+    return value
 
 
 def parser():
@@ -87,9 +113,9 @@ def parser():
                    help="auto: for points without normals, fitted to the octree's voxels (the mapper's "
                         "EstimateNormals), for a slice stack's particles the reader's gradient; voxels: "
                         "fitted to the voxels; pcl: PCL's, 16 neighbours; none: the voxels' occupancy")
-    p.add_argument("--azimuth", type=float, default=0.0)
-    p.add_argument("--elevation", type=float, default=0.0)
-    p.add_argument("--zoom", type=float, default=1.0)
+    p.add_argument("--azimuth", type=finite, default=0.0)
+    p.add_argument("--elevation", type=finite, default=0.0)
+    p.add_argument("--zoom", type=positive, default=1.0)
     p.add_argument("--depth", type=int, default=0, help="octree leaf level (0: automatic)")
     p.add_argument("--range", type=int, nargs=2, default=None, metavar=("FIRST", "LAST"),
                    help="the slice numbers a pattern of slice names reads (default: every number it names "
@@ -112,6 +138,19 @@ def parser():
                    help="keep the box between these fractions (0..1) of the drawn bounds along x, y and z "
                         "(the mapper's cropping to the sub-volume), e.g. 0 1 0.5 1 0 1 for the half of larger y")
     return p
+
+
+def check_output(p, path):
+    """-o names a PNG file in a folder that exists, said before anything is
+    read or drawn (a folder got VTK's "Ran out of disk space", a .jpg name
+    PNG bytes)."""
+    if os.path.isdir(path):
+        p.error("-o names a folder, %s; give the PNG file to write" % path)
+    if not path.lower().endswith(".png"):
+        p.error("-o writes a PNG picture; name the file .png, got %s" % path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        p.error("-o: no folder %s to write %s into" % (folder, os.path.basename(path)))
 
 
 def check_cuts(p, args):
@@ -149,6 +188,7 @@ def main(argv=None):
 
     if not (os.path.exists(args.input) or "%" in args.input):
         p.error("no such file or folder: %s" % args.input)
+    check_output(p, args.output)
     if args.preset is not None and not octoray.vtkOctreeVolumePresets.HasPreset(args.preset):
         p.error("unknown preset %r; known presets: %s"
                 % (args.preset, octoray.vtkOctreeVolumePresets.GetNamesAsString()))
