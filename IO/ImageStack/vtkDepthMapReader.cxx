@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 vtkStandardNewMacro(vtkDepthMapReader);
@@ -166,6 +167,24 @@ int vtkDepthMapReader::RequestData(
     this->Fail(std::string(this->FileName) +
       ": the focal lengths fx and fy must be set and positive (pixels); got fx=" +
       std::to_string(this->FocalLengthX) + ", fy=" + std::to_string(this->FocalLengthY));
+    return 0;
+  }
+  // Settings under which no pixel can be a point: said, not read as an
+  // image of invalid pixels.
+  std::ostringstream range;
+  if (!(this->DepthScale > 0) || !std::isfinite(this->DepthScale))
+  {
+    range << this->FileName << ": DepthScale must be finite and positive (output units per stored value); got "
+          << this->DepthScale;
+  }
+  else if (!(this->MinimumDepth < this->MaximumDepth))
+  {
+    range << this->FileName << ": MinimumDepth (" << this->MinimumDepth << ") must lie below MaximumDepth ("
+          << this->MaximumDepth << ")";
+  }
+  if (!range.str().empty())
+  {
+    this->Fail(range.str());
     return 0;
   }
   std::vector<float> depth;

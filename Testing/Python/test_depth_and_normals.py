@@ -100,6 +100,17 @@ def test_depth_errors(tmp_path, data_dir):
     assert r.GetErrorMessage() == ("colour image '%s' is 2x2 but depth image '%s' is 371x250"
                                    % (small, depth_path))
     assert out.GetNumberOfPoints() == 0
+    # Settings under which no pixel can be a point (they read as an image of
+    # invalid pixels, without a word).
+    for options, message in (
+            ({"DepthScale": -0.001}, "DepthScale must be finite and positive (output units per stored value); "
+                                     "got -0.001"),
+            ({"DepthScale": float("nan")}, "DepthScale must be finite and positive (output units per stored "
+                                           "value); got nan"),
+            ({"MinimumDepth": 5.0, "MaximumDepth": 1.0}, "MinimumDepth (5) must lie below MaximumDepth (1)")):
+        r, out, msgs = depth_reader(depth_path, Intrinsics=(1.0, 1.0, 0.0, 0.0), **options)
+        assert r.GetErrorMessage() == depth_path + ": " + message
+        assert len(msgs.errors) == 1 and out.GetNumberOfPoints() == 0
 
 
 def polydata(xyz):
