@@ -47,7 +47,7 @@ def square_file(name, slabs):
                 for j in range(40):
                     f.write("%g %g %g %g" % (slab * 1.5 + i / 40.0, j / 40.0, (i % 2) * 0.05, slab))
                     f.write(" %g\n" % (slab + 5.0) if left_only else "\n")
-    return OctorayParticleReader(FileName=path)
+    return OctorayParticleReader(FileNames=[path])
 
 
 view = GetActiveViewOrCreate("RenderView")

@@ -71,7 +71,7 @@ def check_cut(what, span, full, lo, hi, voxel):
 
 
 # ---- Points: the column, side-on (looking along +y), z up the picture.
-reader = OctorayParticleReader(FileName=column)
+reader = OctorayParticleReader(FileNames=[column])
 split = RedistributeDataSet(Input=reader)
 d = Show(split, view)
 d.SetRepresentationType("Octree Volume")

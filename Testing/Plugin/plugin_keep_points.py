@@ -17,7 +17,7 @@ LoadPlugin(plugin, remote=False, ns=globals())
 
 import octoray  # noqa: E402  (the build's Python package, on PYTHONPATH)
 
-cloud = servermanager.Fetch(OctorayParticleReader(FileName=data + "/Particles/lidar_simple.particles"))
+cloud = servermanager.Fetch(OctorayParticleReader(FileNames=[data + "/Particles/lidar_simple.particles"]))
 source = TrivialProducer()
 source.GetClientSideObject().SetOutput(cloud)
 view = CreateView("RenderView")

@@ -78,9 +78,7 @@ if args.reader == "open":
 elif args.reader == "Wavelet":
     r = Wavelet()
 else:
-    r = getattr(servermanager.sources, args.reader)(**{
-        "OctorayParticleReader": {"FileName": args.data},
-    }.get(args.reader, {"FileNames": [args.data]}))
+    r = getattr(servermanager.sources, args.reader)(FileNames=[args.data])
 print("reader:", r.GetXMLName())
 if args.expect_reader and r.GetXMLName() != args.expect_reader:
     print(f"FAILED: the reader is {r.GetXMLName()}, expected {args.expect_reader}")

@@ -100,7 +100,7 @@ check("OpenDataFile(x y z .xyz)", OpenDataFile(files["x y z .xyz"][0]).GetXMLNam
 check("OpenDataFile(.txt.gz)", OpenDataFile(txtgz).GetXMLName(), "CSVReader")
 
 # The particle reader on the .txt.
-r = OctorayParticleReader(FileName=txt)
+r = OctorayParticleReader(FileNames=[txt])
 r.UpdatePipeline()
 check(".txt read: points", r.GetDataInformation().GetNumberOfPoints(), 1065)
 check(".txt read: Colors", "Colors" in r.PointData.keys(), True)

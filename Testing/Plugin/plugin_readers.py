@@ -22,7 +22,7 @@ def check(what, got, expected):
 
 # The particle reader by name and through File > Open's reader factory.
 particles = os.path.join(data, "Particles", "lidar_simple.particles")
-r = OctorayParticleReader(FileName=particles)
+r = OctorayParticleReader(FileNames=[particles])
 r.UpdatePipeline()
 check("particles: points", r.GetDataInformation().GetNumberOfPoints(), 1065)
 check("particles: Colors array", "Colors" in r.PointData.keys(), True)
@@ -90,6 +90,32 @@ strided = OctoraySliceStackReader(FileNames=files, Stride=[2, 2, 1])
 strided.UpdatePipeline()
 check("DICOM series: a stride of 2 thins the particles",
       0 < strided.GetDataInformation(0).GetNumberOfPoints() < dicom_points, True)
+
+# A numbered series of particle files (and of PCD files), as File > Open
+# groups them: one reader, each file a time step (a list of files was
+# refused: "This property requires 1 values").
+series = tempfile.mkdtemp()
+names = []
+for k in range(3):
+    names.append(os.path.join(series, "p_%03d.particles" % k))
+    with open(names[-1], "w") as f:
+        f.write("".join("%d %d 0\n" % (i, k) for i in range(10 + k)))
+t = OpenDataFile(names)
+check("particle series: the reader", t.GetXMLName(), "OctorayParticleReader")
+check("particle series: its time steps", list(t.TimestepValues), [0.0, 1.0, 2.0])
+check("particle series: each step's points",
+      [(t.UpdatePipeline(time), t.GetDataInformation().GetNumberOfPoints())[1] for time in (0.0, 1.0, 2.0)],
+      [10, 11, 12])
+pcds = []
+for k in range(2):
+    pcds.append(os.path.join(series, "c_%d.pcd" % k))
+    with open(pcds[-1], "w") as f:
+        f.write("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH %d\nHEIGHT 1\n"
+                "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA ascii\n" % (3 + k, 3 + k))
+        f.write("".join("%d 0 0\n" % i for i in range(3 + k)))
+c = OctorayPCDReader(FileNames=pcds)
+check("PCD series: each step's points",
+      [(c.UpdatePipeline(time), c.GetDataInformation().GetNumberOfPoints())[1] for time in c.TimestepValues], [3, 4])
 
 # A folder without slices: the reader says so once, and nothing else (in one
 # update ParaView asks for the information and then the data: the error was

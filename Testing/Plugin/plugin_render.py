@@ -15,7 +15,7 @@ plugin, data, output = sys.argv[1:4]
 baseline = sys.argv[4] if len(sys.argv) > 4 else None
 LoadPlugin(plugin, remote=True, ns=globals())
 
-reader = OctorayParticleReader(FileName=data + "/Particles/lidar_simple.particles")
+reader = OctorayParticleReader(FileNames=[data + "/Particles/lidar_simple.particles"])
 # The data split over the ranks (a pass-through on one rank).
 split = RedistributeDataSet(Input=reader)
 view = CreateView("RenderView")

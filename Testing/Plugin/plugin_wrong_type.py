@@ -71,7 +71,7 @@ def child(plugin, data, workdir):
             f.write(header + "\n")
             for i in range(20):
                 f.write("%d 0 %d 1%s\n" % (i, len(readers), " 2" if "extra" in header else ""))
-        readers.append(OctorayParticleReader(FileName=path))
+        readers.append(OctorayParticleReader(FileNames=[path]))
     blocks = GroupDatasets(Input=readers)
     display = Show(blocks, view)
     display.SetRepresentationType("Octree Volume")
