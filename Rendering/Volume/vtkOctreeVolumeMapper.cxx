@@ -3,6 +3,7 @@
 
 #include "vtkCellArray.h"
 #include "vtkCommand.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -189,6 +190,15 @@ vtkDataSet* vtkOctreeVolumeMapper::UpdatedInput()
     this->GetInputAlgorithm()->Update();
   }
   vtkDataSet* input = this->GetInput();
+  if (!input && vtkCompositeDataSet::SafeDownCast(this->GetInputDataObject(0, 0)))
+  {
+    // Said once, not "No input." at every frame.
+    this->Internals->WarnOnce(std::string("The input is composite data (a ") +
+      this->GetInputDataObject(0, 0)->GetClassName() +
+      "), which the mapper does not draw: merge its blocks into one point set first (vtkMergeBlocks, or "
+      "vtkAppendDataSets); ParaView's Octree Volume representation does so itself.");
+    return nullptr;
+  }
   if (!input)
   {
     vtkErrorMacro("No input.");

@@ -186,6 +186,24 @@ def test_a_scalar_array_the_input_lacks_is_said_once(mode):
     assert (window_pixels(window) == plain).all()
 
 
+def test_composite_data_is_refused_once_by_name():
+    """Composite data through a pipeline connection: one warning naming it
+    and the filter that merges it (it was "No input." at every frame)."""
+    group = vtk.vtkMultiBlockDataGroupFilter()
+    group.AddInputData(random_cloud(100))
+    mapper = octoray.vtkCPUOctreeVolumeMapper()
+    mapper.SetInputConnection(group.GetOutputPort())
+    window, said = offscreen_view(mapper)
+    executive = vtk.vtkStringOutputWindow()  # the pipeline's own complaint, kept off the test's output
+    previous = vtk.vtkOutputWindow.GetInstance()
+    vtk.vtkOutputWindow.SetInstance(executive)
+    try:
+        assert_said_once(window, said, "The input is composite data (a vtkMultiBlockDataSet), which the mapper "
+                         "does not draw: merge its blocks into one point set first (vtkMergeBlocks")
+    finally:
+        vtk.vtkOutputWindow.SetInstance(previous)
+
+
 def test_a_rectilinear_grid_is_refused_by_name():
     """SetInputData takes point sets and images: a rectilinear grid, which
     vtkVolumeMapper has an overload for, is an error naming its type, as any
