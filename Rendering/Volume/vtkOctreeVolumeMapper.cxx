@@ -406,8 +406,8 @@ void vtkOctreeVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DepthCue: " << this->DepthCue << "\n";
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "ImageBackground: " << this->ImageBackground << "\n";
-  os << indent << "FillBetweenSlices: " << this->FillBetweenSlices << "\n";
-  os << indent << "ImageGradientNormals: " << (this->ImageGradientNormals ? "on" : "off") << "\n";
+  os << indent << "FillBetweenSlices: " << (this->FillBetweenSlices ? "On" : "Off") << "\n";
+  os << indent << "ImageGradientNormals: " << (this->ImageGradientNormals ? "On" : "Off") << "\n";
   os << indent << "ReflectivityArrayName: "
      << (this->ReflectivityArrayName ? this->ReflectivityArrayName : "(none)") << "\n";
   os << indent << "RefractionArrayName: "
