@@ -54,7 +54,7 @@ vtkOctreeBackend::Status vtkOctreeBackend::Acquire(int requested, int cudaDevice
   }
   if (wanted == vtkOctreeVolumeMapper::BACKEND_CUDA)
   {
-    return this->ToCPU("the CUDA backend is not available (" + why + "); using the CPU backend");
+    return this->ToCPU(why + "; using the CPU backend");
   }
   this->LastMessage = "cannot create the octree engine: " + why;
   return Status::Failed;
@@ -75,6 +75,11 @@ vtkOctreeBackend::Status vtkOctreeBackend::Failed(const char* what, const std::s
 vtkOctreeBackend::Status vtkOctreeBackend::ToCPU(const std::string& why)
 {
   this->CudaFailed = true;
+  this->LastMessage = why;
+  if (this->Current && this->Backend == vtkOctreeVolumeMapper::BACKEND_CPU)
+  {
+    return Status::KeptCPU; // a CUDA request on a machine without CUDA: nothing to rebuild
+  }
   try
   {
     this->Make(vtkOctreeVolumeMapper::BACKEND_CPU, -1);
@@ -91,12 +96,13 @@ vtkOctreeBackend::Status vtkOctreeBackend::ToCPU(const std::string& why)
 //------------------------------------------------------------------------------
 void vtkOctreeBackend::Make(int backend, int cudaDevice)
 {
-  this->Current.reset();
-  this->Backend = -1;
-  this->Device = -1;
-  ++this->Replacements;
+  // Made before the engine it replaces goes: an engine that cannot be had
+  // leaves the current one, and its octree, as they were.
   const bool cuda = backend == vtkOctreeVolumeMapper::BACKEND_CUDA;
-  this->Current = octoray::CreateEngine(cuda ? octoray::Backend::CUDA : octoray::Backend::CPU, cudaDevice);
+  std::unique_ptr<octoray::Engine> made =
+    octoray::CreateEngine(cuda ? octoray::Backend::CUDA : octoray::Backend::CPU, cudaDevice);
+  ++this->Replacements;
+  this->Current = std::move(made);
   this->Backend = backend;
   this->Device = cudaDevice;
   this->EngineDescription = this->Current->Description();

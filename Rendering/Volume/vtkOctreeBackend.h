@@ -29,6 +29,7 @@ public:
   {
     Ready,         // the engine is the one asked for (or AUTO's choice)
     SwitchedToCPU, // CUDA could not be had or failed: a CPU engine took over (warn)
+    KeptCPU,       // CUDA was asked for but cannot be had: the CPU engine drawing stays, octree and all (warn)
     Failed         // no engine at all, or the CPU engine failed (error)
   };
 

@@ -62,6 +62,9 @@ vtkOctreeVolumeMapper::vtkInternals::Step vtkOctreeVolumeMapper::vtkInternals::R
       vtkWarningWithObjectMacro(this->Self, << this->Backend.Message());
       this->Input.Forget();
       return Step::Retry;
+    case vtkOctreeBackend::Status::KeptCPU:
+      vtkWarningWithObjectMacro(this->Self, << this->Backend.Message());
+      return Step::Done;
     default:
       vtkErrorWithObjectMacro(this->Self, << this->Backend.Message());
       this->Input.Forget();

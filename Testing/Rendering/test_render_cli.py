@@ -186,6 +186,23 @@ def test_a_scalar_array_the_input_lacks_is_said_once(mode):
     assert (window_pixels(window) == plain).all()
 
 
+def test_a_cuda_request_without_cuda_keeps_the_cpu_octree():
+    """Asking for CUDA where it cannot be had says why once and keeps the
+    CPU engine drawing, octree and all (it made a new CPU engine and built
+    again; the message said "not available" twice)."""
+    if octoray.vtkOctreeVolumeMapper.IsCudaAvailable():
+        pytest.skip("CUDA is available here")
+    mapper = octoray.vtkOctreeVolumeMapper()
+    mapper.SetInputData(random_cloud(1000))
+    window, said = offscreen_view(mapper)
+    window.Render()
+    assert mapper.GetNumberOfBuilds() == 1 and said == []
+    mapper.SetRequestedBackendToCuda()
+    assert_said_once(window, said, "octoray: the CUDA backend is not available: ")
+    assert said[0].rstrip().endswith("; using the CPU backend") and said[0].count("not available") == 1, said
+    assert mapper.GetNumberOfBuilds() == 1 and mapper.GetLastUsedBackendName() == "CPU"
+
+
 def test_composite_data_is_refused_once_by_name():
     """Composite data through a pipeline connection: one warning naming it
     and the filter that merges it (it was "No input." at every frame)."""
