@@ -120,6 +120,26 @@ inline const char* ParseNumber(const char* p, const char* e, Real& v)
   return r.ptr;
 }
 
+// What a token that ParseNumber refused should have been: a number, or,
+// where it is one beyond Real's range ("1e39" in single precision, "1e-400"
+// in double), a number within that range.
+template <typename Real>
+inline const char* NumberExpected(const char* p, const char* e)
+{
+  double d = 0.0;
+  const char* b = p < e && *p == '+' ? p + 1 : p;
+  const auto r = std::from_chars(b, e, d, std::chars_format::general);
+  const bool number = r.ptr != b && (r.ptr == e || EndsToken(*r.ptr)) &&
+    (r.ec == std::errc::result_out_of_range || (r.ec == std::errc() && std::is_same<Real, float>::value));
+  if (!number)
+  {
+    return "a number";
+  }
+  return std::is_same<Real, float>::value
+    ? "a number within single precision's range (OutputPointsPrecision double reads more)"
+    : "a number within double precision's range";
+}
+
 // The token at p for an error message (Printable: at most 40 characters,
 // bytes that are not printable ASCII as \xNN). Looks at no more than 41
 // bytes, whatever the token's length (a 10 GB line of NUL bytes).
@@ -509,7 +529,7 @@ inline bool ParseFields(
       Real v;
       const char* after = ParseNumber(q, e, v);
       const Column& col = pro.Columns[field];
-      if (const char* expected = after ? Expected(col.Target, v) : "a number")
+      if (const char* expected = after ? Expected(col.Target, v) : NumberExpected<Real>(q, e))
       {
         problem = { tok, "expected " + std::string(expected) + " for column " + std::to_string(field + 1) +
             " (" + col.Name + "), found '" + TokenAt(tok, e) + "'" };

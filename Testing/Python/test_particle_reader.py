@@ -165,6 +165,9 @@ def test_double_precision_and_no_vertices(tmp_path):
     ("1,5 2,5 3,5\n", "p.txt:1:2: a comma between digits in a line whose fields are parted by blanks: a decimal "
      "comma? Write decimals with a point (1.5); a comma parts fields"),
     ("1.5, 2.5, 3.5\n1,2,3\n", None),  # commas part fields, with or without blanks
+    # A number beyond single precision was "expected a number".
+    ("1 2 3\n1e39 0 0\n", "p.txt:2:1: expected a number within single precision's range (OutputPointsPrecision "
+     "double reads more) for column 1 (x), found '1e39'"),
     ("1 2\n", "p.txt:1:1: expected 3 (x y z), 4 (x y z scalar), 6 (x y z r g b) or 8"),
     ("# x y q\n1 2 3\n", None),  # not a header (no z): a comment, then 3 columns
     ("# x y z x\n1 2 3 4\n", "p.txt:1:1: bad header line: column 'x' is named twice"),
