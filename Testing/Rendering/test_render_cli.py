@@ -685,13 +685,6 @@ def test_points_at_one_place_show_their_voxel(tmp_path):
     assert not (drawn[0].any() or drawn[-1].any() or drawn[:, 0].any() or drawn[:, -1].any())
 
 
-def test_unwritable_picture_is_an_error(tmp_path):
-    out = tmp_path / "no-such-folder" / "x.png"
-    r = run(PARTICLES, "-o", str(out), "--backend", "cpu", "--size", "64x48")
-    assert r.returncode == 1
-    assert "error: %s: cannot write the picture: no folder %s" % (out, out.parent) in r.stderr
-    assert "wrote" not in r.stdout
-
 
 def test_render_pcd(tmp_path):
     """A .pcd file goes to vtkPCDReader: a binary PCD of a coloured 20 x 20
