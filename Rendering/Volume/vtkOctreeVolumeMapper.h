@@ -19,6 +19,9 @@
  *   viewport is read back so that rays stop there, and the picture
  *   (premultiplied RGBA) is drawn as a full-viewport quad that writes
  *   gl_FragDepth, so the octree hides and is hidden by other actors;
+ *   under dual depth peeling of volumes (UseDepthPeelingForVolumes, on in
+ *   ParaView) it is drawn once a frame onto what the peeling composites
+ *   over, behind every translucent layer, and said once;
  * - vtkVolumeProperty: shade on/off, ambient, diffuse, specular, specular
  *   power, the colour transfer function and scalar opacity on the active
  *   scalars; of several components, on the value the colour function's
