@@ -8,7 +8,8 @@ vtkStructuredGrid. Its display must offer "Octree Volume" (before, the
 representation type was refused without a word, though the warning for
 undrawable data named vtkStructuredGrid among what it draws), and its
 picture must be the picture of the same grid through Merge Blocks (an
-unstructured grid of the same points), pixel for pixel, coloured by RTData.
+unstructured grid of the same points), pixel for pixel, coloured by RTData;
+and ParaView must not warn of a property exposed twice.
 """
 import os
 import sys
@@ -44,7 +45,13 @@ def picture(source, name):
     return offered, d.Representation, screenshot_rgb(path)
 
 
+from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow  # noqa: E402
+paraview_window, said = vtkOutputWindow.GetInstance(), vtkStringOutputWindow()
+vtkOutputWindow.SetInstance(said)
 offered, shown, structured = picture(grid, "structured.png")
+vtkOutputWindow.SetInstance(paraview_window)
+check("the representation exposes each property once (%r)" % said.GetOutput().strip()[:300],
+      "already exists" not in said.GetOutput())
 check("Octree Volume is offered for a vtkStructuredGrid (%s)" % offered, "Octree Volume" in offered)
 check("and shown (%s)" % shown, shown == "Octree Volume")
 _, _, merged = picture(MergeBlocks(Input=grid), "merged.png")
