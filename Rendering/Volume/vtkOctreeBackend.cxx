@@ -89,7 +89,6 @@ vtkOctreeBackend::Status vtkOctreeBackend::ToCPU(const std::string& why)
     this->LastMessage = why + "; cannot create the CPU engine either: " + e.what();
     return Status::Failed;
   }
-  this->LastMessage = why;
   return Status::SwitchedToCPU;
 }
 
